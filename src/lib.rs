@@ -1,0 +1,2 @@
+//! rshape: consistency of frequency-response data with coprime-factor models.
+pub mod system;
