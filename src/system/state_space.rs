@@ -4,10 +4,9 @@ use super::polynomial::Polynomial;
 use super::transfer_function::TransferFunction;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use serde::{Deserialize, Serialize};
 
 /// A real continuous-time state-space model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct StateSpace {
     /// State matrix (n×n).
     pub a: DMatrix<f64>,

@@ -1,0 +1,7 @@
+//! Consistency of data with the perturbed factorization: per-datum envelopes and checks.
+pub mod check;
+pub mod envelope;
+pub mod noise_free;
+
+pub use check::{check, CheckReport, CheckRow};
+pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};

@@ -1,0 +1,136 @@
+//! Noise-free consistency at one frequency (Boulet & Francis 1998, Sec. IV-A).
+//!
+//! * Standard factorization, Theorem 2: the minimum-norm solution of `ΔW = U` (eq. (7)),
+//!   `Δ_i = U_i (W_i^*W_i)^{-1} W_i^*` (eq. (8)), with `U = Ñ − M̃Φ` and `W = [−I; −Φ]`.
+//!   Its norm is the smallest `|r(jω_i)|` that explains the datum.
+//! * Special factorization, Theorem 3: `F_L(P, Φ̂⁻¹) = r·X` with
+//!   `X = [0; M̃⁻¹] + [I; M̃⁻¹Ñ](Φ̂ − P₂₂)⁻¹ C M̃⁻¹`, `Φ̂ = ΦJ⁻¹`, `P₂₂ = C M̃⁻¹ Ñ`, and the
+//!   datum is consistent iff `|r|·σ_p(X) > 1`: the smallest `|r|` is `1/σ_p(X)` in closed
+//!   form (Schmidt–Mirsky, Theorem 7).
+
+use crate::model::FactorsAt;
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// Why a datum cannot be processed: the assumption that fails.
+#[derive(Debug, Clone, PartialEq)]
+pub enum AssumptionFailure {
+    /// `M̃(jω)` is singular (the factorization is not valid there).
+    MSingular,
+    /// A2: the datum `Φ` is singular.
+    DatumSingular,
+    /// `J(jω)` has a zero on its diagonal.
+    JSingular,
+    /// A5: `Φ̂ − P₂₂` is singular (the datum equals the nominal model in some direction).
+    A5,
+    /// The data are not square where the special factorization needs them to be.
+    NotSquare,
+}
+
+impl AssumptionFailure {
+    /// A one-line explanation with what to do.
+    pub fn message(&self) -> &'static str {
+        match self {
+            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the [model] entries",
+            Self::DatumSingular => "assumption A2 fails: the datum Φ is singular; remove this datum or check its columns",
+            Self::JSingular => "J(jω) has a zero on its diagonal: choose an input matrix J without zeros on the jω-axis",
+            Self::A5 => "assumption A5 fails: Φ̂ − C·M̃⁻¹·Ñ is singular (the datum equals the nominal model in some direction); the datum needs no perturbation there, remove it or add noise",
+            Self::NotSquare => "the special factorization (Theorem 3) needs square data (p = m)",
+        }
+    }
+}
+
+/// Relative threshold under which a smallest singular value counts as zero.
+const SINGULAR_RTOL: f64 = 1e-13;
+
+fn singular(a: &DMatrix<Complex64>) -> bool {
+    let sv = a.clone().svd(false, false).singular_values;
+    let max = sv.max();
+    !(sv.min() > SINGULAR_RTOL * max) || !max.is_finite()
+}
+
+/// Theorem 2, eq. (8): the minimum-norm `Δ_i` solving `Δ_i W_i = U_i`, returned with its norm.
+///
+/// Since `W^*W = I + Φ^*Φ` is Hermitian positive definite, `(W^*W)^{-1}` is applied through
+/// its Cholesky factor: `Δ = U L^{-*} L^{-1} W^*`, never an explicit inverse.
+pub fn min_norm_perturbation(
+    f: &FactorsAt,
+    phi: &DMatrix<Complex64>,
+) -> Result<(DMatrix<Complex64>, f64), AssumptionFailure> {
+    if singular(&f.m) {
+        return Err(AssumptionFailure::MSingular);
+    }
+    let m_in = phi.ncols();
+    let u = &f.n - &f.m * phi;
+    let gram = DMatrix::<Complex64>::identity(m_in, m_in) + phi.adjoint() * phi;
+    let chol = gram
+        .cholesky()
+        .expect("I + Φ*Φ is Hermitian positive definite");
+    // Z = U L^{-*}: solve L Zᴴ = Uᴴ.
+    let zh = chol.l().solve_lower_triangular(&u.adjoint()).expect("L has a positive diagonal");
+    let norm = zh.clone().svd(false, false).singular_values.max();
+    // Δ = Z L^{-1} W^*, with W^* = [−I  −Φ^*].
+    let y = chol.l().adjoint().solve_upper_triangular(&zh).expect("L has a positive diagonal").adjoint();
+    let p = phi.nrows();
+    let mut delta = DMatrix::zeros(p, m_in + p);
+    delta.view_mut((0, 0), (p, m_in)).copy_from(&(-&y));
+    delta.view_mut((0, m_in), (p, p)).copy_from(&(-(&y * phi.adjoint())));
+    Ok((delta, norm))
+}
+
+/// Theorem 2: the smallest `|r(jω)|` consistent with the datum, `‖Δ_i‖` of eq. (8).
+pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, AssumptionFailure> {
+    min_norm_perturbation(f, phi).map(|(_, n)| n)
+}
+
+/// The matrix `X` of Theorem 3, `F_L(P, Φ̂⁻¹) = r·X`, computed with LU solves.
+pub fn theorem3_x(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<DMatrix<Complex64>, AssumptionFailure> {
+    let p = phi.nrows();
+    if phi.ncols() != p || f.j.len() != p {
+        return Err(AssumptionFailure::NotSquare);
+    }
+    if singular(&f.m) {
+        return Err(AssumptionFailure::MSingular);
+    }
+    if singular(phi) {
+        return Err(AssumptionFailure::DatumSingular);
+    }
+    if f.j.iter().any(|j| j.norm() == 0.0 || !j.is_finite()) {
+        return Err(AssumptionFailure::JSingular);
+    }
+    let n = f.m.nrows();
+    // Φ̂ = Φ J⁻¹ (J diagonal).
+    let mut phi_hat = phi.clone();
+    for (k, jk) in f.j.iter().enumerate() {
+        let mut col = phi_hat.column_mut(k);
+        col /= *jk;
+    }
+    // [M̃⁻¹Ñ | M̃⁻¹] from one LU factorization of M̃.
+    let lu = f.m.clone().lu();
+    let mut rhs = DMatrix::zeros(n, p + n);
+    rhs.view_mut((0, 0), (n, p)).copy_from(&f.n);
+    rhs.view_mut((0, p), (n, n)).fill_with_identity();
+    let sol = lu.solve(&rhs).ok_or(AssumptionFailure::MSingular)?;
+    let minv_n = sol.columns(0, p).into_owned();
+    let minv = sol.columns(p, n).into_owned();
+    let p22 = &f.c * &minv_n;
+    let k = &phi_hat - &p22;
+    if singular(&k) {
+        return Err(AssumptionFailure::A5);
+    }
+    // Z = (Φ̂ − P₂₂)⁻¹ C M̃⁻¹
+    let z = k.lu().solve(&(&f.c * &minv)).ok_or(AssumptionFailure::A5)?;
+    let mut x = DMatrix::zeros(p + n, n);
+    x.view_mut((0, 0), (p, n)).copy_from(&z);
+    x.view_mut((p, 0), (n, n)).copy_from(&(minv + minv_n * z));
+    Ok(x)
+}
+
+/// Theorem 3: the smallest `|r(jω)|` consistent with the datum, `1/σ_p(X)`.
+pub fn r_min_special(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, AssumptionFailure> {
+    let x = theorem3_x(f, phi)?;
+    let p = phi.nrows();
+    let mut sv: Vec<f64> = x.svd(false, false).singular_values.iter().copied().collect();
+    sv.sort_by(|a, b| b.total_cmp(a));
+    Ok(1.0 / sv[p - 1])
+}

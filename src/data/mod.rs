@@ -1,0 +1,6 @@
+//! Measured frequency-response data: the FRF set and its CSV reader.
+pub mod frf;
+pub mod reader;
+
+pub use frf::FrfData;
+pub use reader::read_frf_csv;

@@ -1,0 +1,274 @@
+//! The TOML config: the nominal factorization, the bound `r`, the data file and the noise.
+//!
+//! ```toml
+//! name = "paper MIMO example"
+//! data = "paper_mimo.csv"            # relative to this file; --data overrides it
+//!
+//! [model]
+//! factorization = "standard"         # or "special"
+//! m = [[{ num = [1, 2], den = [1, 1] }, { num = [1, 3], den = [1, 2] }],
+//!      [0,                              { num = [1, 1], den = [1, 2] }]]
+//! n = [[{ num = [1], den = [1, 1] }, { num = [2], den = [1, 1] }, 0],
+//!      [0, { num = [1], den = [1, 3] }, { num = [2], den = [1, 2] }]]
+//!
+//! [r]
+//! num = [1e-8, 0.3]
+//! den = [1, 1]
+//! ```
+//!
+//! Unknown keys are errors (a typo must not be silently ignored).
+
+use super::factorization::Factorization;
+use crate::error::{Error, Result};
+use crate::system::TransferFunction;
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// One entry of a transfer-function matrix in the config: a number or `{num, den}`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum TfEntry {
+    /// A constant gain.
+    Constant(f64),
+    /// A rational transfer function, coefficients in descending powers of `s`.
+    Rational(RationalEntry),
+}
+
+/// `{ num = [...], den = [...] }`.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RationalEntry {
+    /// Numerator coefficients, descending powers of `s`.
+    pub num: Vec<f64>,
+    /// Denominator coefficients, descending powers of `s`.
+    pub den: Vec<f64>,
+}
+
+impl TfEntry {
+    fn to_tf(&self, what: &str) -> std::result::Result<TransferFunction, String> {
+        match self {
+            TfEntry::Constant(k) if k.is_finite() => Ok(TransferFunction::gain(*k)),
+            TfEntry::Constant(_) => Err(format!("{what}: coefficient is not finite")),
+            TfEntry::Rational(r) => {
+                if r.num.iter().chain(&r.den).any(|c| !c.is_finite()) {
+                    return Err(format!("{what}: a coefficient is not finite"));
+                }
+                if r.den.iter().all(|c| *c == 0.0) {
+                    return Err(format!("{what}: the denominator is zero"));
+                }
+                if r.num.is_empty() {
+                    return Err(format!("{what}: the numerator is empty; write [0] for zero"));
+                }
+                Ok(TransferFunction::new(r.num.clone(), r.den.clone()))
+            }
+        }
+    }
+}
+
+/// The `[model]` table.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSection {
+    /// `"standard"` (G = M̃⁻¹Ñ) or `"special"` (G = C·M̃⁻¹·Ñ·J).
+    pub factorization: super::FactorizationKind,
+    /// `M̃` as rows of entries (or use `m_diag`).
+    #[serde(default)]
+    pub m: Option<Vec<Vec<TfEntry>>>,
+    /// Diagonal of `M̃`, for modal models.
+    #[serde(default)]
+    pub m_diag: Option<Vec<TfEntry>>,
+    /// `Ñ` as rows of entries.
+    pub n: Vec<Vec<TfEntry>>,
+    /// `C` (special factorization only), rows of numbers.
+    #[serde(default)]
+    pub c: Option<Vec<Vec<f64>>>,
+    /// Diagonal of `J` (special factorization only); default all ones.
+    #[serde(default)]
+    pub j: Option<Vec<TfEntry>>,
+}
+
+/// The `[r]` table: the unit bounding the factor perturbations.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RSection {
+    /// Numerator coefficients, descending powers of `s`.
+    pub num: Vec<f64>,
+    /// Denominator coefficients, descending powers of `s`.
+    pub den: Vec<f64>,
+}
+
+/// The `[noise]` table.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoiseSection {
+    /// Global noise-disk radius `L_a` (eq. (5)), in the units of the data.
+    #[serde(default)]
+    pub radius: Option<f64>,
+}
+
+/// The whole file as written.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConfig {
+    /// Free-text name of the model.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Data file, relative to the config file.
+    #[serde(default)]
+    pub data: Option<PathBuf>,
+    /// The nominal factorization.
+    pub model: ModelSection,
+    /// The bound `r(s)`.
+    #[serde(default)]
+    pub r: Option<RSection>,
+    /// The noise model.
+    #[serde(default)]
+    pub noise: NoiseSection,
+}
+
+/// A loaded, validated config.
+#[derive(Debug, Clone)]
+pub struct Config {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// What was written.
+    pub raw: RawConfig,
+    /// The nominal factorization.
+    pub factorization: Factorization,
+    /// The configured bound `r`, if any.
+    pub r: Option<TransferFunction>,
+    /// The data file, resolved relative to the config.
+    pub data: Option<PathBuf>,
+}
+
+fn tf_rows(rows: &[Vec<TfEntry>], name: &str) -> std::result::Result<Vec<Vec<TransferFunction>>, String> {
+    let cols = rows.first().map_or(0, |r| r.len());
+    if rows.is_empty() || cols == 0 {
+        return Err(format!("[model] {name} is empty"));
+    }
+    rows.iter()
+        .enumerate()
+        .map(|(i, row)| {
+            if row.len() != cols {
+                return Err(format!(
+                    "[model] {name}: row {} has {} entries, row 1 has {cols}",
+                    i + 1,
+                    row.len()
+                ));
+            }
+            row.iter()
+                .enumerate()
+                .map(|(j, e)| e.to_tf(&format!("[model] {name}[{}][{}]", i + 1, j + 1)))
+                .collect()
+        })
+        .collect()
+}
+
+impl Config {
+    /// Reads and validates a config file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses config text; `path` is used for messages and to resolve the data file.
+    pub fn parse(text: &str, path: &Path) -> Result<Self> {
+        let err = |msg: String| Error::Config {
+            path: path.to_path_buf(),
+            msg,
+        };
+        let raw: RawConfig = toml::from_str(text).map_err(|e| {
+            let msg = e.message().to_string();
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            let msg = msg.replace('\n', " ");
+            match line {
+                Some(l) => err(format!("line {l}: {msg}")),
+                None => err(msg),
+            }
+        })?;
+        let factorization = Self::build_factorization(&raw.model).map_err(err)?;
+        let r = match &raw.r {
+            Some(r) => {
+                let tf = TfEntry::Rational(RationalEntry {
+                    num: r.num.clone(),
+                    den: r.den.clone(),
+                })
+                .to_tf("[r]")
+                .map_err(err)?;
+                Some(tf)
+            }
+            None => None,
+        };
+        if let Some(la) = raw.noise.radius {
+            if !(la.is_finite() && la >= 0.0) {
+                return Err(err(format!(
+                    "[noise] radius = {la}: must be a finite number ≥ 0"
+                )));
+            }
+        }
+        let base = path.parent().unwrap_or(Path::new("."));
+        let data = raw.data.as_ref().map(|d| base.join(d));
+        Ok(Self {
+            path: path.to_path_buf(),
+            raw,
+            factorization,
+            r,
+            data,
+        })
+    }
+
+    fn build_factorization(m: &ModelSection) -> std::result::Result<Factorization, String> {
+        use super::FactorizationKind::*;
+        let mm = match (&m.m, &m.m_diag) {
+            (Some(rows), None) => crate::system::TfMatrix::from_rows(tf_rows(rows, "m")?)
+                .ok_or("[model] m is not a rectangular matrix")?,
+            (None, Some(diag)) => crate::system::TfMatrix::diagonal(
+                diag.iter()
+                    .enumerate()
+                    .map(|(i, e)| e.to_tf(&format!("[model] m_diag[{}]", i + 1)))
+                    .collect::<std::result::Result<_, _>>()?,
+            ),
+            (Some(_), Some(_)) => return Err("[model]: give either m or m_diag, not both".into()),
+            (None, None) => return Err("[model]: m (or m_diag) is missing".into()),
+        };
+        let nn = crate::system::TfMatrix::from_rows(tf_rows(&m.n, "n")?)
+            .ok_or("[model] n is not a rectangular matrix")?;
+        match m.factorization {
+            Standard => {
+                if m.c.is_some() || m.j.is_some() {
+                    return Err("[model]: c and j belong to factorization = \"special\"".into());
+                }
+                Factorization::standard(mm, nn).map_err(|e| format!("[model]: {e}"))
+            }
+            Special => {
+                let c_rows = m
+                    .c
+                    .as_ref()
+                    .ok_or("[model]: factorization = \"special\" needs c (p×n numbers)")?;
+                let cols = c_rows.first().map_or(0, |r| r.len());
+                if cols == 0 || c_rows.iter().any(|r| r.len() != cols) {
+                    return Err("[model] c must be a non-empty rectangular matrix".into());
+                }
+                if c_rows.iter().flatten().any(|x| !x.is_finite()) {
+                    return Err("[model] c has a non-finite entry".into());
+                }
+                let c = DMatrix::from_fn(c_rows.len(), cols, |i, j| c_rows[i][j]);
+                let j = match &m.j {
+                    Some(j) => j
+                        .iter()
+                        .enumerate()
+                        .map(|(i, e)| e.to_tf(&format!("[model] j[{}]", i + 1)))
+                        .collect::<std::result::Result<_, _>>()?,
+                    None => vec![TransferFunction::gain(1.0); nn.cols()],
+                };
+                Factorization::special(c, mm, nn, j).map_err(|e| format!("[model]: {e}"))
+            }
+        }
+    }
+}

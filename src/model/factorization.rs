@@ -1,0 +1,208 @@
+//! Nominal coprime factorizations `G = C·M̃⁻¹·Ñ·J` (Boulet & Francis 1998, eq. (1)).
+//!
+//! * the **standard** left coprime factorization `G = M̃⁻¹Ñ` (`C = I_p`, `J = I_m`,
+//!   Sec. IV-A "Standard Factorization");
+//! * the **special** factorization for flexible structures (Sec. IV-A, "Special
+//!   Factorization for Square LFSS Models"): `C` a constant `p×n` matrix, `M̃` `n×n`,
+//!   `Ñ` `n×p`, `J` diagonal `p×p`, `n ≥ p` (A3).
+
+use crate::error::{Error, Result};
+use crate::system::{TfMatrix, TransferFunction};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// Which factorization the model uses; it selects Theorem 2 or Theorem 3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FactorizationKind {
+    /// `G = M̃⁻¹Ñ`, Theorem 2 (eq. (8)).
+    Standard,
+    /// `G = C·M̃⁻¹·Ñ·J`, Theorem 3.
+    Special,
+}
+
+/// A nominal coprime factorization `G = C·M̃⁻¹·Ñ·J`.
+#[derive(Debug, Clone)]
+pub struct Factorization {
+    /// Standard or special.
+    pub kind: FactorizationKind,
+    /// Constant output matrix `C` (`p×n`); the identity for the standard factorization.
+    pub c: DMatrix<f64>,
+    /// Denominator factor `M̃` (`n×n`).
+    pub m: TfMatrix,
+    /// Numerator factor `Ñ` (`n×m`).
+    pub n: TfMatrix,
+    /// Diagonal of the input matrix `J` (`m` entries); all ones for the standard case.
+    pub j: Vec<TransferFunction>,
+}
+
+/// The factors evaluated at one frequency.
+#[derive(Debug, Clone)]
+pub struct FactorsAt {
+    /// `C` (`p×n`).
+    pub c: DMatrix<Complex64>,
+    /// `M̃(jω)` (`n×n`).
+    pub m: DMatrix<Complex64>,
+    /// `Ñ(jω)` (`n×m`).
+    pub n: DMatrix<Complex64>,
+    /// Diagonal of `J(jω)`.
+    pub j: Vec<Complex64>,
+}
+
+impl Factorization {
+    /// The standard factorization `G = M̃⁻¹Ñ`; checks that `M̃` is square and the sizes agree.
+    pub fn standard(m: TfMatrix, n: TfMatrix) -> Result<Self> {
+        if m.rows() != m.cols() {
+            return Err(Error::Invalid(format!(
+                "M̃ must be square, got {}×{}",
+                m.rows(),
+                m.cols()
+            )));
+        }
+        if n.rows() != m.rows() {
+            return Err(Error::Invalid(format!(
+                "Ñ must have as many rows as M̃ ({}), got {}",
+                m.rows(),
+                n.rows()
+            )));
+        }
+        let p = m.rows();
+        let inputs = n.cols();
+        let f = Self {
+            kind: FactorizationKind::Standard,
+            c: DMatrix::identity(p, p),
+            m,
+            n,
+            j: vec![TransferFunction::gain(1.0); inputs],
+        };
+        f.check_proper()?;
+        Ok(f)
+    }
+
+    /// The special factorization `G = C·M̃⁻¹·Ñ·J`; checks sizes, `n ≥ p` (A3) and that `C`
+    /// has full row rank (A4).
+    pub fn special(
+        c: DMatrix<f64>,
+        m: TfMatrix,
+        n: TfMatrix,
+        j: Vec<TransferFunction>,
+    ) -> Result<Self> {
+        let modes = m.rows();
+        if m.cols() != modes {
+            return Err(Error::Invalid(format!(
+                "M̃ must be square, got {}×{}",
+                m.rows(),
+                m.cols()
+            )));
+        }
+        if c.ncols() != modes {
+            return Err(Error::Invalid(format!(
+                "C must have {modes} columns (one per row of M̃), got {}",
+                c.ncols()
+            )));
+        }
+        let p = c.nrows();
+        if n.rows() != modes || n.cols() != j.len() {
+            return Err(Error::Invalid(format!(
+                "Ñ must be {modes}×{} (modes × inputs), got {}×{}",
+                j.len(),
+                n.rows(),
+                n.cols()
+            )));
+        }
+        if modes < p {
+            return Err(Error::Invalid(format!(
+                "assumption A3 fails: n = {modes} modes < p = {p} outputs; add modes"
+            )));
+        }
+        let sv = c.clone().svd(false, false).singular_values;
+        let smax = sv.max();
+        let rank = sv.iter().filter(|s| **s > 1e-12 * smax.max(1e-300)).count();
+        if rank < p {
+            return Err(Error::Invalid(format!(
+                "assumption A4 fails: C ({p}×{modes}) has rank {rank} < {p}; its rows must be independent"
+            )));
+        }
+        let f = Self {
+            kind: FactorizationKind::Special,
+            c,
+            m,
+            n,
+            j,
+        };
+        f.check_proper()?;
+        Ok(f)
+    }
+
+    fn check_proper(&self) -> Result<()> {
+        let all = self
+            .m
+            .entries()
+            .iter()
+            .chain(self.n.entries())
+            .chain(self.j.iter());
+        for tf in all {
+            if !tf.is_proper() {
+                return Err(Error::Invalid(
+                    "every entry of M̃, Ñ and J must be proper (deg num ≤ deg den): the factors live in RH∞".into(),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of outputs `p`.
+    pub fn outputs(&self) -> usize {
+        self.c.nrows()
+    }
+
+    /// Number of inputs `m`.
+    pub fn inputs(&self) -> usize {
+        self.j.len()
+    }
+
+    /// Number of rows of `M̃` (`p` for the standard factorization, the number of modes `n`
+    /// for the special one).
+    pub fn states(&self) -> usize {
+        self.m.rows()
+    }
+
+    /// The factors at `s = jω`.
+    pub fn at(&self, omega: f64) -> FactorsAt {
+        FactorsAt {
+            c: self.c.map(|x| Complex64::new(x, 0.0)),
+            m: self.m.freq(omega),
+            n: self.n.freq(omega),
+            j: self.j.iter().map(|t| t.freq(omega)).collect(),
+        }
+    }
+
+    /// The nominal plant `G(jω) = C·M̃⁻¹·Ñ·J`, by an LU solve with `M̃`.
+    /// Returns `None` where `M̃(jω)` is singular.
+    pub fn plant(&self, omega: f64) -> Option<DMatrix<Complex64>> {
+        self.at(omega).plant()
+    }
+
+    /// `σ_min(M̃(jω))`, the A1 limit on `|r(jω)|`.
+    pub fn a1_limit(&self, omega: f64) -> f64 {
+        sigma_min(&self.m.freq(omega))
+    }
+}
+
+impl FactorsAt {
+    /// `C·M̃⁻¹·Ñ·J` at this frequency, `None` where `M̃` is singular.
+    pub fn plant(&self) -> Option<DMatrix<Complex64>> {
+        let x = self.m.clone().lu().solve(&self.n)?;
+        let mut g = &self.c * x;
+        for (k, jk) in self.j.iter().enumerate() {
+            let mut col = g.column_mut(k);
+            col *= *jk;
+        }
+        g.iter().all(|v| v.is_finite()).then_some(g)
+    }
+}
+
+/// Smallest singular value of a complex matrix.
+pub fn sigma_min(a: &DMatrix<Complex64>) -> f64 {
+    a.clone().svd(false, false).singular_values.min()
+}

@@ -1,0 +1,6 @@
+//! Nominal models: coprime factorizations, the uncertainty bound `r`, and the TOML config.
+pub mod config;
+pub mod factorization;
+
+pub use config::Config;
+pub use factorization::{FactorizationKind, Factorization, FactorsAt};
