@@ -67,14 +67,24 @@ pub fn min_norm_perturbation(
         .cholesky()
         .expect("I + Φ*Φ is Hermitian positive definite");
     // Z = U L^{-*}: solve L Zᴴ = Uᴴ.
-    let zh = chol.l().solve_lower_triangular(&u.adjoint()).expect("L has a positive diagonal");
+    let zh = chol
+        .l()
+        .solve_lower_triangular(&u.adjoint())
+        .expect("L has a positive diagonal");
     let norm = zh.clone().svd(false, false).singular_values.max();
     // Δ = Z L^{-1} W^*, with W^* = [−I  −Φ^*].
-    let y = chol.l().adjoint().solve_upper_triangular(&zh).expect("L has a positive diagonal").adjoint();
+    let y = chol
+        .l()
+        .adjoint()
+        .solve_upper_triangular(&zh)
+        .expect("L has a positive diagonal")
+        .adjoint();
     let p = phi.nrows();
     let mut delta = DMatrix::zeros(p, m_in + p);
     delta.view_mut((0, 0), (p, m_in)).copy_from(&(-&y));
-    delta.view_mut((0, m_in), (p, p)).copy_from(&(-(&y * phi.adjoint())));
+    delta
+        .view_mut((0, m_in), (p, p))
+        .copy_from(&(-(&y * phi.adjoint())));
     Ok((delta, norm))
 }
 
@@ -84,7 +94,10 @@ pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, As
 }
 
 /// The matrix `X` of Theorem 3, `F_L(P, Φ̂⁻¹) = r·X`, computed with LU solves.
-pub fn theorem3_x(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<DMatrix<Complex64>, AssumptionFailure> {
+pub fn theorem3_x(
+    f: &FactorsAt,
+    phi: &DMatrix<Complex64>,
+) -> Result<DMatrix<Complex64>, AssumptionFailure> {
     let p = phi.nrows();
     if phi.ncols() != p || f.j.len() != p {
         return Err(AssumptionFailure::NotSquare);
@@ -130,7 +143,12 @@ pub fn theorem3_x(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<DMatrix<Com
 pub fn r_min_special(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, AssumptionFailure> {
     let x = theorem3_x(f, phi)?;
     let p = phi.nrows();
-    let mut sv: Vec<f64> = x.svd(false, false).singular_values.iter().copied().collect();
+    let mut sv: Vec<f64> = x
+        .svd(false, false)
+        .singular_values
+        .iter()
+        .copied()
+        .collect();
     sv.sort_by(|a, b| b.total_cmp(a));
     Ok(1.0 / sv[p - 1])
 }

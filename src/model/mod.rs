@@ -3,4 +3,4 @@ pub mod config;
 pub mod factorization;
 
 pub use config::Config;
-pub use factorization::{FactorizationKind, Factorization, FactorsAt};
+pub use factorization::{Factorization, FactorizationKind, FactorsAt};
