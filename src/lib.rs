@@ -17,6 +17,8 @@ pub mod consistency;
 pub mod data;
 pub mod error;
 pub mod model;
+pub mod pipeline;
+pub mod plot;
 pub mod report;
 pub mod system;
 pub mod util;

@@ -1,0 +1,111 @@
+//! `rshape run CONFIG [--data FILE] [--noise-radius X] --out DIR`: the whole pipeline
+//! (envelope, check of the configured r, fit, certificate, exports, figures) with
+//! `DIR/report.json` and a summary on the terminal.
+
+use super::common::{fmt_g, InputArgs};
+use crate::pipeline::{self, outputs::write_outputs};
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `rshape run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Model and data.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Output directory (created if needed).
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn list(v: &[f64]) -> String {
+    v.iter().map(|w| fmt_g(*w)).collect::<Vec<_>>().join(", ")
+}
+
+/// Runs `rshape run`: exit 0 when the pipeline completed (whatever the verdict; see
+/// `consistent` in report.json, or use `rshape check` to gate on it), 2 on an error.
+pub fn run(a: &RunArgs) -> Result<i32> {
+    let t = Instant::now();
+    let inputs = a.input.load()?;
+    let load_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (config, data) = (&inputs.config, &inputs.data);
+    let mut out = pipeline::run(config, data, a.input.noise_radius)?;
+    out.timings.0.insert("load".into(), load_ms);
+    let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;
+
+    let name = rep
+        .name
+        .clone()
+        .unwrap_or_else(|| config.path.display().to_string());
+    println!("rshape run: {name}");
+    println!(
+        "  data      {} ({} points, {}×{}, {})",
+        data.path.display(),
+        rep.n_data,
+        rep.size[0],
+        rep.size[1],
+        if rep.noisy { "noisy" } else { "noise-free" }
+    );
+    println!(
+        "  envelope  {:?}, max r_min = {}",
+        rep.method,
+        rep.max_r_min.map_or("-".into(), fmt_g)
+    );
+    if !rep.beyond_a1.is_empty() {
+        println!(
+            "            r_min reaches the A1 limit at omega = {} rad/s: no admissible r explains these data",
+            list(&rep.beyond_a1)
+        );
+    }
+    match rep.consistent {
+        Some(true) => println!(
+            "  check     CONSISTENT: the configured r explains all {} data",
+            rep.n_data
+        ),
+        Some(false) => println!(
+            "  check     INCONSISTENT at {} of {} data: omega = {} rad/s",
+            rep.failing_omegas.len(),
+            rep.n_data,
+            list(&rep.failing_omegas)
+        ),
+        None => println!("  check     no [r] in the config: nothing to check"),
+    }
+    match (&out.fit, &rep.r_fitted) {
+        (Ok(f), Some(j)) => println!(
+            "  fit       r = ({})/({}) [{}]",
+            f.r.num
+                .coeffs()
+                .iter()
+                .map(|c| fmt_g(*c))
+                .collect::<Vec<_>>()
+                .join(", "),
+            f.r.den
+                .coeffs()
+                .iter()
+                .map(|c| fmt_g(*c))
+                .collect::<Vec<_>>()
+                .join(", "),
+            j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
+        ),
+        _ => println!(
+            "  fit       failed: {}",
+            rep.fit_error.clone().unwrap_or_default()
+        ),
+    }
+    for w in &rep.warnings {
+        println!("  warning   {w}");
+    }
+    println!(
+        "  time      {} ms",
+        fmt_g(rep.timings_ms.get("total").copied().unwrap_or(0.0))
+    );
+    println!("  wrote     {}", a.out.display());
+    for f in &files {
+        if let Some(n) = f.file_name() {
+            println!("            {}", n.to_string_lossy());
+        }
+    }
+    Ok(0)
+}

@@ -1,0 +1,96 @@
+//! The `rshape run` pipeline: envelope → check of the configured `r` → fit → certificate →
+//! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
+//! writes; neither prints.
+pub mod integration;
+pub mod outputs;
+
+use crate::consistency::{check, CheckReport, Envelope};
+use crate::data::FrfData;
+use crate::error::Result;
+use crate::model::Config;
+use integration::FittedR;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Wall-clock time per stage in milliseconds, keyed by stage name.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Timings(pub BTreeMap<String, f64>);
+
+impl Timings {
+    /// Runs `f` and records its duration under `name`.
+    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
+        let t = Instant::now();
+        let out = f();
+        self.0
+            .insert(name.to_string(), t.elapsed().as_secs_f64() * 1e3);
+        out
+    }
+}
+
+/// Everything the pipeline computed.
+#[derive(Debug, Clone)]
+pub struct RunOutcome {
+    /// Per-datum smallest consistent `|r|` and the A1 limit.
+    pub envelope: Envelope,
+    /// Per-datum noise radii, for noisy data.
+    pub noise_radii: Option<Vec<f64>>,
+    /// The check of the configured `r` (`None` when the config has no `[r]`).
+    pub check: Option<CheckReport>,
+    /// The fitted `r`, or why the fit failed (a failed fit does not stop the run).
+    pub fit: std::result::Result<FittedR, String>,
+    /// `μ_Γ` per datum for the configured `r` (noisy data, when available).
+    pub mu: Option<Vec<f64>>,
+    /// Warnings for the reader.
+    pub warnings: Vec<String>,
+    /// Time per stage.
+    pub timings: Timings,
+}
+
+/// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
+/// sizes, a failed assumption at a datum) is an error; the fit and μ failures are kept in
+/// the outcome.
+pub fn run(config: &Config, data: &FrfData, noise_radius: Option<f64>) -> Result<RunOutcome> {
+    let mut timings = Timings::default();
+    let f = &config.factorization;
+    let radii = integration::noise_radii(config, data, noise_radius);
+    let (envelope, mut warnings) = timings.time("envelope", || {
+        integration::envelope(f, data, radii.as_deref())
+    })?;
+    let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
+    let fit = timings.time("fit", || {
+        integration::fit_r(&envelope).map_err(|e| crate::cli::one_line(&e.to_string()))
+    });
+    if let Err(e) = &fit {
+        warnings.push(format!("fit failed: {e}"));
+    }
+    let mu = match (&radii, &config.r) {
+        (Some(rad), Some(r)) => {
+            timings.time("mu", || match integration::mu_per_datum(f, data, rad, r) {
+                Some(Ok(v)) => Some(v),
+                Some(Err(e)) => {
+                    warnings.push(format!("μ per datum failed: {e}"));
+                    None
+                }
+                None => None,
+            })
+        }
+        _ => None,
+    };
+    if let Some(c) = &check {
+        if !c.a1_violations.is_empty() {
+            warnings.push(format!(
+                "A1 fails for the configured r at {} datum(s): |r| ≥ σ_min(M̃)",
+                c.a1_violations.len()
+            ));
+        }
+    }
+    Ok(RunOutcome {
+        envelope,
+        noise_radii: radii,
+        check,
+        fit,
+        mu,
+        warnings,
+        timings,
+    })
+}

@@ -1,0 +1,132 @@
+//! Writing the outputs of `rshape run` into a directory, each file atomically:
+//! `envelope.csv`, the exports of the fitted `r` (`r.json`, ...), the figures
+//! (`r_vs_delta.svg`, `bode.svg`, `mu.svg`) and, last, `report.json`.
+
+use super::RunOutcome;
+use crate::consistency::EnvelopeMethod;
+use crate::data::FrfData;
+use crate::error::{Error, Result};
+use crate::model::Config;
+use crate::plot::{bode_svg, mu_svg, r_vs_delta_svg, BodeInput, MuInput, RVsDeltaInput};
+use crate::report::envelope_csv;
+use crate::report::run_report::RunReport;
+use crate::system::logspace;
+use crate::util::write_atomic;
+use std::path::{Path, PathBuf};
+
+/// Number of points of the dense grid of the curves.
+pub const DENSE_POINTS: usize = 800;
+
+/// The dense grid: a quarter decade beyond the data on each side.
+pub fn dense_grid(omega: &[f64]) -> Vec<f64> {
+    let lo = omega.first().copied().unwrap_or(0.1);
+    let hi = omega.last().copied().unwrap_or(10.0);
+    let pad = 10f64.powf(0.25);
+    logspace(lo / pad, hi * pad, DENSE_POINTS)
+}
+
+/// Label of the per-datum smallest `|r|` for a method.
+pub fn r_min_label(m: EnvelopeMethod) -> &'static str {
+    match m {
+        EnvelopeMethod::Theorem2 => "‖Δᵢ‖, min-norm perturbation (Thm 2, eq. 8)",
+        EnvelopeMethod::Theorem3 => "smallest |r| per datum (Thm 3)",
+        EnvelopeMethod::Theorem4Mu => "smallest |r| per datum, μ bisection (Thm 4)",
+        EnvelopeMethod::File => "smallest |r| per datum",
+    }
+}
+
+/// Writes every output of a run into `dir` and returns the report and the files written
+/// (`report.json` last).
+pub fn write_outputs(
+    dir: &Path,
+    config: &Config,
+    data: &FrfData,
+    out: &mut RunOutcome,
+) -> Result<(RunReport, Vec<PathBuf>)> {
+    let mut files = Vec::new();
+    let env = &out.envelope;
+    let p = dir.join("envelope.csv");
+    write_atomic(&p, envelope_csv(env).as_bytes())?;
+    files.push(p);
+    if let Ok(fit) = &out.fit {
+        let written = out
+            .timings
+            .time("exports", || super::integration::export_r(fit, dir))?;
+        files.extend(written);
+    }
+    let t = std::time::Instant::now();
+    let svgs = figures(config, data, out)?;
+    out.timings
+        .0
+        .insert("figures".into(), t.elapsed().as_secs_f64() * 1e3);
+    for (name, text) in svgs {
+        let p = dir.join(name);
+        write_atomic(&p, text.as_bytes())?;
+        files.push(p);
+    }
+    let report_path = dir.join("report.json");
+    files.push(report_path.clone());
+    let report = RunReport::new(config, data, out, &files);
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
+    write_atomic(&report_path, text.as_bytes())?;
+    Ok((report, files))
+}
+
+/// Renders the figures: `(file name, SVG text)`.
+pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<(String, String)>> {
+    let env = &out.envelope;
+    let grid = dense_grid(&env.omega);
+    let f = &config.factorization;
+    let a1: Vec<f64> = grid.iter().map(|w| f.a1_limit(*w)).collect();
+    let failing: Vec<bool> = match &out.check {
+        Some(c) => c.rows.iter().map(|r| !r.consistent).collect(),
+        None => vec![false; env.len()],
+    };
+    let name = config
+        .raw
+        .name
+        .clone()
+        .unwrap_or_else(|| config.path.display().to_string());
+    let mut svgs = Vec::new();
+    let title = format!("Smallest consistent |r| per datum vs |r(jω)|: {name}");
+    svgs.push((
+        "r_vs_delta.svg".to_string(),
+        r_vs_delta_svg(&RVsDeltaInput {
+            title: &title,
+            omega: &env.omega,
+            r_min: &env.r_min,
+            r_min_label: r_min_label(env.method),
+            failing: &failing,
+            r_configured: config.r.as_ref(),
+            r_fitted: out.fit.as_ref().ok().map(|f| &f.r),
+            grid: &grid,
+            a1_on_grid: Some(&a1),
+        })?,
+    ));
+    let model: Vec<_> = grid.iter().map(|w| f.plant(*w)).collect();
+    let title = format!("Bode: data vs nominal model: {name}");
+    svgs.push((
+        "bode.svg".to_string(),
+        bode_svg(&BodeInput {
+            title: &title,
+            omega: &data.omega,
+            data: &data.response,
+            noise_radius: out.noise_radii.as_deref(),
+            grid: &grid,
+            model: &model,
+        })?,
+    ));
+    if let Some(mu) = &out.mu {
+        let title = format!("μ test per datum for the configured r (Fig. 8): {name}");
+        svgs.push((
+            "mu.svg".to_string(),
+            mu_svg(&MuInput {
+                title: &title,
+                omega: &env.omega,
+                mu,
+            })?,
+        ));
+    }
+    Ok(svgs)
+}

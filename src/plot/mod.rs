@@ -1,0 +1,18 @@
+//! Figures as SVG text, drawn with plotters' SVG backend (text is emitted as `<text>`
+//! elements, so no system font is needed to make or to view them).
+//!
+//! Each function takes plain data and returns the SVG document as a `String`; the caller
+//! writes it (atomically).  The figures are the analogues of the paper's:
+//! - [`r_vs_delta`]: Fig. 3 and Fig. 8 side by side in spirit: `|r(jω)|` against the
+//!   per-datum smallest consistent `|r|` (`‖Δᵢ‖` of eq. (8), or the Theorem 4 bisection);
+//! - [`bode`]: the data (with noise-disk error bars, eq. (5)) against the nominal model,
+//!   as in Fig. 7;
+//! - [`mu`]: `μ_Γ` per datum with the line `μ = 1` (Fig. 8).
+pub mod bode;
+pub mod mu;
+pub mod r_vs_delta;
+pub mod style;
+
+pub use bode::{bode_svg, BodeInput};
+pub use mu::{mu_svg, MuInput};
+pub use r_vs_delta::{r_vs_delta_svg, RVsDeltaInput};

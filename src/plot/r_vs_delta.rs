@@ -1,0 +1,166 @@
+//! `r_vs_delta.svg`: the analogue of Fig. 3 (noise-free: `|r(jω)|` against the norms of the
+//! minimum-norm perturbations `‖Δᵢ‖` of eq. (8)) and of Fig. 8 (noisy: against the
+//! Theorem 4 bisection values), on log-log axes, with the A1 limit `σ_min(M̃(jω))`.
+
+use super::style::{self, *};
+use crate::error::Result;
+use crate::system::TransferFunction;
+use plotters::prelude::*;
+
+/// What the figure shows.  Slices indexed by datum have the length of `omega`.
+pub struct RVsDeltaInput<'a> {
+    /// Title of the figure.
+    pub title: &'a str,
+    /// Data frequencies (rad/s).
+    pub omega: &'a [f64],
+    /// Smallest consistent `|r|` per datum (`inf` when no admissible `r` explains it).
+    pub r_min: &'a [f64],
+    /// Legend label of the per-datum values, e.g. `‖Δᵢ‖ (Theorem 2, eq. 8)`.
+    pub r_min_label: &'a str,
+    /// Per datum: true when the configured `r` fails to explain it.
+    pub failing: &'a [bool],
+    /// The configured `r`, when there is one.
+    pub r_configured: Option<&'a TransferFunction>,
+    /// The fitted `r`, when there is one.
+    pub r_fitted: Option<&'a TransferFunction>,
+    /// Dense frequency grid for the curves (rad/s).
+    pub grid: &'a [f64],
+    /// `σ_min(M̃(jω))` on `grid` (the A1 limit), when the model is known.
+    pub a1_on_grid: Option<&'a [f64]>,
+}
+
+/// Renders `r_vs_delta.svg`.
+pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
+    let mag =
+        |r: &TransferFunction| -> Vec<f64> { inp.grid.iter().map(|w| r.freq(*w).norm()).collect() };
+    let conf = inp.r_configured.map(mag);
+    let fit = inp.r_fitted.map(mag);
+    let (xlo, xhi) = omega_range(inp.omega);
+    // The y range is set by the data and the r curves; the A1 curve may leave it.
+    let ys = inp
+        .r_min
+        .iter()
+        .chain(conf.iter().flatten())
+        .chain(fit.iter().flatten())
+        .chain(inp.a1_on_grid.into_iter().flatten());
+    let (ylo, yhi) = log_range(ys, 2.5).unwrap_or((1e-3, 1e3));
+    let (ylo, yhi) = (ylo.max(yhi * 1e-12), yhi);
+
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(inp.title, (FONT, CAPTION))
+            .margin(14)
+            .x_label_area_size(52)
+            .y_label_area_size(78)
+            .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("frequency ω (rad/s)")
+            .y_desc("magnitude (absolute, unitless)")
+            .axis_desc_style((FONT, AXIS))
+            .label_style((FONT, TICKS))
+            .x_label_formatter(&log_tick)
+            .y_label_formatter(&log_tick)
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()
+            .map_err(plot_err)?;
+
+        let grid = inp.grid;
+        let curve = |v: &[f64]| -> Vec<(f64, f64)> {
+            grid.iter()
+                .zip(v)
+                .filter(|(_, y)| y.is_finite() && **y > 0.0)
+                .map(|(w, y)| (*w, style::clamp(*y, ylo, yhi)))
+                .collect()
+        };
+        if let Some(a1) = inp.a1_on_grid {
+            let s = ShapeStyle::from(&C_PURPLE).stroke_width(2);
+            chart
+                .draw_series(DashedLineSeries::new(curve(a1), 8, 5, s))
+                .map_err(plot_err)?
+                .label("A1 limit σ_min(M̃(jω)): |r| must stay below")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+        }
+        if let Some(c) = &conf {
+            let s = ShapeStyle::from(&C_BLUE).stroke_width(3);
+            chart
+                .draw_series(LineSeries::new(curve(c), s))
+                .map_err(plot_err)?
+                .label(format!(
+                    "|r(jω)|, configured r = {}",
+                    tf_label(inp.r_configured.expect("set"))
+                ))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+        }
+        if let Some(f) = &fit {
+            let s = ShapeStyle::from(&C_ORANGE).stroke_width(3);
+            chart
+                .draw_series(DashedLineSeries::new(curve(f), 12, 4, s))
+                .map_err(plot_err)?
+                .label(format!(
+                    "|r(jω)|, fitted r = {}",
+                    tf_label(inp.r_fitted.expect("set"))
+                ))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+        }
+        let pts = |want_fail: bool| -> Vec<(f64, f64)> {
+            inp.omega
+                .iter()
+                .zip(inp.r_min)
+                .zip(inp.failing)
+                .filter(|((_, r), f)| **f == want_fail && r.is_finite() && **r > 0.0)
+                .map(|((w, r), _)| (*w, style::clamp(*r, ylo, yhi)))
+                .collect()
+        };
+        let ok = pts(false);
+        if !ok.is_empty() {
+            chart
+                .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
+                .map_err(plot_err)?
+                .label(format!("{} (explained)", inp.r_min_label))
+                .legend(|(x, y)| Circle::new((x + 12, y), 5, C_GREEN.filled()));
+        }
+        let bad = pts(true);
+        if !bad.is_empty() {
+            chart
+                .draw_series(bad.iter().map(|p| {
+                    EmptyElement::at(*p)
+                        + Circle::new((0, 0), 8, C_RED.stroke_width(3))
+                        + Cross::new((0, 0), 5, C_RED.stroke_width(2))
+                }))
+                .map_err(plot_err)?
+                .label(format!("{}: FAILING, |r(jω)| ≤ r_min", inp.r_min_label))
+                .legend(|(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + Circle::new((0, 0), 7, C_RED.stroke_width(3))
+                        + Cross::new((0, 0), 4, C_RED.stroke_width(2))
+                });
+        }
+        let infinite: Vec<(f64, f64)> = inp
+            .omega
+            .iter()
+            .zip(inp.r_min)
+            .filter(|(_, r)| r.is_infinite())
+            .map(|(w, _)| (*w, yhi))
+            .collect();
+        if !infinite.is_empty() {
+            let tri = |(x, y): (i32, i32)| vec![(x - 7, y + 12), (x + 7, y + 12), (x, y)];
+            chart
+                .draw_series(
+                    infinite
+                        .iter()
+                        .map(|p| EmptyElement::at(*p) + Polygon::new(tri((0, 0)), C_RED.filled())),
+                )
+                .map_err(plot_err)?
+                .label("r_min = ∞: no admissible r explains the datum (drawn at the top)")
+                .legend(move |(x, y)| Polygon::new(tri((x + 12, y - 6)), C_RED.filled()));
+        }
+        legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+        root.present().map_err(plot_err)?;
+    }
+    Ok(svg)
+}

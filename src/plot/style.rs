@@ -1,0 +1,162 @@
+//! Shared look of the figures: size, fonts, palette, legend placement, axis ranges.
+
+use crate::error::{Error, Result};
+use plotters::prelude::*;
+use plotters::style::RGBColor;
+
+/// Width and height of every figure in pixels.
+pub const SIZE: (u32, u32) = (960, 620);
+/// Font family (generic, so any SVG viewer picks a font it has).
+pub const FONT: &str = "sans-serif";
+/// Caption font size.
+pub const CAPTION: u32 = 22;
+/// Axis-label font size.
+pub const AXIS: u32 = 17;
+/// Tick-label font size.
+pub const TICKS: u32 = 14;
+/// Legend font size.
+pub const LEGEND: u32 = 14;
+
+/// Blue: the configured `r`.
+pub const C_BLUE: RGBColor = RGBColor(31, 119, 180);
+/// Orange: the fitted `r`.
+pub const C_ORANGE: RGBColor = RGBColor(230, 120, 20);
+/// Green: consistent data.
+pub const C_GREEN: RGBColor = RGBColor(44, 160, 44);
+/// Red: failing data.
+pub const C_RED: RGBColor = RGBColor(214, 39, 40);
+/// Purple: the A1 limit.
+pub const C_PURPLE: RGBColor = RGBColor(148, 103, 189);
+/// Grey: reference lines.
+pub const C_GREY: RGBColor = RGBColor(90, 90, 90);
+
+/// A qualitative palette for channels.
+pub const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(230, 120, 20),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+/// Maps a plotters error into the library error.
+pub fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
+    Error::Invalid(format!("drawing a figure: {e:?}"))
+}
+
+/// A log-axis range covering the positive finite values, padded by a factor (at least one
+/// decade in total); `None` when there is no positive finite value.
+pub fn log_range<'a, I: IntoIterator<Item = &'a f64>>(values: I, pad: f64) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for &v in values {
+        if v.is_finite() && v > 0.0 {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if hi == 0.0 {
+        return None;
+    }
+    let (mut lo, mut hi) = (lo / pad, hi * pad);
+    if hi / lo < 10.0 {
+        let mid = (lo * hi).sqrt();
+        lo = mid / 10f64.sqrt();
+        hi = mid * 10f64.sqrt();
+    }
+    Some((lo, hi))
+}
+
+/// The frequency axis: the data range extended by a quarter decade on each side.
+pub fn omega_range(omega: &[f64]) -> (f64, f64) {
+    log_range(omega, 10f64.powf(0.25)).unwrap_or((0.1, 10.0))
+}
+
+/// Clamps `v` into `[lo, hi]` (for drawing values that sit outside the axis).
+pub fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
+    v.max(lo).min(hi)
+}
+
+/// The standard legend box: white, framed, in the given corner.
+pub fn legend<'a, 'b, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    chart: &'b mut ChartContext<'a, DB, CT>,
+    pos: SeriesLabelPosition,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(pos)
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .label_font((FONT, LEGEND))
+        .margin(8)
+        .draw()
+        .map_err(plot_err)
+}
+
+/// Formats a tick label of a log axis as `1e-3`, `0.01`, `100`, `1e5`.
+pub fn log_tick(v: &f64) -> String {
+    let e = v.log10();
+    if (e - e.round()).abs() < 1e-9 {
+        let k = e.round() as i32;
+        if (-2..=3).contains(&k) {
+            format!("{}", 10f64.powi(k))
+        } else {
+            format!("1e{k}")
+        }
+    } else {
+        let s = format!("{v:.3e}");
+        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        if x == "0" {
+            m.to_string()
+        } else {
+            format!("{m}e{x}")
+        }
+    }
+}
+
+/// A short human form of a transfer function, e.g. `(1e-8 s + 0.3)/(s + 1)`, or
+/// `order-n unit` when that would be too long for a legend.
+pub fn tf_label(tf: &crate::system::TransferFunction) -> String {
+    fn poly(c: &[f64]) -> String {
+        let n = c.len();
+        let terms: Vec<String> = c
+            .iter()
+            .enumerate()
+            .filter(|(_, x)| **x != 0.0)
+            .map(|(k, x)| {
+                let p = n - 1 - k;
+                let coef = if p > 0 && *x == 1.0 {
+                    String::new()
+                } else {
+                    crate::cli::common::fmt_g(*x)
+                };
+                match p {
+                    0 => crate::cli::common::fmt_g(*x),
+                    1 => format!("{coef} s"),
+                    _ => format!("{coef} s^{p}"),
+                }
+                .trim()
+                .to_string()
+            })
+            .collect();
+        if terms.is_empty() {
+            "0".into()
+        } else {
+            terms.join(" + ").replace("+ -", "− ")
+        }
+    }
+    let (num, den) = (poly(tf.num.coeffs()), poly(tf.den.coeffs()));
+    let full = if den == "1" {
+        num
+    } else {
+        format!("({num})/({den})")
+    };
+    if full.chars().count() > 48 {
+        format!("order-{} unit", tf.den.degree())
+    } else {
+        full
+    }
+}

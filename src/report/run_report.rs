@@ -1,0 +1,157 @@
+//! `report.json` of `rshape run`: the verdict of the check of the configured `r`, the
+//! per-datum envelope, the fitted `r` (as in `r.json`) with its certificate, and the time
+//! per stage.
+
+use crate::data::FrfData;
+use crate::model::Config;
+use crate::pipeline::RunOutcome;
+use serde::Serialize;
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// One datum of `report.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReportDatum {
+    /// Frequency (rad/s).
+    pub omega: f64,
+    /// Smallest consistent `|r|` at this datum (`null` when infinite).
+    pub r_min: Option<f64>,
+    /// `σ_min(M̃(jω))`, the A1 limit.
+    pub a1_limit: Option<f64>,
+    /// Noise radius at this datum (noisy data).
+    pub noise_radius: Option<f64>,
+    /// `|r(jω)|` of the configured `r`.
+    pub r_configured_abs: Option<f64>,
+    /// True when the configured `r` explains the datum.
+    pub consistent: Option<bool>,
+    /// `μ_Γ` for the configured `r` (noisy data, when computed).
+    pub mu: Option<f64>,
+}
+
+/// The configured `r` as coefficients.
+#[derive(Debug, Clone, Serialize)]
+pub struct Coeffs {
+    /// Numerator, descending powers of `s`.
+    pub num: Vec<f64>,
+    /// Denominator, descending powers of `s`.
+    pub den: Vec<f64>,
+}
+
+/// The whole `report.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunReport {
+    /// Version of rshape that wrote the report.
+    pub rshape_version: String,
+    /// Name of the model (config `name`).
+    pub name: Option<String>,
+    /// The config file.
+    pub config: PathBuf,
+    /// The data file.
+    pub data: PathBuf,
+    /// Number of data.
+    pub n_data: usize,
+    /// Outputs × inputs of the data.
+    pub size: [usize; 2],
+    /// How the envelope was computed (`theorem2`, `theorem3`, `theorem4_mu`).
+    pub method: crate::consistency::EnvelopeMethod,
+    /// True when noise radii were given.
+    pub noisy: bool,
+    /// True when the configured `r` explains every datum (`null` without a configured `r`).
+    pub consistent: Option<bool>,
+    /// Frequencies (rad/s) of the data the configured `r` does not explain.
+    pub failing_omegas: Vec<f64>,
+    /// Frequencies (rad/s) where the configured `r` violates A1.
+    pub a1_violations: Vec<f64>,
+    /// Frequencies (rad/s) where `r_min` reaches the A1 limit: no admissible `r` explains them.
+    pub beyond_a1: Vec<f64>,
+    /// Largest finite `r_min`.
+    pub max_r_min: Option<f64>,
+    /// The configured `r`.
+    pub r_configured: Option<Coeffs>,
+    /// The fitted `r`, as in `r.json` (`null` when the fit failed).
+    pub r_fitted: Option<Value>,
+    /// The certificate of the fitted `r`.
+    pub certificate: Option<Value>,
+    /// Why the fit failed.
+    pub fit_error: Option<String>,
+    /// Per-datum values.
+    pub data_points: Vec<ReportDatum>,
+    /// Warnings.
+    pub warnings: Vec<String>,
+    /// Files written, relative to the output directory.
+    pub files: Vec<String>,
+    /// Milliseconds per stage, and their sum under `total`.
+    pub timings_ms: BTreeMap<String, f64>,
+}
+
+fn finite(x: f64) -> Option<f64> {
+    x.is_finite().then_some(x)
+}
+
+impl RunReport {
+    /// Assembles the report of a run.
+    pub fn new(config: &Config, data: &FrfData, out: &RunOutcome, files: &[PathBuf]) -> Self {
+        let env = &out.envelope;
+        let data_points = (0..env.len())
+            .map(|i| {
+                let row = out.check.as_ref().map(|c| &c.rows[i]);
+                ReportDatum {
+                    omega: env.omega[i],
+                    r_min: finite(env.r_min[i]),
+                    a1_limit: env.a1_limit.as_ref().map(|a| a[i]),
+                    noise_radius: out.noise_radii.as_ref().map(|r| r[i]),
+                    r_configured_abs: row.map(|r| r.r_abs),
+                    consistent: row.map(|r| r.consistent),
+                    mu: out.mu.as_ref().map(|m| m[i]),
+                }
+            })
+            .collect();
+        let max_r_min = env
+            .r_min
+            .iter()
+            .copied()
+            .filter(|x| x.is_finite())
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        Self {
+            rshape_version: env!("CARGO_PKG_VERSION").to_string(),
+            name: config.raw.name.clone(),
+            config: config.path.clone(),
+            data: data.path.clone(),
+            n_data: env.len(),
+            size: [data.outputs(), data.inputs()],
+            method: env.method,
+            noisy: out.noise_radii.is_some(),
+            consistent: out.check.as_ref().map(|c| c.consistent),
+            failing_omegas: out
+                .check
+                .as_ref()
+                .map_or(Vec::new(), |c| c.failing_omegas.clone()),
+            a1_violations: out
+                .check
+                .as_ref()
+                .map_or(Vec::new(), |c| c.a1_violations.clone()),
+            beyond_a1: env.beyond_a1(),
+            max_r_min,
+            r_configured: config.r.as_ref().map(|r| Coeffs {
+                num: r.num.coeffs().to_vec(),
+                den: r.den.coeffs().to_vec(),
+            }),
+            r_fitted: out.fit.as_ref().ok().map(|f| f.json.clone()),
+            certificate: out.fit.as_ref().ok().map(|f| f.certificate.clone()),
+            fit_error: out.fit.as_ref().err().cloned(),
+            data_points,
+            warnings: out.warnings.clone(),
+            files: files
+                .iter()
+                .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .collect(),
+            timings_ms: {
+                let mut t = out.timings.0.clone();
+                let total: f64 = t.values().sum();
+                t.insert("total".into(), total);
+                t
+            },
+        }
+    }
+}
