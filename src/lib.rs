@@ -12,6 +12,7 @@
 //! `‖Δ(jω)‖ < |r(jω)|`, `r` a unit of RH∞.
 #![warn(missing_docs)]
 
+pub mod batch;
 pub mod cli;
 pub mod consistency;
 pub mod data;

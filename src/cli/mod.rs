@@ -4,9 +4,11 @@
 //! Exit codes: 0 success (and consistent, for `check`), 1 inconsistent data (`check`),
 //! 2 any error (bad input, usage), 3 some datasets failed (`batch`).
 
+pub mod batch;
 pub mod check;
 pub mod common;
 pub mod envelope;
+pub mod merge;
 pub mod run;
 
 use clap::{Parser, Subcommand};
@@ -30,6 +32,10 @@ pub enum Command {
     Check(check::CheckArgs),
     /// The whole pipeline: envelope, check, fit, certificate, exports, figures, report.json.
     Run(run::RunArgs),
+    /// Many datasets on one model, in parallel: per-dataset envelopes, summary.csv, one r.
+    Batch(batch::BatchArgs),
+    /// Combine the outputs of `batch --shard K/N` runs.
+    Merge(merge::MergeArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -46,6 +52,8 @@ pub fn main() -> i32 {
         Command::Envelope(a) => envelope::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Run(a) => run::run(&a),
+        Command::Batch(a) => batch::run(&a),
+        Command::Merge(a) => merge::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,217 @@
+//! Which datasets a batch processes: every `*.csv` file of a directory (sorted by name), or
+//! the rows of a manifest.
+//!
+//! Manifest format (CSV, `#` starts a comment line, paths relative to the manifest):
+//!
+//! ```text
+//! name,data,noise_radius
+//! run01,experiments/run01.csv,0.002
+//! run02,experiments/run02.csv,
+//! ```
+//!
+//! Only `data` is required; `name` defaults to the file stem and an empty or missing
+//! `noise_radius` means "as for a single run" (`--noise-radius`, the data file, the config).
+
+use crate::error::{Error, Result};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+/// One dataset of a batch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dataset {
+    /// Position in the full (unsharded) list, 0-based: the output order.
+    pub index: usize,
+    /// Unique name, safe as a directory name.
+    pub name: String,
+    /// The FRF CSV file.
+    pub path: PathBuf,
+    /// Noise radius for this dataset (manifest), overriding the run-wide one.
+    pub noise_radius: Option<f64>,
+}
+
+/// A name made safe for a directory: characters other than `A-Za-z0-9._-` become `_`.
+pub fn safe_name(s: &str) -> String {
+    let n: String = s
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if n.is_empty() || n.starts_with('.') {
+        format!("_{n}")
+    } else {
+        n
+    }
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map_or("dataset".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Every `*.csv` file in `dir` (not recursive), sorted by file name.
+pub fn from_dir(dir: &Path) -> Result<Vec<Dataset>> {
+    let rd = std::fs::read_dir(dir).map_err(|source| Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut paths: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
+        .collect();
+    paths.sort();
+    if paths.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no *.csv dataset in this directory",
+            dir.display()
+        )));
+    }
+    let list = paths
+        .into_iter()
+        .enumerate()
+        .map(|(index, path)| Dataset {
+            index,
+            name: safe_name(&stem(&path)),
+            noise_radius: None,
+            path,
+        })
+        .collect();
+    unique(list)
+}
+
+/// The datasets listed in a manifest (see the module doc for the format).
+pub fn from_manifest(file: &Path) -> Result<Vec<Dataset>> {
+    let text = std::fs::read_to_string(file).map_err(|source| Error::Io {
+        path: file.to_path_buf(),
+        source,
+    })?;
+    let base = file.parent().unwrap_or(Path::new("."));
+    let err = |line: usize, msg: String| Error::Data {
+        path: file.to_path_buf(),
+        line,
+        msg,
+    };
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .map(|(k, l)| (k + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (hl, header) = rows.next().ok_or_else(|| {
+        err(
+            1,
+            "empty manifest: expected a header `name,data,noise_radius`".into(),
+        )
+    })?;
+    let cols: Vec<String> = split_csv_line(header)
+        .into_iter()
+        .map(|c| c.trim().to_string())
+        .collect();
+    let col = |n: &str| cols.iter().position(|c| c == n);
+    let data_col = col("data").ok_or_else(|| {
+        err(hl, format!("header `{header}` has no `data` column; expected `name,data,noise_radius` (name and noise_radius optional)"))
+    })?;
+    if let Some(bad) = cols
+        .iter()
+        .find(|c| !["name", "data", "noise_radius"].contains(&c.as_str()))
+    {
+        return Err(err(
+            hl,
+            format!("unknown column `{bad}`; the columns are name, data, noise_radius"),
+        ));
+    }
+    let (name_col, noise_col) = (col("name"), col("noise_radius"));
+    let mut list = Vec::new();
+    for (line, row) in rows {
+        let f = split_csv_line(row);
+        let get = |c: Option<usize>| {
+            c.and_then(|c| f.get(c))
+                .map(|s| s.trim())
+                .filter(|s| !s.is_empty())
+        };
+        let data = get(Some(data_col)).ok_or_else(|| {
+            err(
+                line,
+                "empty `data` field: give the path of an FRF CSV file".into(),
+            )
+        })?;
+        let path = base.join(data);
+        let noise_radius = match get(noise_col) {
+            None => None,
+            Some(s) => match s.parse::<f64>() {
+                Ok(x) if x.is_finite() && x >= 0.0 => Some(x),
+                _ => {
+                    return Err(err(
+                        line,
+                        format!("noise_radius `{s}` is not a finite number ≥ 0"),
+                    ))
+                }
+            },
+        };
+        let name = safe_name(&get(name_col).map_or_else(|| stem(&path), str::to_string));
+        list.push(Dataset {
+            index: list.len(),
+            name,
+            path,
+            noise_radius,
+        });
+    }
+    if list.is_empty() {
+        return Err(err(hl, "the manifest lists no dataset".into()));
+    }
+    unique(list)
+}
+
+fn unique(list: Vec<Dataset>) -> Result<Vec<Dataset>> {
+    let mut seen = BTreeSet::new();
+    for d in &list {
+        if !seen.insert(d.name.clone()) {
+            return Err(Error::Invalid(format!(
+                "two datasets are named `{}`: names must be unique (they name the output directories)",
+                d.name
+            )));
+        }
+    }
+    Ok(list)
+}
+
+/// Splits one CSV line, honouring double quotes (`""` inside quotes is a quote).
+pub fn split_csv_line(line: &str) -> Vec<String> {
+    let mut out = vec![String::new()];
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match (c, quoted) {
+            ('"', true) if chars.peek() == Some(&'"') => {
+                chars.next();
+                out.last_mut().expect("non-empty").push('"');
+            }
+            ('"', _) => quoted = !quoted,
+            (',', false) => out.push(String::new()),
+            _ => out.last_mut().expect("non-empty").push(c),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn split_quotes() {
+        assert_eq!(
+            split_csv_line(r#"a,"b,c","d""e",f"#),
+            vec!["a", "b,c", "d\"e", "f"]
+        );
+    }
+
+    #[test]
+    fn safe_names() {
+        assert_eq!(safe_name("run 01/x"), "run_01_x");
+        assert_eq!(safe_name(".."), "_..");
+    }
+}

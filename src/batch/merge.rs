@@ -1,0 +1,100 @@
+//! `rshape merge`: combines the outputs of shards (`rshape batch --shard K/N`) into one:
+//! the summary rows in dataset order, the pointwise maximum of the shards' combined
+//! envelopes and one `r` fitted above it.  The per-dataset files stay in the shard
+//! directories.
+
+use super::combine::{combine, parse_envelope_csv};
+use super::summary::{self, SummaryRow};
+use super::{finish, BatchReport, FinishInput, Shard};
+use crate::error::{Error, Result};
+use crate::system::TransferFunction;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// What a merge found besides the report.
+#[derive(Debug, Clone)]
+pub struct MergeOutcome {
+    /// The merged `batch.json`.
+    pub report: BatchReport,
+    /// The merged rows, in dataset order.
+    pub rows: Vec<SummaryRow>,
+    /// Indices of the full list that no shard covered.
+    pub missing: Vec<usize>,
+}
+
+/// Merges shard directories into `out`.  Two shards holding the same dataset index, or
+/// shards of different batches (different totals), are errors.
+pub fn merge(shards: &[PathBuf], out: &Path) -> Result<MergeOutcome> {
+    let t = std::time::Instant::now();
+    if shards.is_empty() {
+        return Err(Error::Invalid("give at least one shard directory".into()));
+    }
+    let mut rows: Vec<SummaryRow> = Vec::new();
+    let mut envs = Vec::new();
+    let mut first: Option<BatchReport> = None;
+    for dir in shards {
+        let bj = dir.join("batch.json");
+        let rep: BatchReport = serde_json::from_str(&read(&bj)?).map_err(|e| {
+            Error::Invalid(format!("{}: not a batch.json of rshape: {e}", bj.display()))
+        })?;
+        if let Some(f) = &first {
+            if f.n_total != rep.n_total {
+                return Err(Error::Invalid(format!(
+                    "{}: this shard comes from a batch of {} datasets, the first one from a batch of {}",
+                    dir.display(),
+                    rep.n_total,
+                    f.n_total
+                )));
+            }
+        }
+        let sp = dir.join("summary.csv");
+        rows.extend(summary::parse(&read(&sp)?, &sp.display().to_string())?);
+        let ep = dir.join("combined_envelope.csv");
+        if ep.exists() {
+            envs.push(parse_envelope_csv(&read(&ep)?, &ep.display().to_string())?);
+        }
+        first.get_or_insert(rep);
+    }
+    let first = first.expect("at least one shard");
+    rows.sort_by_key(|r| r.index);
+    if let Some(w) = rows.windows(2).find(|w| w[0].index == w[1].index) {
+        return Err(Error::Invalid(format!(
+            "dataset {} (`{}`) appears in two shards: merge each shard once",
+            w[0].index, w[0].name
+        )));
+    }
+    let have: BTreeSet<usize> = rows.iter().map(|r| r.index).collect();
+    let missing: Vec<usize> = (0..first.n_total).filter(|i| !have.contains(i)).collect();
+    let combined = combine(envs.iter());
+    let r = first
+        .r_configured
+        .as_ref()
+        .map(|c| TransferFunction::new(c.num.clone(), c.den.clone()));
+    let mut timings = BTreeMap::new();
+    timings.insert("read".into(), t.elapsed().as_secs_f64() * 1e3);
+    let report = finish(
+        out,
+        &rows,
+        combined.as_ref(),
+        FinishInput {
+            config: first.config.clone(),
+            r_configured: r.as_ref(),
+            n_total: first.n_total,
+            shard: Shard::ALL,
+            merged_from: shards.to_vec(),
+            timings_ms: timings,
+        },
+    )?;
+    Ok(MergeOutcome {
+        report,
+        rows,
+        missing,
+    })
+}

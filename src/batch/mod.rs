@@ -1,0 +1,185 @@
+//! Batch runs over many datasets measured on one nominal model (e.g. repeated experiments):
+//! per dataset the envelope and the check of the configured `r`; over all of them the
+//! combined envelope (pointwise maximum) and one `r` fitted above it.
+//!
+//! Output directory `OUT/`:
+//! - `summary.csv`: one row per dataset ([`summary`]);
+//! - `datasets/NAME/envelope.csv`, `datasets/NAME/result.json`: per dataset;
+//! - `combined_envelope.csv`: the combined envelope ([`combine`]);
+//! - `r.json` (and the other exports of the fit): one `r` covering every dataset;
+//! - `batch.json`: counts, shard, fitted `r`, certificate, timings ([`BatchReport`]).
+//!
+//! Datasets come from a directory or a manifest ([`discover`]), can be split into shards
+//! ([`shard`]) and the shard outputs recombined ([`merge`]).
+pub mod combine;
+pub mod discover;
+pub mod merge;
+pub mod runner;
+pub mod shard;
+pub mod summary;
+
+use crate::consistency::{check, Envelope};
+use crate::error::{Error, Result};
+use crate::pipeline::integration;
+use crate::report::envelope_csv;
+use crate::report::run_report::Coeffs;
+use crate::system::TransferFunction;
+use crate::util::write_atomic;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use shard::Shard;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use summary::SummaryRow;
+
+/// Exit code when every dataset succeeded.
+pub const EXIT_OK: i32 = 0;
+/// Exit code when some datasets failed (the others completed).
+pub const EXIT_SOME_FAILED: i32 = 3;
+
+/// `batch.json`: what a batch (or a merge of shards) did.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BatchReport {
+    /// Version of rshape.
+    pub rshape_version: String,
+    /// The config file.
+    pub config: PathBuf,
+    /// The configured `r`, if any.
+    pub r_configured: Option<CoeffsOwned>,
+    /// Datasets in the full (unsharded) list.
+    pub n_total: usize,
+    /// The shard this output covers (`0/1` for a whole batch or a merge).
+    pub shard: Shard,
+    /// Datasets processed here.
+    pub n_datasets: usize,
+    /// Datasets that succeeded.
+    pub n_ok: usize,
+    /// Datasets that failed.
+    pub n_failed: usize,
+    /// Datasets the configured `r` explains.
+    pub n_consistent: usize,
+    /// Frequencies of the combined envelope.
+    pub n_frequencies: usize,
+    /// Largest finite `r_min` of the combined envelope.
+    pub max_r_min: Option<f64>,
+    /// True when the configured `r` explains every datum of every successful dataset.
+    pub consistent_all: Option<bool>,
+    /// The `r` fitted above the combined envelope, as in `r.json`.
+    pub r_fitted: Option<Value>,
+    /// Its certificate.
+    pub certificate: Option<Value>,
+    /// Why the fit failed.
+    pub fit_error: Option<String>,
+    /// Shard directories merged into this output (`rshape merge`).
+    pub merged_from: Vec<PathBuf>,
+    /// Milliseconds per stage.
+    pub timings_ms: BTreeMap<String, f64>,
+}
+
+/// Coefficients of `r` (owned, deserializable twin of [`Coeffs`]).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CoeffsOwned {
+    /// Numerator, descending powers of `s`.
+    pub num: Vec<f64>,
+    /// Denominator, descending powers of `s`.
+    pub den: Vec<f64>,
+}
+
+impl From<&TransferFunction> for CoeffsOwned {
+    fn from(r: &TransferFunction) -> Self {
+        let c = Coeffs {
+            num: r.num.coeffs().to_vec(),
+            den: r.den.coeffs().to_vec(),
+        };
+        CoeffsOwned {
+            num: c.num,
+            den: c.den,
+        }
+    }
+}
+
+/// What the batch-wide stage needs besides the rows and the combined envelope.
+pub struct FinishInput<'a> {
+    /// The config file.
+    pub config: PathBuf,
+    /// The configured `r`.
+    pub r_configured: Option<&'a TransferFunction>,
+    /// Datasets in the full list.
+    pub n_total: usize,
+    /// The shard.
+    pub shard: Shard,
+    /// Shard directories merged.
+    pub merged_from: Vec<PathBuf>,
+    /// Timings so far.
+    pub timings_ms: BTreeMap<String, f64>,
+}
+
+/// The batch-wide stage, shared by `batch` and `merge`: fits one `r` above the combined
+/// envelope, writes `combined_envelope.csv`, the exports, `summary.csv` and, last,
+/// `batch.json` into `out`.
+pub fn finish(
+    out: &Path,
+    rows: &[SummaryRow],
+    combined: Option<&Envelope>,
+    inp: FinishInput,
+) -> Result<BatchReport> {
+    let mut timings = inp.timings_ms;
+    let t = std::time::Instant::now();
+    let fit = combined.map(integration::fit_r);
+    timings.insert("fit".into(), t.elapsed().as_secs_f64() * 1e3);
+    let t = std::time::Instant::now();
+    if let Some(env) = combined {
+        write_atomic(
+            &out.join("combined_envelope.csv"),
+            envelope_csv(env).as_bytes(),
+        )?;
+    }
+    if let Some(Ok(f)) = &fit {
+        integration::export_r(f, out)?;
+    }
+    write_atomic(&out.join("summary.csv"), summary::render(rows).as_bytes())?;
+    timings.insert("write".into(), t.elapsed().as_secs_f64() * 1e3);
+    let ok = rows.iter().filter(|r| r.ok).count();
+    let report = BatchReport {
+        rshape_version: env!("CARGO_PKG_VERSION").to_string(),
+        config: inp.config,
+        r_configured: inp.r_configured.map(CoeffsOwned::from),
+        n_total: inp.n_total,
+        shard: inp.shard,
+        n_datasets: rows.len(),
+        n_ok: ok,
+        n_failed: rows.len() - ok,
+        n_consistent: rows.iter().filter(|r| r.consistent == Some(true)).count(),
+        n_frequencies: combined.map_or(0, |e| e.len()),
+        max_r_min: combined.and_then(|e| {
+            e.r_min
+                .iter()
+                .copied()
+                .filter(|x| x.is_finite())
+                .reduce(f64::max)
+        }),
+        consistent_all: match (inp.r_configured, combined) {
+            (Some(r), Some(env)) => Some(check(r, env).consistent),
+            _ => None,
+        },
+        r_fitted: fit
+            .as_ref()
+            .and_then(|f| f.as_ref().ok())
+            .map(|f| f.json.clone()),
+        certificate: fit
+            .as_ref()
+            .and_then(|f| f.as_ref().ok())
+            .map(|f| f.certificate.clone()),
+        fit_error: match &fit {
+            Some(Err(e)) => Some(crate::cli::one_line(&e.to_string())),
+            None => Some("no dataset succeeded: nothing to fit".into()),
+            _ => None,
+        },
+        merged_from: inp.merged_from,
+        timings_ms: timings,
+    };
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| Error::Invalid(format!("batch.json: {e}")))?;
+    write_atomic(&out.join("batch.json"), text.as_bytes())?;
+    Ok(report)
+}

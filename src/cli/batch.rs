@@ -1,0 +1,181 @@
+//! `rshape batch CONFIG (--data-dir DIR | --manifest FILE) --out OUT [--shard K/N]`:
+//! many datasets on one model, in parallel, with `OUT/summary.csv`.
+//! Exit 0 when every dataset succeeded, 3 when some failed, 2 on a usage error.
+
+use super::common::fmt_g;
+use crate::batch::{
+    self, combine::combine, discover, runner, shard::Shard, summary::SummaryRow, FinishInput,
+};
+use crate::model::Config;
+use anyhow::{anyhow, Result};
+use clap::{ArgGroup, Args};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `rshape batch`.
+#[derive(Debug, Args)]
+#[command(group(ArgGroup::new("source").required(true).args(["data_dir", "manifest"])))]
+pub struct BatchArgs {
+    /// The TOML config (model and r); its `data` entry is ignored.
+    pub config: PathBuf,
+    /// Every *.csv file of this directory is a dataset (sorted by name).
+    #[arg(long)]
+    pub data_dir: Option<PathBuf>,
+    /// A manifest CSV with columns name,data,noise_radius (only data required).
+    #[arg(long)]
+    pub manifest: Option<PathBuf>,
+    /// Output directory (created if needed).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Noise radius for datasets without one in the manifest.
+    #[arg(long)]
+    pub noise_radius: Option<f64>,
+    /// Process every N-th dataset starting at K (0-based), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    /// Do not write OUT/datasets/NAME/ (only summary.csv, the combined envelope and r).
+    #[arg(long)]
+    pub no_dataset_files: bool,
+}
+
+/// Runs `rshape batch`.
+pub fn run(a: &BatchArgs) -> Result<i32> {
+    let t0 = Instant::now();
+    let config = Config::load(&a.config)?;
+    if let Some(x) = a.noise_radius {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(anyhow!("--noise-radius {x}: must be a finite number ≥ 0"));
+        }
+    }
+    let all = match (&a.data_dir, &a.manifest) {
+        (Some(d), _) => discover::from_dir(d)?,
+        (None, Some(m)) => discover::from_manifest(m)?,
+        (None, None) => unreachable!("clap requires one source"),
+    };
+    let shard = a
+        .shard
+        .as_deref()
+        .map(Shard::parse)
+        .transpose()?
+        .unwrap_or(Shard::ALL);
+    let datasets = shard.select(&all, |d| d.index);
+    let opts = runner::RunOptions {
+        noise_radius: a.noise_radius,
+        per_dataset_files: !a.no_dataset_files,
+    };
+
+    let bar = if std::io::stderr().is_terminal() {
+        let b = ProgressBar::with_draw_target(
+            Some(datasets.len() as u64),
+            ProgressDrawTarget::stderr(),
+        );
+        b.set_style(
+            ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} datasets  {elapsed_precise} (eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &|| bar.inc(1));
+    let results = match a.jobs {
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()?
+            .install(work),
+        None => work(),
+    };
+    bar.finish_and_clear();
+    let mut timings = BTreeMap::new();
+    timings.insert("load".to_string(), load_ms);
+    timings.insert("datasets".to_string(), t.elapsed().as_secs_f64() * 1e3);
+    let t = Instant::now();
+    let combined = combine(results.iter().filter_map(|r| r.envelope.as_ref()));
+    timings.insert("combine".to_string(), t.elapsed().as_secs_f64() * 1e3);
+    let rows: Vec<SummaryRow> = results.iter().map(SummaryRow::from).collect();
+    let rep = batch::finish(
+        &a.out,
+        &rows,
+        combined.as_ref(),
+        FinishInput {
+            config: config.path.clone(),
+            r_configured: config.r.as_ref(),
+            n_total: all.len(),
+            shard,
+            merged_from: Vec::new(),
+            timings_ms: timings,
+        },
+    )?;
+    print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());
+    Ok(if rep.n_failed > 0 {
+        batch::EXIT_SOME_FAILED
+    } else {
+        batch::EXIT_OK
+    })
+}
+
+/// Prints the result of a batch or a merge.
+pub fn print_summary(
+    rep: &batch::BatchReport,
+    rows: &[SummaryRow],
+    out: &std::path::Path,
+    secs: f64,
+) {
+    let shard = if rep.shard.n > 1 {
+        format!(" (shard {}/{})", rep.shard.k, rep.shard.n)
+    } else {
+        String::new()
+    };
+    println!(
+        "rshape batch: {} of {} dataset(s) processed{shard}, {} ok, {} failed, in {} s",
+        rep.n_datasets,
+        rep.n_total,
+        rep.n_ok,
+        rep.n_failed,
+        fmt_g(secs)
+    );
+    if rep.r_configured.is_some() {
+        println!(
+            "  configured r explains {} of {} successful dataset(s)",
+            rep.n_consistent, rep.n_ok
+        );
+    }
+    println!(
+        "  combined envelope: {} frequencies, max r_min = {}",
+        rep.n_frequencies,
+        rep.max_r_min.map_or("-".into(), fmt_g)
+    );
+    match (&rep.r_fitted, &rep.fit_error) {
+        (Some(j), _) => println!(
+            "  fitted r covering all datasets: num = {}, den = {} [{}]",
+            j.get("num").map_or("?".into(), |v| v.to_string()),
+            j.get("den").map_or("?".into(), |v| v.to_string()),
+            j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
+        ),
+        (None, Some(e)) => println!("  fit failed: {e}"),
+        _ => {}
+    }
+    for r in rows.iter().filter(|r| !r.ok).take(10) {
+        println!("  FAILED {}: {}", r.name, r.error);
+    }
+    if rep.n_failed > 10 {
+        println!(
+            "  ... and {} more failed dataset(s): see summary.csv",
+            rep.n_failed - 10
+        );
+    }
+    println!(
+        "  wrote {}/summary.csv, batch.json, combined_envelope.csv, r.json",
+        out.display()
+    );
+}

@@ -1,0 +1,44 @@
+//! `rshape merge SHARD_DIR... --out OUT`: combines the outputs of `rshape batch --shard`.
+//! Exit 0 when every merged dataset succeeded, 3 when some failed or are missing, 2 on an
+//! error.
+
+use crate::batch::{self, merge::merge};
+use anyhow::Result;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Arguments of `rshape merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Output directories of the shards.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// Output directory of the merged batch.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `rshape merge`.
+pub fn run(a: &MergeArgs) -> Result<i32> {
+    let t = std::time::Instant::now();
+    let m = merge(&a.shards, &a.out)?;
+    super::batch::print_summary(&m.report, &m.rows, &a.out, t.elapsed().as_secs_f64());
+    if !m.missing.is_empty() {
+        println!(
+            "  MISSING {} dataset(s) of {} (indices {}): merge every shard",
+            m.missing.len(),
+            m.report.n_total,
+            m.missing
+                .iter()
+                .take(20)
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(if m.report.n_failed > 0 || !m.missing.is_empty() {
+        batch::EXIT_SOME_FAILED
+    } else {
+        batch::EXIT_OK
+    })
+}
