@@ -20,8 +20,19 @@ pub struct RunArgs {
     pub out: PathBuf,
 }
 
+/// At most 8 frequencies, then how many in all.
 fn list(v: &[f64]) -> String {
-    v.iter().map(|w| fmt_g(*w)).collect::<Vec<_>>().join(", ")
+    let head = v
+        .iter()
+        .take(8)
+        .map(|w| fmt_g(*w))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if v.len() > 8 {
+        format!("{head}, … ({} in all)", v.len())
+    } else {
+        head
+    }
 }
 
 /// Runs `rshape run`: exit 0 when the pipeline completed (whatever the verdict; see

@@ -68,6 +68,13 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
         .collect::<Vec<f64>>();
     let (ylo, yhi) = log_range(&mags, 2.0).unwrap_or((1e-3, 1e3));
     let ylo = ylo.max(yhi * 1e-10);
+    let bar_floor = ylo;
+    let rows = channels.len() + usize::from(inp.noise_radius.is_some());
+    let (ylo, yhi) = reserve_bottom(
+        ylo,
+        yhi,
+        legend_fraction(rows, (SIZE.1 + 260) * 55 / 100 - 100),
+    );
     let noisy = inp.noise_radius.is_some();
 
     let mut svg = String::new();
@@ -110,9 +117,14 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
                 format!("G{}{}", i + 1, j + 1)
             };
             let s = ShapeStyle::from(&col).stroke_width(2);
+            let label = if line.is_empty() {
+                format!("{name}: data (markers); nominal model ≡ 0, not drawn")
+            } else {
+                format!("{name}: nominal model (line), data (markers)")
+            };
             mag.draw_series(LineSeries::new(line, s))
                 .map_err(plot_err)?
-                .label(format!("{name}: nominal model (line), data (markers)"))
+                .label(label)
                 .legend(move |(x, y)| {
                     EmptyElement::at((x, y))
                         + PathElement::new(vec![(0, 0), (24, 0)], s)
@@ -122,7 +134,7 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
                 let a = d[(i, j)].norm();
                 let r = radius(k);
                 if r > 0.0 {
-                    let lo = clamp((a - r).max(ylo), ylo, yhi);
+                    let lo = clamp((a - r).max(bar_floor), bar_floor, yhi);
                     let hi = clamp(a + r, ylo, yhi);
                     mag.draw_series(std::iter::once(PathElement::new(
                         vec![(*w, lo), (*w, hi)],

@@ -45,6 +45,12 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
         .chain(inp.a1_on_grid.into_iter().flatten());
     let (ylo, yhi) = log_range(ys, 2.5).unwrap_or((1e-3, 1e3));
     let (ylo, yhi) = (ylo.max(yhi * 1e-12), yhi);
+    let rows = 2
+        + usize::from(conf.is_some())
+        + usize::from(fit.is_some())
+        + usize::from(inp.a1_on_grid.is_some())
+        + usize::from(inp.r_min.iter().any(|r| r.is_infinite()));
+    let (ylo, yhi) = reserve_bottom(ylo, yhi, legend_fraction(rows, SIZE.1 - 120));
 
     let mut svg = String::new();
     {
