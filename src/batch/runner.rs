@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::model::Config;
 use crate::pipeline::integration;
 use crate::report::envelope_csv;
-use crate::util::write_atomic;
+use crate::util::write_atomic_nosync;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
@@ -104,10 +104,10 @@ fn fill(
     }
     if opts.per_dataset_files {
         let dir = out.join("datasets").join(&d.name);
-        write_atomic(&dir.join("envelope.csv"), envelope_csv(&env).as_bytes())?;
+        write_atomic_nosync(&dir.join("envelope.csv"), envelope_csv(&env).as_bytes())?;
         let json =
             serde_json::to_string_pretty(&*res).map_err(|e| Error::Invalid(e.to_string()))?;
-        write_atomic(&dir.join("result.json"), json.as_bytes())?;
+        write_atomic_nosync(&dir.join("result.json"), json.as_bytes())?;
     }
     res.envelope = Some(env);
     Ok(())
