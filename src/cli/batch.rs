@@ -136,7 +136,7 @@ pub fn print_summary(
     } else {
         String::new()
     };
-    println!(
+    outln!(
         "rshape batch: {} of {} dataset(s) processed{shard}, {} ok, {} failed, in {} s",
         rep.n_datasets,
         rep.n_total,
@@ -145,36 +145,37 @@ pub fn print_summary(
         fmt_g(secs)
     );
     if rep.r_configured.is_some() {
-        println!(
+        outln!(
             "  configured r explains {} of {} successful dataset(s)",
-            rep.n_consistent, rep.n_ok
+            rep.n_consistent,
+            rep.n_ok
         );
     }
-    println!(
+    outln!(
         "  combined envelope: {} frequencies, max r_min = {}",
         rep.n_frequencies,
         rep.max_r_min.map_or("-".into(), fmt_g)
     );
     match (&rep.r_fitted, &rep.fit_error) {
-        (Some(j), _) => println!(
+        (Some(j), _) => outln!(
             "  fitted r covering all datasets: num = {}, den = {} [{}]",
             j.get("num").map_or("?".into(), |v| v.to_string()),
             j.get("den").map_or("?".into(), |v| v.to_string()),
             j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
         ),
-        (None, Some(e)) => println!("  fit failed: {e}"),
+        (None, Some(e)) => outln!("  fit failed: {e}"),
         _ => {}
     }
     for r in rows.iter().filter(|r| !r.ok).take(10) {
-        println!("  FAILED {}: {}", r.name, r.error);
+        outln!("  FAILED {}: {}", r.name, r.error);
     }
     if rep.n_failed > 10 {
-        println!(
+        outln!(
             "  ... and {} more failed dataset(s): see summary.csv",
             rep.n_failed - 10
         );
     }
-    println!(
+    outln!(
         "  wrote {}/summary.csv, batch.json, combined_envelope.csv, r.json",
         out.display()
     );

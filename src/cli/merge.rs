@@ -24,7 +24,7 @@ pub fn run(a: &MergeArgs) -> Result<i32> {
     let m = merge(&a.shards, &a.out)?;
     super::batch::print_summary(&m.report, &m.rows, &a.out, t.elapsed().as_secs_f64());
     if !m.missing.is_empty() {
-        println!(
+        outln!(
             "  MISSING {} dataset(s) of {} (indices {}): merge every shard",
             m.missing.len(),
             m.report.n_total,

@@ -4,6 +4,14 @@
 //! Exit codes: 0 success (and consistent, for `check`), 1 inconsistent data (`check`),
 //! 2 any error (bad input, usage), 3 some datasets failed (`batch`).
 
+/// `println!` that ignores a closed stdout (`rshape ... | head` must not panic).
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
+
 pub mod batch;
 pub mod check;
 pub mod common;

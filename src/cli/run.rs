@@ -50,8 +50,8 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         .name
         .clone()
         .unwrap_or_else(|| config.path.display().to_string());
-    println!("rshape run: {name}");
-    println!(
+    outln!("rshape run: {name}");
+    outln!(
         "  data      {} ({} points, {}×{}, {})",
         data.path.display(),
         rep.n_data,
@@ -59,32 +59,32 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         rep.size[1],
         if rep.noisy { "noisy" } else { "noise-free" }
     );
-    println!(
+    outln!(
         "  envelope  {:?}, max r_min = {}",
         rep.method,
         rep.max_r_min.map_or("-".into(), fmt_g)
     );
     if !rep.beyond_a1.is_empty() {
-        println!(
+        outln!(
             "            r_min reaches the A1 limit at omega = {} rad/s: no admissible r explains these data",
             list(&rep.beyond_a1)
         );
     }
     match rep.consistent {
-        Some(true) => println!(
+        Some(true) => outln!(
             "  check     CONSISTENT: the configured r explains all {} data",
             rep.n_data
         ),
-        Some(false) => println!(
+        Some(false) => outln!(
             "  check     INCONSISTENT at {} of {} data: omega = {} rad/s",
             rep.failing_omegas.len(),
             rep.n_data,
             list(&rep.failing_omegas)
         ),
-        None => println!("  check     no [r] in the config: nothing to check"),
+        None => outln!("  check     no [r] in the config: nothing to check"),
     }
     match (&out.fit, &rep.r_fitted) {
-        (Ok(f), Some(j)) => println!(
+        (Ok(f), Some(j)) => outln!(
             "  fit       r = ({})/({}) [{}]",
             f.r.num
                 .coeffs()
@@ -100,22 +100,22 @@ pub fn run(a: &RunArgs) -> Result<i32> {
                 .join(", "),
             j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
         ),
-        _ => println!(
+        _ => outln!(
             "  fit       failed: {}",
             rep.fit_error.clone().unwrap_or_default()
         ),
     }
     for w in &rep.warnings {
-        println!("  warning   {w}");
+        outln!("  warning   {w}");
     }
-    println!(
+    outln!(
         "  time      {} ms",
         fmt_g(rep.timings_ms.get("total").copied().unwrap_or(0.0))
     );
-    println!("  wrote     {}", a.out.display());
+    outln!("  wrote     {}", a.out.display());
     for f in &files {
         if let Some(n) = f.file_name() {
-            println!("            {}", n.to_string_lossy());
+            outln!("            {}", n.to_string_lossy());
         }
     }
     Ok(0)
