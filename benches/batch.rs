@@ -68,6 +68,7 @@ fn batch_1000(bencher: divan::Bencher) {
                 shard: Shard::ALL,
                 merged_from: vec![],
                 timings_ms: Default::default(),
+                factorization: Some(&config.factorization),
             },
         )
         .unwrap();

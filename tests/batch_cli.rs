@@ -246,3 +246,59 @@ fn usage_errors_exit_2() {
     let empty = tempfile::tempdir().unwrap();
     assert_eq!(batch(empty.path(), out.path(), &[]).status.code(), Some(2));
 }
+
+/// The noisy robot model: a manifest with per-dataset noise radii and a corrupt file.
+#[test]
+fn robot_manifest_with_noise_and_a_corrupt_file() {
+    let cfg = root().join("configs/robot.toml");
+    if !cfg.exists() {
+        eprintln!("configs/robot.toml not present: skipped");
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let data = root().join("configs/robot.csv");
+    std::fs::write(
+        d.path().join("broken.csv"),
+        "omega_rad_s,re_1_1,im_1_1\n1,0.1\n",
+    )
+    .unwrap();
+    let m = d.path().join("runs.csv");
+    std::fs::write(
+        &m,
+        format!(
+            "name,data,noise_radius\nA,{0},0.06\nB,broken.csv,\nC,{0},0.08\n",
+            data.display()
+        ),
+    )
+    .unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let o = rshape(&[
+        "batch".as_ref(),
+        cfg.as_os_str(),
+        "--manifest".as_ref(),
+        m.as_os_str(),
+        "--out".as_ref(),
+        out.path().as_os_str(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let r = rows(out.path());
+    assert_eq!(
+        r.iter().map(|r| r[2].as_str()).collect::<Vec<_>>(),
+        ["ok", "failed", "ok"]
+    );
+    assert_eq!(r[0][3], "211");
+    // More noise explains more: the larger radius never needs a larger r.
+    let a: f64 = r[0][4].parse().unwrap();
+    let c: f64 = r[2][4].parse().unwrap();
+    assert!(c <= a, "{c} > {a}");
+    let res = json(&out.path().join("datasets/A/result.json"));
+    assert_eq!(res["n_data"], 211);
+    let b = json(&out.path().join("batch.json"));
+    assert_eq!(b["n_frequencies"], 211);
+    assert!(b["r_fitted"]["num"].is_array());
+}

@@ -77,6 +77,9 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<MergeOutcome> {
         .r_configured
         .as_ref()
         .map(|c| TransferFunction::new(c.num.clone(), c.den.clone()));
+    // The model (for the A1 limit of the fit) from the config the shards ran with, if it
+    // can still be read.
+    let config = crate::model::Config::load(&first.config).ok();
     let mut timings = BTreeMap::new();
     timings.insert("read".into(), t.elapsed().as_secs_f64() * 1e3);
     let report = finish(
@@ -90,6 +93,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<MergeOutcome> {
             shard: Shard::ALL,
             merged_from: shards.to_vec(),
             timings_ms: timings,
+            factorization: config.as_ref().map(|c| &c.factorization),
         },
     )?;
     Ok(MergeOutcome {

@@ -112,6 +112,8 @@ pub struct FinishInput<'a> {
     pub merged_from: Vec<PathBuf>,
     /// Timings so far.
     pub timings_ms: BTreeMap<String, f64>,
+    /// The model, for the A1 limit `σ_min(M̃(jω))` the fitted `r` must stay below.
+    pub factorization: Option<&'a crate::model::Factorization>,
 }
 
 /// The batch-wide stage, shared by `batch` and `merge`: fits one `r` above the combined
@@ -125,7 +127,9 @@ pub fn finish(
 ) -> Result<BatchReport> {
     let mut timings = inp.timings_ms;
     let t = std::time::Instant::now();
-    let fit = combined.map(integration::fit_r);
+    let a1 = inp.factorization.map(|f| move |w: f64| f.a1_limit(w));
+    let a1_dyn: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
+    let fit = combined.map(|env| integration::fit_r(env, a1_dyn));
     timings.insert("fit".into(), t.elapsed().as_secs_f64() * 1e3);
     let t = std::time::Instant::now();
     if let Some(env) = combined {

@@ -93,7 +93,7 @@ fn fill(
         )));
     }
     res.n_data = data.len();
-    let radii = integration::noise_radii(config, &data, d.noise_radius.or(opts.noise_radius));
+    let radii = integration::noise_radii(config, &data, d.noise_radius.or(opts.noise_radius))?;
     let (env, warnings) = integration::envelope(&config.factorization, &data, radii.as_deref())?;
     res.warnings = warnings;
     res.max_r_min = env.r_min.iter().copied().reduce(f64::max);

@@ -114,6 +114,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             shard,
             merged_from: Vec::new(),
             timings_ms: timings,
+            factorization: Some(&config.factorization),
         },
     )?;
     print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());
@@ -158,10 +159,15 @@ pub fn print_summary(
     );
     match (&rep.r_fitted, &rep.fit_error) {
         (Some(j), _) => outln!(
-            "  fitted r covering all datasets: num = {}, den = {} [{}]",
+            "  fitted r covering all datasets: num = {}, den = {} [order {}, certificate {}]",
             j.get("num").map_or("?".into(), |v| v.to_string()),
             j.get("den").map_or("?".into(), |v| v.to_string()),
-            j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
+            j.get("order").map_or("?".into(), |v| v.to_string()),
+            match j.pointer("/certificate/passed").and_then(|p| p.as_bool()) {
+                Some(true) => "passed",
+                Some(false) => "FAILED",
+                None => "-",
+            }
         ),
         (None, Some(e)) => outln!("  fit failed: {e}"),
         _ => {}

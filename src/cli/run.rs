@@ -98,7 +98,15 @@ pub fn run(a: &RunArgs) -> Result<i32> {
                 .map(|c| fmt_g(*c))
                 .collect::<Vec<_>>()
                 .join(", "),
-            j.get("method").and_then(|m| m.as_str()).unwrap_or("fit")
+            format!(
+                "order {}, certificate {}",
+                j.get("order").map_or("?".into(), |o| o.to_string()),
+                match j.pointer("/certificate/passed").and_then(|p| p.as_bool()) {
+                    Some(true) => "passed",
+                    Some(false) => "FAILED",
+                    None => "-",
+                }
+            )
         ),
         _ => outln!(
             "  fit       failed: {}",

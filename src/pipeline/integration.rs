@@ -16,18 +16,25 @@ use crate::system::TransferFunction;
 use serde::Serialize;
 use serde_json::{json, Value};
 
-/// Where the per-datum noise radii come from, in priority order: `--noise-radius`, the
-/// data file's `noise_radius` column, the config's `[noise] radius`.  `None` (noise-free)
-/// when none is given or all radii are zero.
-// INTEGRATION(mu): replace with `model::noise` once it lands, keeping this priority order.
-pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Option<Vec<f64>> {
-    let radii = match (cli, &data.noise_radius, config.raw.noise.radius) {
+/// Per-datum noise radii, in priority order: `--noise-radius` (or a manifest's per-dataset
+/// radius), the config's `[noise] radius`, the data file's `noise_radius` column.  `None`
+/// (noise-free) when none is given or all radii are zero.
+// INTEGRATION(mu): replace with `model::noise::noise_radii` once it lands (same precedence).
+pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<Option<Vec<f64>>> {
+    if let Some(x) = cli {
+        if !(x.is_finite() && x >= 0.0) {
+            return Err(Error::Invalid(format!(
+                "noise radius {x}: must be a finite number ≥ 0"
+            )));
+        }
+    }
+    let radii = match (cli, config.raw.noise.radius, &data.noise_radius) {
         (Some(x), _, _) => vec![x; data.len()],
-        (None, Some(col), _) => col.clone(),
-        (None, None, Some(x)) => vec![x; data.len()],
-        (None, None, None) => return None,
+        (None, Some(x), _) => vec![x; data.len()],
+        (None, None, Some(col)) => col.clone(),
+        (None, None, None) => return Ok(None),
     };
-    radii.iter().any(|r| *r > 0.0).then_some(radii)
+    Ok(radii.iter().any(|r| *r > 0.0).then_some(radii))
 }
 
 /// The envelope of the data: noise-free (Theorem 2 / Theorem 3) when `radii` is `None`,
@@ -80,7 +87,7 @@ struct C2([f64; 2]);
 
 /// Fits the smallest unit `r` above the envelope.
 // INTEGRATION(fit): call `fit::...` and take `r.json` from `report::export`.
-pub fn fit_r(env: &Envelope) -> Result<FittedR> {
+pub fn fit_r(env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) -> Result<FittedR> {
     let top = env
         .r_min
         .iter()
@@ -101,10 +108,13 @@ pub fn fit_r(env: &Envelope) -> Result<FittedR> {
         .map(|x| k / x)
         .collect();
     let min_ratio = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-    let a1_ok = env
-        .a1_limit
-        .as_ref()
-        .is_none_or(|a| a.iter().all(|l| k < *l));
+    let a1_ok = match a1 {
+        Some(f) => env.omega.iter().all(|w| k < f(*w)),
+        None => env
+            .a1_limit
+            .as_ref()
+            .is_none_or(|a| a.iter().all(|l| k < *l)),
+    };
     let certificate = json!({
         "covers_all_finite_data": env.r_min.iter().filter(|x| x.is_finite()).all(|x| k > *x),
         "min_ratio_at_data": min_ratio,

@@ -52,13 +52,14 @@ pub struct RunOutcome {
 pub fn run(config: &Config, data: &FrfData, noise_radius: Option<f64>) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
-    let radii = integration::noise_radii(config, data, noise_radius);
+    let radii = integration::noise_radii(config, data, noise_radius)?;
     let (envelope, mut warnings) = timings.time("envelope", || {
         integration::envelope(f, data, radii.as_deref())
     })?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
-        integration::fit_r(&envelope).map_err(|e| crate::cli::one_line(&e.to_string()))
+        let a1 = |w: f64| f.a1_limit(w);
+        integration::fit_r(&envelope, Some(&a1)).map_err(|e| crate::cli::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {
         warnings.push(format!("fit failed: {e}"));

@@ -88,8 +88,14 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         .name
         .clone()
         .unwrap_or_else(|| config.path.display().to_string());
+    // Titles must fit on one line of the figure.
+    let name = if name.chars().count() > 64 {
+        format!("{}…", name.chars().take(63).collect::<String>())
+    } else {
+        name
+    };
     let mut svgs = Vec::new();
-    let title = format!("Smallest consistent |r| per datum vs |r(jω)|: {name}");
+    let title = format!("Smallest consistent |r| per datum vs |r(jω)| — {name}");
     svgs.push((
         "r_vs_delta.svg".to_string(),
         r_vs_delta_svg(&RVsDeltaInput {
@@ -105,7 +111,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         })?,
     ));
     let model: Vec<_> = grid.iter().map(|w| f.plant(*w)).collect();
-    let title = format!("Bode: data vs nominal model: {name}");
+    let title = format!("Bode: data vs nominal model — {name}");
     svgs.push((
         "bode.svg".to_string(),
         bode_svg(&BodeInput {
@@ -118,7 +124,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         })?,
     ));
     if let Some(mu) = &out.mu {
-        let title = format!("μ test per datum for the configured r (Fig. 8): {name}");
+        let title = format!("μ_Γ per datum, configured r (Fig. 8) — {name}");
         svgs.push((
             "mu.svg".to_string(),
             mu_svg(&MuInput {

@@ -49,7 +49,9 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
         + usize::from(conf.is_some())
         + usize::from(fit.is_some())
         + usize::from(inp.a1_on_grid.is_some())
-        + usize::from(inp.r_min.iter().any(|r| r.is_infinite()));
+        + usize::from(inp.r_min.iter().any(|r| r.is_infinite()))
+        + usize::from(inp.r_min.contains(&0.0));
+    let floor = ylo;
     let (ylo, yhi) = reserve_bottom(ylo, yhi, legend_fraction(rows, SIZE.1 - 120));
 
     let mut svg = String::new();
@@ -164,6 +166,29 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 .map_err(plot_err)?
                 .label("r_min = ∞: no admissible r explains the datum (drawn at the top)")
                 .legend(move |(x, y)| Polygon::new(tri((x + 12, y - 6)), C_RED.filled()));
+        }
+        let zeros: Vec<(f64, f64)> = inp
+            .omega
+            .iter()
+            .zip(inp.r_min)
+            .filter(|(_, r)| **r == 0.0)
+            .map(|(w, _)| (*w, floor))
+            .collect();
+        if !zeros.is_empty() {
+            let tri = |(x, y): (i32, i32)| vec![(x - 4, y - 7), (x + 4, y - 7), (x, y)];
+            let col = C_GREEN.mix(0.55);
+            chart
+                .draw_series(
+                    zeros
+                        .iter()
+                        .map(|p| EmptyElement::at(*p) + Polygon::new(tri((0, 0)), col.filled())),
+                )
+                .map_err(plot_err)?
+                .label(format!(
+                    "r_min = 0 at {} data: explained by the noise alone (drawn at the bottom)",
+                    zeros.len()
+                ))
+                .legend(move |(x, y)| Polygon::new(tri((x + 12, y + 4)), col.filled()));
         }
         legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
         root.present().map_err(plot_err)?;
