@@ -6,6 +6,7 @@
 
 pub mod check;
 pub mod common;
+pub mod compare;
 pub mod envelope;
 
 use clap::{Parser, Subcommand};
@@ -27,6 +28,8 @@ pub enum Command {
     Envelope(envelope::EnvelopeArgs),
     /// Check the configured r (or --r-num/--r-den) against every datum.
     Check(check::CheckArgs),
+    /// Compare the model with the data: misfit per frequency, failing bands, error measures.
+    Compare(compare::CompareArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -42,6 +45,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Envelope(a) => envelope::run(&a),
         Command::Check(a) => check::run(&a),
+        Command::Compare(a) => compare::run(&a),
     };
     match result {
         Ok(code) => code,
