@@ -7,7 +7,9 @@
 pub mod check;
 pub mod common;
 pub mod compare;
+pub mod diagnose;
 pub mod envelope;
+pub mod history;
 
 use clap::{Parser, Subcommand};
 
@@ -30,6 +32,10 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Compare the model with the data: misfit per frequency, failing bands, error measures.
     Compare(compare::CompareArgs),
+    /// Rank candidate missing effects (delay, lag, mode, …) by how much each lowers the error.
+    Diagnose(diagnose::DiagnoseArgs),
+    /// Error measures across model revisions (table and error-vs-revision SVG).
+    History(history::HistoryArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -46,6 +52,8 @@ pub fn main() -> i32 {
         Command::Envelope(a) => envelope::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Compare(a) => compare::run(&a),
+        Command::Diagnose(a) => diagnose::run(&a),
+        Command::History(a) => history::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -8,3 +8,8 @@ pub mod compare;
 pub mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
+pub mod candidates;
+pub mod engine;
+pub mod fit;
+
+pub use engine::{apply_candidate, diagnose, Diagnosis};
