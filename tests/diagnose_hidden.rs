@@ -48,7 +48,9 @@ fn twomass() -> (PhysicalModel, Vec<f64>) {
         }],
         ..Default::default()
     };
-    let w = (11..=250).map(|f| std::f64::consts::TAU * f as f64).collect();
+    let w = (11..=250)
+        .map(|f| std::f64::consts::TAU * f as f64)
+        .collect();
     (m, w)
 }
 
@@ -77,11 +79,17 @@ fn effect(kind: EffectKind, set: impl Fn(&mut EffectSpec)) -> EffectSpec {
 fn truth(base: &PhysicalModel, h: &Hidden) -> PhysicalModel {
     let mut m = base.clone();
     match h {
-        Hidden::Delay(t) => m.effect.push(effect(EffectKind::Delay, |e| e.tau_s = Some(*t))),
-        Hidden::Lag(w) => m.effect.push(effect(EffectKind::Lag, |e| e.omega_c = Some(*w))),
+        Hidden::Delay(t) => m
+            .effect
+            .push(effect(EffectKind::Delay, |e| e.tau_s = Some(*t))),
+        Hidden::Lag(w) => m
+            .effect
+            .push(effect(EffectKind::Lag, |e| e.omega_c = Some(*w))),
         Hidden::Gain(k) => m.effect.push(effect(EffectKind::Gain, |e| e.k = Some(*k))),
         Hidden::Sign => m.effect.push(effect(EffectKind::Sign, |_| {})),
-        Hidden::NmpZero(z) => m.effect.push(effect(EffectKind::NmpZero, |e| e.z = Some(*z))),
+        Hidden::NmpZero(z) => m
+            .effect
+            .push(effect(EffectKind::NmpZero, |e| e.z = Some(*z))),
         Hidden::Zoh(t) => m.effect.push(effect(EffectKind::Zoh, |e| e.t_s = Some(*t))),
         Hidden::Mode(w, z, rho) => m.mode.push(ModeSpec {
             name: None,
@@ -250,7 +258,10 @@ fn run_suite(name: &str, base: PhysicalModel, w: Vec<f64>) {
                 let gm: Vec<Complex64> = w.iter().map(|x| revised.eval_siso(*x)).collect();
                 let (_, rms, _, inv) = misfit(&siso, &gm);
                 let inv = inv.unwrap();
-                msg += &format!("→ applied rms {rms:.3} inv {:.1} % ({secs:.2} s)", 100.0 * inv);
+                msg += &format!(
+                    "→ applied rms {rms:.3} inv {:.1} % ({secs:.2} s)",
+                    100.0 * inv
+                );
                 ok &= inv <= 0.05 && rms <= 1.0;
             }
             None => {
@@ -286,7 +297,12 @@ fn run_suite(name: &str, base: PhysicalModel, w: Vec<f64>) {
         }
     }
     println!("{name}: slowest diagnose call {slowest:.2} s");
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -299,4 +315,27 @@ fn hidden_effects_robot() {
 fn hidden_effects_twomass() {
     let (b, w) = twomass();
     run_suite("twomass", b, w);
+}
+
+/// A short delay and an NMP zero far above the band look alike inside it: diagnose ranks the
+/// delay first (fewer assumptions), reports the tie, and says where to measure.
+#[test]
+fn delay_and_far_nmp_zero_are_reported_as_a_tie() {
+    let (base, w) = twomass();
+    let h = Hidden::Delay(0.3 / w[w.len() - 1]);
+    let siso = data(&truth(&base, &h), &w, 1000);
+    let d = diagnose(&base, &siso, 1).unwrap();
+    assert_eq!(d.candidates[0].effect, "delay");
+    let tie = d
+        .ties
+        .iter()
+        .find(|t| t.effects.contains(&"nmp_zero".to_string()))
+        .expect("a delay/nmp_zero tie");
+    assert!(tie.bic_gap < 6.0);
+    assert!(
+        tie.disambiguation.contains("above"),
+        "{}",
+        tie.disambiguation
+    );
+    println!("tie: {:?}", tie);
 }

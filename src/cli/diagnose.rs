@@ -59,7 +59,12 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             config.path.display()
         )
     })?;
-    let siso = prepare(config, &inputs.data, channel_arg(&a.channel)?, a.input.noise_radius)?;
+    let siso = prepare(
+        config,
+        &inputs.data,
+        channel_arg(&a.channel)?,
+        a.input.noise_radius,
+    )?;
     let d = diagnose(&base, &siso, a.max_effects.max(1))?;
     if let (Some(k), Some(out)) = (a.apply, &a.write) {
         let revised = apply_candidate(&base, &d, k)?;
@@ -68,7 +73,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         raw.physical = Some(revised);
         raw.name = Some(format!(
             "{} + {}",
-            raw.name.clone().unwrap_or_else(|| config.path.display().to_string()),
+            raw.name
+                .clone()
+                .unwrap_or_else(|| config.path.display().to_string()),
             c.effect
         ));
         let out_dir = out
@@ -149,7 +156,11 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
                 100.0 * c.invalid_fraction_before,
                 100.0 * c.invalid_fraction_after,
                 if c.passes { "pass" } else { "-" },
-                if c.tie_with_best { "  (tie with #1)" } else { "" }
+                if c.tie_with_best {
+                    "  (tie with #1)"
+                } else {
+                    ""
+                }
             );
             println!("    {params}");
             println!("    {}", c.explanation);

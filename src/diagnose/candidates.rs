@@ -163,7 +163,10 @@ impl Cand {
                 ("zeta", clamp_zeta(e(th[1])), clamp_zeta(e(th[1]))),
                 ("rho", th[2], 1.0),
             ],
-            Cand::ModeShift(i) => vec![("mode", (*i + 1) as f64, 0.0), ("omega_n", e(th[0]), e(th[0]))],
+            Cand::ModeShift(i) => vec![
+                ("mode", (*i + 1) as f64, 0.0),
+                ("omega_n", e(th[0]), e(th[0])),
+            ],
             Cand::Damping(i) => vec![
                 ("mode", (*i + 1) as f64, 0.0),
                 ("zeta", clamp_zeta(e(th[0])), clamp_zeta(e(th[0]))),
@@ -177,8 +180,11 @@ impl Cand {
 
     /// Writes the effect into a physical model (SISO).
     pub fn apply_to(&self, th: &[f64], m: &mut PhysicalModel, note: &str) {
-        let p: std::collections::HashMap<&str, f64> =
-            self.si_params(th).iter().map(|(n, v, _)| (*n, *v)).collect();
+        let p: std::collections::HashMap<&str, f64> = self
+            .si_params(th)
+            .iter()
+            .map(|(n, v, _)| (*n, *v))
+            .collect();
         let mut effect = |kind: EffectKind, set: &dyn Fn(&mut EffectSpec)| {
             let mut e = EffectSpec::new(kind);
             set(&mut e);

@@ -107,7 +107,10 @@ impl<'a> Problem<'a> {
             base,
             omega: siso.omega.clone(),
             g: siso.g.clone(),
-            inv_sigma: radius.iter().map(|r| std::f64::consts::SQRT_2 / r).collect(),
+            inv_sigma: radius
+                .iter()
+                .map(|r| std::f64::consts::SQRT_2 / r)
+                .collect(),
             radius,
             core0,
             path0,
@@ -137,7 +140,13 @@ impl<'a> Problem<'a> {
         let mut off = 0;
         for c in &mods.cands {
             let n = c.n_params();
-            c.modify(&mods.theta[off..off + n], self.base, omega, &mut core, &mut path);
+            c.modify(
+                &mods.theta[off..off + n],
+                self.base,
+                omega,
+                &mut core,
+                &mut path,
+            );
             off += n;
         }
         core * path
@@ -264,13 +273,19 @@ impl<'a> Problem<'a> {
                 .collect();
             let mut local: Vec<(f64, f64)> = (0..vs.len())
                 .filter(|&i| {
-                    (i == 0 || vs[i].0 <= vs[i - 1].0) && (i + 1 == vs.len() || vs[i].0 <= vs[i + 1].0)
+                    (i == 0 || vs[i].0 <= vs[i - 1].0)
+                        && (i + 1 == vs.len() || vs[i].0 <= vs[i + 1].0)
                 })
                 .map(|i| vs[i])
                 .collect();
             local.sort_by(|a, b| a.0.total_cmp(&b.0));
             vs.sort_by(|a, b| a.0.total_cmp(&b.0));
-            local.into_iter().chain(vs).take(keep).map(|(_, x)| vec![x]).collect()
+            local
+                .into_iter()
+                .chain(vs)
+                .take(keep)
+                .map(|(_, x)| vec![x])
+                .collect()
         };
         let log_grid = |lo: f64, hi: f64, n: usize| -> Vec<f64> {
             (0..n)
@@ -284,7 +299,13 @@ impl<'a> Problem<'a> {
             let mut off = 0;
             for cc in &cur.cands {
                 let n = cc.n_params();
-                cc.modify(&cur.theta[off..off + n], self.base, self.omega[k], &mut core, &mut path);
+                cc.modify(
+                    &cur.theta[off..off + n],
+                    self.base,
+                    self.omega[k],
+                    &mut core,
+                    &mut path,
+                );
                 off += n;
             }
             path
@@ -308,7 +329,9 @@ impl<'a> Problem<'a> {
             Cand::Feedthrough => vec![vec![ls(&|k| path_of(k))]],
             Cand::ModeShift(i) => {
                 let w0 = self.base.mode[i].omega_n;
-                let grid: Vec<f64> = (0..61).map(|j| w0.ln() + (j as f64 - 30.0) / 60.0).collect();
+                let grid: Vec<f64> = (0..61)
+                    .map(|j| w0.ln() + (j as f64 - 30.0) / 60.0)
+                    .collect();
                 grid_best(&grid, 3)
             }
             Cand::Damping(i) => {
@@ -341,6 +364,23 @@ impl<'a> Problem<'a> {
                 trials.into_iter().take(4).map(|t| t.1).collect()
             }
         }
+    }
+}
+
+/// Prior order among near-ties (lower first).
+fn prior(c: &Cand) -> usize {
+    match c {
+        Cand::Sign => 0,
+        Cand::Gain => 1,
+        Cand::Delay => 2,
+        Cand::Lag => 3,
+        Cand::Zoh => 4,
+        Cand::Feedthrough => 5,
+        Cand::Integrator(_) => 6,
+        Cand::Damping(_) => 7,
+        Cand::ModeShift(_) => 8,
+        Cand::NmpZero => 9,
+        Cand::Mode => 10,
     }
 }
 
@@ -606,13 +646,23 @@ impl Problem<'_> {
             });
         }
         out.sort_by(|a, b| b.delta_bic.total_cmp(&a.delta_bic));
+        // Near-ties with the best are ordered by fewer parameters, then by the prior order
+        // of the catalogue (a delay before an NMP zero far above the band, which only a
+        // measurement there can tell apart); the tie is still reported.
+        if let Some(best) = out.first().map(|c| c.delta_bic) {
+            let n_tied = out
+                .iter()
+                .take_while(|c| best - c.delta_bic < TIE_BIC)
+                .count();
+            out[..n_tied].sort_by_key(|c| (c.n_params, prior(&c.cand)));
+        }
         // Keep the best of each effect name (mode_shift over modes, integrator over orders).
         let mut seen = std::collections::HashSet::new();
         out.retain(|c| seen.insert(c.effect.clone()));
         for (k, c) in out.iter_mut().enumerate() {
             c.rank = k + 1;
         }
-        if let Some(best) = out.first().map(|c| c.delta_bic) {
+        if let Some(best) = out.iter().map(|c| c.delta_bic).reduce(f64::max) {
             for c in out.iter_mut().skip(1) {
                 c.tie_with_best = best - c.delta_bic < TIE_BIC && c.delta_bic > MIN_DELTA_BIC;
             }
@@ -630,7 +680,7 @@ impl Problem<'_> {
             .filter(|c| c.tie_with_best)
             .map(|c| Tie {
                 effects: [best.effect.clone(), c.effect.clone()],
-                bic_gap: best.delta_bic - c.delta_bic,
+                bic_gap: (best.delta_bic - c.delta_bic).abs(),
                 disambiguation: self.disambiguate(&best.mods, &c.mods),
             })
             .collect()
@@ -738,6 +788,10 @@ pub fn apply_candidate(base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Resu
     let mut m = base.clone();
     let n = c.cand.n_params();
     let th = &c.mods.theta[c.mods.theta.len() - n..];
-    c.cand.apply_to(th, &mut m, &format!("added by rshape diagnose: {}", c.effect));
+    c.cand.apply_to(
+        th,
+        &mut m,
+        &format!("added by rshape diagnose: {}", c.effect),
+    );
     Ok(m)
 }

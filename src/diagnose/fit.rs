@@ -110,7 +110,10 @@ mod tests {
         let xs: Vec<f64> = (0..20).map(|k| k as f64 * 0.1).collect();
         let f = |t: &[f64], r: &mut Vec<f64>| {
             r.clear();
-            r.extend(xs.iter().map(|x| t[0] * (-t[1] * x).exp() - 2.0 * (-1.5 * x).exp()));
+            r.extend(
+                xs.iter()
+                    .map(|x| t[0] * (-t[1] * x).exp() - 2.0 * (-1.5 * x).exp()),
+            );
         };
         let res = lm(f, &[1.0, 0.5], &[1.0, 1.0], 100);
         assert!((res.theta[0] - 2.0).abs() < 1e-6 && (res.theta[1] - 1.5).abs() < 1e-6);
