@@ -33,6 +33,7 @@ fn twomass() -> (PhysicalModel, Vec<f64>) {
     let m = PhysicalModel {
         factor_pole: Some(10.0),
         rigid_body: vec![PoleAtZeroSpec {
+            friction_pole: None,
             name: None,
             mass: 1.0,
             input_gain: Gains::Scalar(1.0),
@@ -103,6 +104,7 @@ fn truth(base: &PhysicalModel, h: &Hidden) -> PhysicalModel {
         Hidden::Damping(i, z) => m.mode[*i].zeta = *z,
         Hidden::Integrator(o, c) => {
             let p = PoleAtZeroSpec {
+                friction_pole: None,
                 name: None,
                 mass: 1.0,
                 input_gain: Gains::Scalar(1.0),

@@ -135,7 +135,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         100.0 * d.before.invalid_fraction
     );
     if !d.candidates.is_empty() {
-        println!("\ncandidates (ranked by ΔBIC = 2ΔV − n·ln 2F; pass = ΔBIC > 10, fewer invalid data, holdout ok):");
+        println!("\ncandidates (ranked by ΔBIC = 2ΔV − n·ln 2F; pass = ΔBIC > 10, no more invalid data, holdout ok):");
         for c in &d.candidates {
             let params = c
                 .params

@@ -37,10 +37,13 @@ pub enum Cand {
     NmpZero,
     /// Zero-order hold; θ = [ln T].
     Zoh,
+    /// Viscous friction on rigid body `i` of the base model: `1/s²` becomes
+    /// `1/(s (s + p))`; θ = [ln p].  (An extension beyond the list.)
+    Friction(usize),
 }
 
 /// The effect names of the JSON output.
-pub const EFFECT_NAMES: [&str; 11] = [
+pub const EFFECT_NAMES: [&str; 12] = [
     "delay",
     "lag",
     "gain",
@@ -52,10 +55,11 @@ pub const EFFECT_NAMES: [&str; 11] = [
     "feedthrough",
     "nmp_zero",
     "zoh",
+    "friction",
 ];
 
 fn clamp_zeta(z: f64) -> f64 {
-    z.clamp(1e-4, 0.99)
+    z.clamp(1e-4, 0.7)
 }
 
 impl Cand {
@@ -73,6 +77,7 @@ impl Cand {
             Cand::Feedthrough => "feedthrough",
             Cand::NmpZero => "nmp_zero",
             Cand::Zoh => "zoh",
+            Cand::Friction(_) => "friction",
         }
     }
 
@@ -145,6 +150,12 @@ impl Cand {
                 *core += mode_term(w, z, rho) - mode_term(m.omega_n, m.zeta, rho);
             }
             Cand::Integrator(order) => *core += th[0] / s.powi(*order as i32),
+            Cand::Friction(i) => {
+                let r = &base.rigid_body[*i];
+                let rho = r.output_gain.to_vec(1)[0] * r.input_gain.to_vec(1)[0] / r.mass;
+                let p0 = r.friction_pole.unwrap_or(0.0);
+                *core += rho / (s * (s + th[0].exp())) - rho / (s * (s + p0));
+            }
             Cand::Feedthrough => *core += th[0],
         }
     }
@@ -175,6 +186,10 @@ impl Cand {
             Cand::Feedthrough => vec![("d", th[0], 1.0)],
             Cand::NmpZero => vec![("z", e(th[0]), e(th[0]))],
             Cand::Zoh => vec![("t_s", e(th[0]), e(th[0]))],
+            Cand::Friction(i) => vec![
+                ("rigid_body", (*i + 1) as f64, 0.0),
+                ("pole", e(th[0]), e(th[0])),
+            ],
         }
     }
 
@@ -207,9 +222,11 @@ impl Cand {
                 output_gain: crate::model::physical::Gains::Scalar(p["rho"]),
             }),
             Cand::ModeShift(i) => m.mode[*i].omega_n = p["omega_n"],
+            Cand::Friction(i) => m.rigid_body[*i].friction_pole = Some(p["pole"]),
             Cand::Damping(i) => m.mode[*i].zeta = p["zeta"],
             Cand::Integrator(o) => {
                 let spec = PoleAtZeroSpec {
+                    friction_pole: None,
                     name: Some(note.to_string()),
                     mass: 1.0,
                     input_gain: crate::model::physical::Gains::Scalar(1.0),
@@ -319,6 +336,11 @@ pub fn explain(c: &Cand, th: &[f64], base: &PhysicalModel, omega: &[f64]) -> Str
             "magnitude matches but phase falls and saturates towards −180° (−90° at {}): a non-minimum-phase zero at z = {}",
             fmt_w(p["z"]),
             fmt_w(p["z"])
+        ),
+        Cand::Friction(i) => format!(
+            "the phase leads −180° at low frequency by atan(p/ω) and the lead fades with frequency, while the magnitude follows the rigid body: viscous friction on rigid body {}, pole p = c_v/J = {}",
+            i + 1,
+            fmt_w(p["pole"])
         ),
         Cand::Zoh => format!(
             "phase falls linearly (mean delay T/2 = {} ms) and magnitude droops like sinc(ωT/2) ({} dB at {}): a zero-order hold with T = {} ms (fs = {} Hz)",

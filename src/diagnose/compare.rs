@@ -114,7 +114,8 @@ impl Siso {
 }
 
 /// Selects the SISO channel and resolves the noise radius: `--noise-radius`, else the data's
-/// `noise_radius` column, else `[noise] std_file × std_factor`, else `[noise] radius`.
+/// `noise_radius` column, else `[noise] std_file × std_factor` (for data other than the
+/// config's own, `<data stem>_std.csv` beside the data), else `[noise] radius`.
 pub fn prepare(
     config: &Config,
     data: &FrfData,
@@ -164,10 +165,36 @@ pub fn prepare(
         (Some(vec![x; ch.len()]), format!("--noise-radius {x}"))
     } else if let Some(r) = &data.noise_radius {
         (Some(r.clone()), "noise_radius column of the data".into())
-    } else if let Some((file, k)) = &config.noise_std {
-        let sd = read_std_csv(file)?;
+    } else if let Some((cfg_file, k)) = &config.noise_std {
+        // The config's std file belongs to the config's data.  With other data (--data),
+        // use `<data stem>_std.csv` beside them.
+        let same = config.data.as_ref().is_some_and(|d| {
+            d == &data.path
+                || d.canonicalize()
+                    .ok()
+                    .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
+        });
+        let file = if same {
+            cfg_file.clone()
+        } else {
+            let stem = data
+                .path
+                .file_stem()
+                .map(|s| s.to_string_lossy().to_string())
+                .unwrap_or_default();
+            let sib = data.path.with_file_name(format!("{stem}_std.csv"));
+            if !sib.exists() {
+                return Err(Error::Invalid(format!(
+                    "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
+                    data.path.display(),
+                    sib.display()
+                )));
+            }
+            sib
+        };
+        let sd = read_std_csv(&file)?;
         (
-            Some(sd.radius_at(file, &ch.omega, out, inp, *k)?),
+            Some(sd.radius_at(&file, &ch.omega, out, inp, *k)?),
             format!("{k} × std_{out}_{inp} of {}", file.display()),
         )
     } else if let Some(x) = config.raw.noise.radius {

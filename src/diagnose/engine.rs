@@ -6,7 +6,7 @@
 //! * Each candidate is fitted by Levenberg–Marquardt from the best points of a grid or a
 //!   closed-form estimate (effects.md), jointly with every effect accepted before.
 //! * Score: `ΔBIC = 2(V₀ − V) − n_θ·ln(2F)`. A candidate **passes** when ΔBIC > 10, the
-//!   invalid fraction falls, and a holdout check passes (fit on 3 of every 4 data, the held-out
+//!   invalid fraction does not rise, and a holdout check passes (fit on 3 of every 4 data, the held-out
 //!   quarter's `V` must fall too).
 //! * Stop when the model is consistent (`invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`), when no
 //!   candidate passes, or after `max_effects` effects. Candidates within 6 of the best BIC are
@@ -338,6 +338,7 @@ impl<'a> Problem<'a> {
                 let _ = i;
                 grid_best(&log_grid(1e-3, 0.7, 30), 3)
             }
+            Cand::Friction(_) => grid_best(&log_grid(wmin / 1000.0, wmax, 40), 3),
             Cand::Mode => {
                 // ω_n candidates: local maxima of |e|/r, plus a log grid over the band.
                 let c: Vec<f64> = (0..self.f())
@@ -381,6 +382,7 @@ fn prior(c: &Cand) -> usize {
         Cand::ModeShift(_) => 8,
         Cand::NmpZero => 9,
         Cand::Mode => 10,
+        Cand::Friction(_) => 6,
     }
 }
 
@@ -514,6 +516,9 @@ pub fn candidate_list(base: &PhysicalModel) -> Vec<Cand> {
         v.push(Cand::ModeShift(i));
         v.push(Cand::Damping(i));
     }
+    for i in 0..base.rigid_body.len() {
+        v.push(Cand::Friction(i));
+    }
     v
 }
 
@@ -588,6 +593,9 @@ impl Problem<'_> {
                     continue;
                 }
             }
+            if matches!(c, Cand::Friction(_)) && used.contains(&c) {
+                continue;
+            }
             let (mods, v, jtj) = self.fit_candidate(cur, c, &all);
             if !v.is_finite() {
                 continue;
@@ -609,7 +617,10 @@ impl Problem<'_> {
                 }
                 let idx = ntot - n_new + j.min(n_new.saturating_sub(1));
                 let idx = match c {
-                    Cand::ModeShift(_) | Cand::Damping(_) | Cand::Integrator(_) => ntot - 1,
+                    Cand::ModeShift(_)
+                    | Cand::Damping(_)
+                    | Cand::Integrator(_)
+                    | Cand::Friction(_) => ntot - 1,
                     _ => idx,
                 };
                 let sd = cov
@@ -621,7 +632,7 @@ impl Problem<'_> {
             let (cm, flags1) = self.invalid_flags(&mods);
             let fixed: Vec<bool> = flags0.iter().zip(&flags1).map(|(a, b)| *a && !*b).collect();
             let passes = delta_bic > MIN_DELTA_BIC
-                && m.invalid_fraction < cur_m.invalid_fraction
+                && m.invalid_fraction <= cur_m.invalid_fraction
                 && holdout_ok;
             out.push(CandidateReport {
                 rank: 0,

@@ -13,7 +13,7 @@
 //! input_gain = 1800.0      # b: a number (SISO) or a list, one per input
 //! output_gain = -3.30e-3   # c: a number (SISO) or a list, one per output
 //!
-//! [[physical.rigid_body]]  # c·b/(m·s²)
+//! [[physical.rigid_body]]  # c·b/(m·s²), or c·b/(m·s·(s + p)) with friction_pole = p
 //! input_gain = 1.0
 //! output_gain = 100.0
 //!
@@ -138,6 +138,10 @@ pub struct PoleAtZeroSpec {
     /// Output gains `c`.
     #[serde(default)]
     pub output_gain: Gains,
+    /// Rigid bodies only: viscous-friction pole `p = c_v/m` in rad/s, making the term
+    /// `c bᵀ/(m s (s + p))`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub friction_pole: Option<f64>,
 }
 
 /// The kind of a path effect.
@@ -463,6 +467,15 @@ impl PhysicalModel {
                 if !(md.mass.is_finite() && md.mass > 0.0) {
                     return Err(format!("{at}: mass = {} must be positive", md.mass));
                 }
+                match md.friction_pole {
+                    Some(_) if name == "integrator" => {
+                        return Err(format!("{at}: friction_pole belongs to a rigid_body"))
+                    }
+                    Some(p) if !(p.is_finite() && p >= 0.0) => {
+                        return Err(format!("{at}: friction_pole = {p} must be ≥ 0 (rad/s)"))
+                    }
+                    _ => {}
+                }
                 gains_ok(&md.input_gain, m, &at, "input_gain")?;
                 gains_ok(&md.output_gain, p, &at, "output_gain")?;
             }
@@ -540,7 +553,12 @@ impl PhysicalModel {
             add(&md.output_gain, &md.input_gain, (d * md.mass).inv());
         }
         for md in &self.rigid_body {
-            add(&md.output_gain, &md.input_gain, (s * s * md.mass).inv());
+            let p = md.friction_pole.unwrap_or(0.0);
+            add(
+                &md.output_gain,
+                &md.input_gain,
+                (s * (s + p) * md.mass).inv(),
+            );
         }
         for md in &self.integrator {
             add(&md.output_gain, &md.input_gain, (s * md.mass).inv());
@@ -629,6 +647,9 @@ impl PhysicalModel {
                 };
                 let mut num = vec![md.mass];
                 num.extend(std::iter::repeat_n(0.0, order));
+                if let Some(p) = md.friction_pole {
+                    num = vec![md.mass, md.mass * p, 0.0];
+                }
                 m_diag.push(TransferFunction {
                     num: Polynomial::new(num),
                     den: qk.clone(),
