@@ -14,7 +14,7 @@ pub struct CompareArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// SISO channel of MIMO data, `OUT,IN` (1-based); overrides the config's [channel].
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
     /// Write the Bode overlay (data and model) to this SVG file.
     #[arg(long)]

@@ -16,7 +16,7 @@ pub struct DiagnoseArgs {
     #[command(flatten)]
     pub input: InputArgs,
     /// SISO channel of MIMO data, `OUT,IN` (1-based).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
     /// Most effects to add greedily.
     #[arg(long, default_value_t = 3)]

@@ -22,7 +22,7 @@ pub struct HistoryArgs {
     #[arg(long)]
     pub noise_radius: Option<f64>,
     /// SISO channel `OUT,IN`.
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
     /// Write the error-vs-revision figure here.
     #[arg(long)]
