@@ -203,7 +203,7 @@ pub fn prepare(
         (None, "none (misfit relative to |G_d|)".into())
     };
     if let Some(r) = &radius {
-        if let Some(k) = r.iter().position(|x| !(*x > 0.0)) {
+        if let Some(k) = r.iter().position(|x| x.is_nan() || *x <= 0.0) {
             return Err(Error::Invalid(format!(
                 "{}: noise radius {} at omega = {} rad/s must be positive",
                 data.path.display(),

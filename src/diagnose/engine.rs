@@ -185,8 +185,8 @@ impl<'a> Problem<'a> {
         let mut v = 0.0;
         let mut c2 = 0.0;
         let mut bad = 0usize;
-        for k in 0..self.f() {
-            let e = (self.g[k] - gm[k]).norm();
+        for (k, gmk) in gm.iter().enumerate() {
+            let e = (self.g[k] - gmk).norm();
             v += (e * self.inv_sigma[k]).powi(2);
             let c = e / self.radius[k];
             c2 += c * c;

@@ -144,8 +144,7 @@ pub fn error_history(
             .iter()
             .cloned()
             .fold(f64::INFINITY, f64::min)
-            .min(0.5)
-            .max(1e-6);
+            .clamp(1e-6, 0.5);
         let hi = misfit_rms.iter().cloned().fold(1.0, f64::max) * 1.5;
         let lab = labels.to_vec();
         let mut a = ChartBuilder::on(&top)
