@@ -151,10 +151,9 @@ pub fn prepare(
     if channel.is_none()
         && config.raw.channel.is_none()
         && (data.outputs() > 1 || data.inputs() > 1)
-        && mp * mm == 1
     {
         return Err(Error::Invalid(format!(
-            "{}: the data are {}×{} and the model is SISO: choose a channel with [channel] output/input or --channel OUT,IN",
+            "{}: the data are {}×{}: choose the SISO channel to compare with [channel] output/input or --channel OUT,IN",
             data.path.display(),
             data.outputs(),
             data.inputs()
