@@ -16,6 +16,7 @@ pub mod batch;
 pub mod cli;
 pub mod consistency;
 pub mod data;
+pub mod diagnose;
 pub mod error;
 pub mod model;
 pub mod pipeline;

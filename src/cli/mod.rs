@@ -15,7 +15,10 @@ macro_rules! outln {
 pub mod batch;
 pub mod check;
 pub mod common;
+pub mod compare;
+pub mod diagnose;
 pub mod envelope;
+pub mod history;
 pub mod merge;
 pub mod run;
 
@@ -44,6 +47,12 @@ pub enum Command {
     Batch(batch::BatchArgs),
     /// Combine the outputs of `batch --shard K/N` runs.
     Merge(merge::MergeArgs),
+    /// Compare the model with the data: misfit per frequency, failing bands, error measures.
+    Compare(compare::CompareArgs),
+    /// Rank candidate missing effects (delay, lag, mode, …) by how much each lowers the error.
+    Diagnose(diagnose::DiagnoseArgs),
+    /// Error measures across model revisions (table and error-vs-revision SVG).
+    History(history::HistoryArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -62,6 +71,9 @@ pub fn main() -> i32 {
         Command::Run(a) => run::run(&a),
         Command::Batch(a) => batch::run(&a),
         Command::Merge(a) => merge::run(&a),
+        Command::Compare(a) => compare::run(&a),
+        Command::Diagnose(a) => diagnose::run(&a),
+        Command::History(a) => history::run(&a),
     };
     match result {
         Ok(code) => code,
