@@ -41,41 +41,43 @@ fn setup() -> (Config, tempfile::TempDir) {
 #[divan::bench(sample_count = 1, sample_size = 1)]
 fn batch_1000(bencher: divan::Bencher) {
     let (config, dir) = setup();
-    bencher.bench_local(|| {
-        let out = tempfile::tempdir().unwrap();
-        let t = std::time::Instant::now();
-        let list = discover::from_dir(dir.path()).unwrap();
-        let opts = runner::RunOptions {
-            noise_radius: None,
-            per_dataset_files: true,
-        };
-        let res = runner::run_all(&config, &list, &opts, out.path(), &|| {});
-        assert!(
-            res.iter().all(|r| r.ok()),
-            "{:?}",
-            res.iter().find(|r| !r.ok()).map(|r| &r.error)
-        );
-        let combined = combine(res.iter().filter_map(|r| r.envelope.as_ref()));
-        let rows: Vec<SummaryRow> = res.iter().map(SummaryRow::from).collect();
-        batch::finish(
-            out.path(),
-            &rows,
-            combined.as_ref(),
-            batch::FinishInput {
-                config: config.path.clone(),
-                r_configured: config.r.as_ref(),
-                n_total: list.len(),
-                shard: Shard::ALL,
-                merged_from: vec![],
-                timings_ms: Default::default(),
-                factorization: Some(&config.factorization),
-            },
-        )
-        .unwrap();
-        eprintln!(
-            "batch bench: {} datasets in {:.2} s",
-            list.len(),
-            t.elapsed().as_secs_f64()
-        );
-    });
+    // The output directory is made before and deleted after the timed part.
+    bencher
+        .with_inputs(|| tempfile::tempdir().unwrap())
+        .bench_local_values(|out| {
+            let t = std::time::Instant::now();
+            let list = discover::from_dir(dir.path()).unwrap();
+            let opts = runner::RunOptions {
+                noise_radius: None,
+                per_dataset_files: true,
+            };
+            let res = runner::run_all(&config, &list, &opts, out.path(), &|| {});
+            assert!(
+                res.iter().all(|r| r.ok()),
+                "{:?}",
+                res.iter().find(|r| !r.ok()).map(|r| &r.error)
+            );
+            let combined = combine(res.iter().filter_map(|r| r.envelope.as_ref()));
+            let rows: Vec<SummaryRow> = res.iter().map(SummaryRow::from).collect();
+            batch::finish(
+                out.path(),
+                &rows,
+                combined.as_ref(),
+                batch::FinishInput {
+                    config: config.path.clone(),
+                    r_configured: config.r.as_ref(),
+                    n_total: list.len(),
+                    shard: Shard::ALL,
+                    merged_from: vec![],
+                    timings_ms: Default::default(),
+                    factorization: Some(&config.factorization),
+                },
+            )
+            .unwrap();
+            eprintln!(
+                "batch bench: {} datasets in {:.2} s",
+                list.len(),
+                t.elapsed().as_secs_f64()
+            );
+        });
 }
