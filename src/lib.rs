@@ -16,6 +16,7 @@ pub mod consistency;
 pub mod data;
 pub mod error;
 pub mod model;
+pub mod mu;
 pub mod system;
 pub mod util;
 
