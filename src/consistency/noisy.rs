@@ -285,8 +285,9 @@ pub fn r_min_noisy(at: &FactorsAt, phi: Complex64, la: f64, settings: &Bisection
         fb = mu_of(b, &mut out) - 1.0;
         iters += 1;
     }
-    // Report the end of the final bracket where μ > 1 (the smallest |r| that is verified).
-    out.r_min = if fb > 0.0 { b } else { c };
+    // Report the end of the final bracket where μ > 1 (the smallest verified |r|); when
+    // μ(b) = 1 exactly, b itself is the infimum.
+    out.r_min = if fb >= 0.0 { b } else { c };
     Ok(out)
 }
 
