@@ -12,11 +12,13 @@
 //! `‖Δ(jω)‖ < |r(jω)|`, `r` a unit of RH∞.
 #![warn(missing_docs)]
 
+pub mod cli;
 pub mod consistency;
 pub mod data;
 pub mod error;
 pub mod model;
 pub mod mu;
+pub mod report;
 pub mod system;
 pub mod util;
 

@@ -52,14 +52,22 @@ pub fn check(r: &TransferFunction, env: &Envelope) -> CheckReport {
                 omega,
                 r_abs,
                 r_min,
-                ratio: if r_min > 0.0 { r_abs / r_min } else { f64::INFINITY },
+                ratio: if r_min > 0.0 {
+                    r_abs / r_min
+                } else {
+                    f64::INFINITY
+                },
                 consistent: r_abs > r_min,
                 a1_limit: a1,
                 a1_ok: a1.is_none_or(|a| r_abs < a),
             }
         })
         .collect();
-    let failing_omegas = rows.iter().filter(|r| !r.consistent).map(|r| r.omega).collect();
+    let failing_omegas = rows
+        .iter()
+        .filter(|r| !r.consistent)
+        .map(|r| r.omega)
+        .collect();
     let a1_violations = rows.iter().filter(|r| !r.a1_ok).map(|r| r.omega).collect();
     CheckReport {
         consistent: rows.iter().all(|r| r.consistent),

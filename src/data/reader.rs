@@ -41,9 +41,12 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
         .enumerate()
         .map(|(k, l)| (k + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = rows
-        .next()
-        .ok_or_else(|| err(1, "empty file: expected a header such as `freq_hz,re_1_1,im_1_1`".into()))?;
+    let (hline, header) = rows.next().ok_or_else(|| {
+        err(
+            1,
+            "empty file: expected a header such as `freq_hz,re_1_1,im_1_1`".into(),
+        )
+    })?;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let hz = match names[0] {
         "omega_rad_s" => false,
@@ -76,25 +79,49 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
         m = m.max(parsed.1);
     }
     if p == 0 {
-        return Err(err(hline, "no response columns: add re_1_1,im_1_1 (or mag_1_1,phase_deg_1_1)".into()));
+        return Err(err(
+            hline,
+            "no response columns: add re_1_1,im_1_1 (or mag_1_1,phase_deg_1_1)".into(),
+        ));
     }
     // Every (i, j) needs one complete representation.
     let mut layout = vec![(Part::Re, 0usize, 0usize); p * m];
     for i in 1..=p {
         for j in 1..=m {
             let re = (cells.get(&(i, j, Part::Re)), cells.get(&(i, j, Part::Im)));
-            let mp = (cells.get(&(i, j, Part::Mag)), cells.get(&(i, j, Part::PhaseDeg)));
+            let mp = (
+                cells.get(&(i, j, Part::Mag)),
+                cells.get(&(i, j, Part::PhaseDeg)),
+            );
             layout[(i - 1) * m + (j - 1)] = match (re, mp) {
                 ((Some(a), Some(b)), (None, None)) => (Part::Re, *a, *b),
                 ((None, None), (Some(a), Some(b))) => (Part::Mag, *a, *b),
-                ((Some(_), None), _) => return Err(err(hline, format!("missing column im_{i}_{j}"))),
-                ((None, Some(_)), _) => return Err(err(hline, format!("missing column re_{i}_{j}"))),
-                (_, (Some(_), None)) => return Err(err(hline, format!("missing column phase_deg_{i}_{j}"))),
-                (_, (None, Some(_))) => return Err(err(hline, format!("missing column mag_{i}_{j}"))),
-                ((None, None), (None, None)) => {
-                    return Err(err(hline, format!("missing columns re_{i}_{j},im_{i}_{j} (the data are {p}×{m})")))
+                ((Some(_), None), _) => {
+                    return Err(err(hline, format!("missing column im_{i}_{j}")))
                 }
-                _ => return Err(err(hline, format!("entry ({i},{j}) is given both as re/im and as mag/phase: keep one"))),
+                ((None, Some(_)), _) => {
+                    return Err(err(hline, format!("missing column re_{i}_{j}")))
+                }
+                (_, (Some(_), None)) => {
+                    return Err(err(hline, format!("missing column phase_deg_{i}_{j}")))
+                }
+                (_, (None, Some(_))) => {
+                    return Err(err(hline, format!("missing column mag_{i}_{j}")))
+                }
+                ((None, None), (None, None)) => {
+                    return Err(err(
+                        hline,
+                        format!("missing columns re_{i}_{j},im_{i}_{j} (the data are {p}×{m})"),
+                    ))
+                }
+                _ => {
+                    return Err(err(
+                        hline,
+                        format!(
+                            "entry ({i},{j}) is given both as re/im and as mag/phase: keep one"
+                        ),
+                    ))
+                }
             };
         }
     }
@@ -109,10 +136,19 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
         }
         let num = |col: usize| -> Result<f64> {
             let v: f64 = fields[col].parse().map_err(|_| {
-                err(line, format!("column `{}`: `{}` is not a number", names[col], fields[col]))
+                err(
+                    line,
+                    format!("column `{}`: `{}` is not a number", names[col], fields[col]),
+                )
             })?;
             if !v.is_finite() {
-                return Err(err(line, format!("column `{}`: value `{}` is not finite", names[col], fields[col])));
+                return Err(err(
+                    line,
+                    format!(
+                        "column `{}`: value `{}` is not finite",
+                        names[col], fields[col]
+                    ),
+                ));
             }
             Ok(v)
         };
@@ -120,7 +156,11 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
         if f <= 0.0 {
             return Err(err(line, format!("frequency {f} must be positive")));
         }
-        let omega = if hz { 2.0 * std::f64::consts::PI * f } else { f };
+        let omega = if hz {
+            2.0 * std::f64::consts::PI * f
+        } else {
+            f
+        };
         let mut phi = DMatrix::zeros(p, m);
         for i in 0..p {
             for j in 0..m {
@@ -130,7 +170,10 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
                     Part::Re => Complex64::new(x, y),
                     _ => {
                         if x < 0.0 {
-                            return Err(err(line, format!("column `{}`: magnitude {x} is negative", names[a])));
+                            return Err(err(
+                                line,
+                                format!("column `{}`: magnitude {x} is negative", names[a]),
+                            ));
                         }
                         Complex64::from_polar(x, y.to_radians())
                     }

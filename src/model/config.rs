@@ -58,7 +58,9 @@ impl TfEntry {
                     return Err(format!("{what}: the denominator is zero"));
                 }
                 if r.num.is_empty() {
-                    return Err(format!("{what}: the numerator is empty; write [0] for zero"));
+                    return Err(format!(
+                        "{what}: the numerator is empty; write [0] for zero"
+                    ));
                 }
                 Ok(TransferFunction::new(r.num.clone(), r.den.clone()))
             }
@@ -159,7 +161,10 @@ pub struct Config {
     pub data: Option<PathBuf>,
 }
 
-fn tf_rows(rows: &[Vec<TfEntry>], name: &str) -> std::result::Result<Vec<Vec<TransferFunction>>, String> {
+fn tf_rows(
+    rows: &[Vec<TfEntry>],
+    name: &str,
+) -> std::result::Result<Vec<Vec<TransferFunction>>, String> {
     let cols = rows.first().map_or(0, |r| r.len());
     if rows.is_empty() || cols == 0 {
         return Err(format!("[model] {name} is empty"));
@@ -258,10 +263,9 @@ impl Config {
                 Factorization::standard(mm, nn).map_err(|e| format!("[model]: {e}"))
             }
             Special => {
-                let c_rows = m
-                    .c
-                    .as_ref()
-                    .ok_or("[model]: factorization = \"special\" needs c (p×n numbers)")?;
+                let c_rows =
+                    m.c.as_ref()
+                        .ok_or("[model]: factorization = \"special\" needs c (p×n numbers)")?;
                 let cols = c_rows.first().map_or(0, |r| r.len());
                 if cols == 0 || c_rows.iter().any(|r| r.len() != cols) {
                     return Err("[model] c must be a non-empty rectangular matrix".into());

@@ -4,4 +4,4 @@ pub mod factorization;
 pub mod noise;
 
 pub use config::Config;
-pub use factorization::{FactorizationKind, Factorization, FactorsAt};
+pub use factorization::{Factorization, FactorizationKind, FactorsAt};

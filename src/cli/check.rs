@@ -1,0 +1,107 @@
+//! `rshape check CONFIG [--r-num a,b,.. --r-den c,d,..]`: exit 0 when consistent, 1 when not.
+
+use super::common::{fmt_g, InputArgs};
+use crate::consistency::check;
+use crate::system::TransferFunction;
+use anyhow::{anyhow, Result};
+use clap::Args;
+
+/// Arguments of `rshape check`.
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Model and data.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Numerator of r, descending powers of s (overrides the config's [r]).
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub r_num: Option<Vec<f64>>,
+    /// Denominator of r, descending powers of s.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub r_den: Option<Vec<f64>>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Resolves r from the flags or the config and checks that it is a unit of RH∞.
+pub fn resolve_r(
+    num: &Option<Vec<f64>>,
+    den: &Option<Vec<f64>>,
+    config: &crate::model::Config,
+) -> Result<TransferFunction> {
+    let r = match (num, den) {
+        (Some(n), Some(d)) => {
+            if n.iter().chain(d).any(|c| !c.is_finite()) || d.iter().all(|c| *c == 0.0) {
+                return Err(anyhow!(
+                    "--r-num/--r-den: coefficients must be finite and the denominator nonzero"
+                ));
+            }
+            TransferFunction::new(n.clone(), d.clone())
+        }
+        (None, None) => config.r.clone().ok_or_else(|| {
+            anyhow!(
+                "{}: no r to check: add an [r] table with num and den, or pass --r-num and --r-den",
+                config.path.display()
+            )
+        })?,
+        _ => return Err(anyhow!("give both --r-num and --r-den")),
+    };
+    if !r.is_unit() {
+        return Err(anyhow!(
+            "r = ({:?})/({:?}) is not a unit of RH∞: it must be biproper (equal degrees) with poles and zeros in the open left half-plane",
+            r.num.coeffs(),
+            r.den.coeffs()
+        ));
+    }
+    Ok(r)
+}
+
+/// Runs `rshape check`.
+pub fn run(a: &CheckArgs) -> Result<i32> {
+    let (inputs, env) = a.input.envelope()?;
+    let r = resolve_r(&a.r_num, &a.r_den, &inputs.config)?;
+    let rep = check(&r, &env);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&rep)?);
+    } else {
+        println!(
+            "{:>12} {:>12} {:>12} {:>10} {:>12} {:>4}",
+            "omega_rad_s", "|r(jw)|", "r_min", "ratio", "a1_limit", "A1"
+        );
+        for row in &rep.rows {
+            println!(
+                "{:>12} {:>12} {:>12} {:>10} {:>12} {:>4}{}",
+                fmt_g(row.omega),
+                fmt_g(row.r_abs),
+                fmt_g(row.r_min),
+                fmt_g(row.ratio),
+                row.a1_limit.map_or("-".into(), fmt_g),
+                if row.a1_ok { "ok" } else { "FAIL" },
+                if row.consistent {
+                    ""
+                } else {
+                    "  <- inconsistent"
+                }
+            );
+        }
+        let list = |v: &[f64]| v.iter().map(|w| fmt_g(*w)).collect::<Vec<_>>().join(", ");
+        if !rep.a1_violations.is_empty() {
+            println!(
+                "A1 violated (|r| >= sigma_min(M~)) at {} datum(s): omega = {} rad/s; the perturbed plants need not all be stable there",
+                rep.a1_violations.len(),
+                list(&rep.a1_violations)
+            );
+        }
+        if rep.consistent {
+            println!("consistent: r explains all {} data", rep.rows.len());
+        } else {
+            println!(
+                "inconsistent at {} of {} data: omega = {} rad/s",
+                rep.failing_omegas.len(),
+                rep.rows.len(),
+                list(&rep.failing_omegas)
+            );
+        }
+    }
+    Ok(if rep.consistent { 0 } else { 1 })
+}

@@ -1,0 +1,58 @@
+//! Command-line interface.  Each subcommand lives in its own file and is a thin layer over
+//! the library: parse, load, compute, print, write (atomically).
+//!
+//! Exit codes: 0 success (and consistent, for `check`), 1 inconsistent data (`check`),
+//! 2 any error (bad input, usage), 3 some datasets failed (`batch`).
+
+pub mod check;
+pub mod common;
+pub mod envelope;
+
+use clap::{Parser, Subcommand};
+
+/// rshape: consistency of frequency-response data with coprime-factor models, and the
+/// smallest uncertainty bound r(s) that explains them.
+#[derive(Debug, Parser)]
+#[command(name = "rshape", version, about, long_about = None)]
+pub struct Cli {
+    /// The subcommand.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Per-datum smallest |r| consistent with the data (the lower envelope) and the A1 limit.
+    Envelope(envelope::EnvelopeArgs),
+    /// Check the configured r (or --r-num/--r-den) against every datum.
+    Check(check::CheckArgs),
+}
+
+/// Runs the CLI and returns the process exit code.
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = match cli.command {
+        Command::Envelope(a) => envelope::run(&a),
+        Command::Check(a) => check::run(&a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {}", one_line(&format!("{e:#}")));
+            2
+        }
+    }
+}
+
+/// Folds a message onto one line.
+pub fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}

@@ -1,0 +1,4 @@
+//! Reports: text and CSV renderings of envelopes and checks.
+pub mod csv;
+
+pub use self::csv::envelope_csv;
