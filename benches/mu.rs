@@ -18,7 +18,8 @@ fn main() {
 }
 
 fn robot() -> (Config, FrfData) {
-    let cfg = Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml")).unwrap();
+    let cfg =
+        Config::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml")).unwrap();
     let data = read_frf_csv(cfg.data.as_ref().unwrap()).unwrap();
     (cfg, data)
 }
@@ -35,7 +36,11 @@ fn robot_lfts() -> Vec<DMatrix<Complex64>> {
             let at = cfg.factorization.at(data.omega[k]);
             let phi = data.response[k][(0, 0)];
             let d = r_min_noisy(&at, phi, la, &BisectionSettings::default()).unwrap();
-            let rho = if d.r_min > 0.0 && d.r_min.is_finite() { d.r_min } else { d.a1_limit };
+            let rho = if d.r_min > 0.0 && d.r_min.is_finite() {
+                d.r_min
+            } else {
+                d.a1_limit
+            };
             gamma_lft(&at, phi, Complex64::new(rho, 0.0), la).unwrap()
         })
         .collect()
@@ -48,11 +53,12 @@ fn mu_robot_7x6_per_22(b: Bencher) {
     let ms = robot_lfts();
     let s = FullPlusScalar::gamma(5);
     let set = MuSettings::default();
-    b.counter(divan::counter::ItemsCount::new(ms.len())).bench(|| {
-        for m in &ms {
-            black_box(mu_full_scalar(black_box(m), s, &set).unwrap());
-        }
-    });
+    b.counter(divan::counter::ItemsCount::new(ms.len()))
+        .bench(|| {
+            for m in &ms {
+                black_box(mu_full_scalar(black_box(m), s, &set).unwrap());
+            }
+        });
 }
 
 /// The whole 211-point noisy envelope with the configured `L_a = 0.06` (most data lie within

@@ -26,7 +26,10 @@ const POINTS: usize = 211;
 
 fn plant(s: Complex64, eps: &[f64; 5], alpha: &[f64; 5], beta: &[f64; 5]) -> Complex64 {
     (0..5)
-        .map(|k| C[k] * N[k] * (1.0 + eps[k]) / (4.0 * s * s + A[k] * (1.0 + alpha[k]) * s + B[k] * (1.0 + beta[k])))
+        .map(|k| {
+            C[k] * N[k] * (1.0 + eps[k])
+                / (4.0 * s * s + A[k] * (1.0 + alpha[k]) * s + B[k] * (1.0 + beta[k]))
+        })
         .sum()
 }
 
@@ -39,11 +42,29 @@ fn main() -> anyhow::Result<()> {
     let cfg = rshape::model::Config::load(&root.join("robot.toml"))?;
     let mut worst = 0.0f64;
     let mut out = String::new();
-    writeln!(out, "# Synthetic data for configs/robot.toml, written by examples/robot_data.rs (seed 1998).")?;
-    writeln!(out, "# Perturbed plant: stiffness factors 1+beta = {:?}", beta.map(|b| 1.0 + b))?;
-    writeln!(out, "#   damping factors 1+alpha = {:?}", alpha.map(|a| 1.0 + a))?;
-    writeln!(out, "#   input-gain factors 1+eps = {:?}", eps.map(|e| 1.0 + e))?;
-    writeln!(out, "# Noise: uniform in the disk of radius {NOISE} (L_a = 0.06 in the config).")?;
+    writeln!(
+        out,
+        "# Synthetic data for configs/robot.toml, written by examples/robot_data.rs (seed 1998)."
+    )?;
+    writeln!(
+        out,
+        "# Perturbed plant: stiffness factors 1+beta = {:?}",
+        beta.map(|b| 1.0 + b)
+    )?;
+    writeln!(
+        out,
+        "#   damping factors 1+alpha = {:?}",
+        alpha.map(|a| 1.0 + a)
+    )?;
+    writeln!(
+        out,
+        "#   input-gain factors 1+eps = {:?}",
+        eps.map(|e| 1.0 + e)
+    )?;
+    writeln!(
+        out,
+        "# Noise: uniform in the disk of radius {NOISE} (L_a = 0.06 in the config)."
+    )?;
     writeln!(out, "omega_rad_s,re_1_1,im_1_1")?;
     for i in 0..POINTS {
         let omega = 64f64.powf(i as f64 / (POINTS - 1) as f64);
@@ -57,8 +78,13 @@ fn main() -> anyhow::Result<()> {
         let phi = g + Complex64::from_polar(NOISE * u.sqrt(), th);
         writeln!(out, "{omega:.12e},{:.12e},{:.12e}", phi.re, phi.im)?;
     }
-    anyhow::ensure!(worst < 1e-10, "the example's nominal plant disagrees with robot.toml ({worst:e})");
+    anyhow::ensure!(
+        worst < 1e-10,
+        "the example's nominal plant disagrees with robot.toml ({worst:e})"
+    );
     std::fs::write(root.join("robot.csv"), out)?;
-    println!("wrote configs/robot.csv ({POINTS} points); nominal model check: max rel. diff {worst:.1e}");
+    println!(
+        "wrote configs/robot.csv ({POINTS} points); nominal model check: max rel. diff {worst:.1e}"
+    );
     Ok(())
 }

@@ -13,7 +13,8 @@
 //! Doyle 1993; a non-square full block is made square by zero padding, which changes
 //! neither side).  `σ̄` is convex in `t = ln d` (Sezginer and Overton 1990) with derivative
 //! `dσ̄/dt = σ̄·(|y_last|² − |x_last|²)` for the top singular pair `M_d x = σ̄ y`; the search
-//! is a bracketed root search (Brent's method) on the sign-monotone `h(t) = |y_last|² − |x_last|²`.
+//! is a safeguarded Newton search (analytic second derivative, bisection fallback) for the
+//! root of the sign-monotone `h(t) = |y_last|² − |x_last|²`.
 //!
 //! **Lower bound.**  Every vector `x ≠ 0` gives `μ ≥ min(‖(Mx)₁‖/‖x₁‖, |(Mx)₂|/|x₂|)` with a
 //! certificate `Δ̃ = x₁z₁*/‖z₁‖²`, `w̃ = x₂/z₂` (`z = Mx`): then `M·Δ_s·z = z`, so
@@ -38,7 +39,10 @@ pub struct FullPlusScalar {
 impl FullPlusScalar {
     /// The structure `Γ` of eq. (16) for `n` modes: `Δ̃ ∈ ℂ^{n×(n+1)}`, `M ∈ ℂ^{(n+2)×(n+1)}`.
     pub fn gamma(n: usize) -> Self {
-        Self { rows: n, cols: n + 1 }
+        Self {
+            rows: n,
+            cols: n + 1,
+        }
     }
 
     /// Shape `(rows, cols)` of `M`.
@@ -142,8 +146,16 @@ impl MuBounds {
 fn lower_of(x: &DVector<Complex64>, z: &DVector<Complex64>, q: usize, k: usize) -> f64 {
     let x1 = x.rows(0, q).norm();
     let x2 = x[q].norm();
-    let r1 = if x1 > 0.0 { z.rows(0, k).norm() / x1 } else { f64::INFINITY };
-    let r2 = if x2 > 0.0 { z[k].norm() / x2 } else { f64::INFINITY };
+    let r1 = if x1 > 0.0 {
+        z.rows(0, k).norm() / x1
+    } else {
+        f64::INFINITY
+    };
+    let r2 = if x2 > 0.0 {
+        z[k].norm() / x2
+    } else {
+        f64::INFINITY
+    };
     let lb = r1.min(r2);
     if lb.is_finite() {
         lb
@@ -156,6 +168,8 @@ fn lower_of(x: &DVector<Complex64>, z: &DVector<Complex64>, q: usize, k: usize) 
 struct Eval {
     sigma: f64,
     h: f64,
+    /// `d²(ln σ̄²)/dt²` (NaN when `σ̄` is repeated or zero).
+    curv: f64,
 }
 
 struct Search<'a> {
@@ -214,25 +228,44 @@ impl Search<'_> {
     }
 
     /// Evaluates `σ̄(M_d)` and `h(t)` at `t = ln d`, updating both bounds.
+    ///
+    /// The top right singular pair comes from the Hermitian eigenproblem of the Gram matrix
+    /// `M_dᴴM_d` (about half the cost of a complex SVD at these sizes): `σ̄ = √λ_max` (the
+    /// largest eigenvalue is computed to `O(ε)‖M_d‖²`, i.e. `σ̄` to `O(ε)` relative), `x` its
+    /// eigenvector and `y = M_d x/σ̄`.  The lower bound uses `x` through the exact formula of
+    /// [`lower_of`], so an inexact `x` can only weaken it, never invalidate it.
     fn eval(&mut self, t: f64) -> Option<Eval> {
-        let svd = self.svd(t)?;
-        let (u, vt) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
-        let (imax, &sigma) = svd
-            .singular_values
+        self.evals += 1;
+        let (q, k) = (self.q, self.k);
+        let md = self.scaled(t);
+        let gram = md.adjoint() * &md;
+        let Some(eig) = gram.try_symmetric_eigen(f64::EPSILON, self.settings.svd_max_iter) else {
+            self.svd_failed = true;
+            return None;
+        };
+        let (imax, &lambda) = eig
+            .eigenvalues
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))?;
-        let (q, k) = (self.q, self.k);
-        let h = u[(k, imax)].norm_sqr() - vt[(imax, q)].norm_sqr();
+        let sigma = lambda.max(0.0).sqrt();
+        let xs = eig.eigenvectors.column(imax);
+        let ys = &md * xs;
+        let h = if sigma > 0.0 {
+            ys[k].norm_sqr() / (sigma * sigma) - xs[q].norm_sqr()
+        } else {
+            0.0
+        };
+        let curv = curvature(&md, &eig.eigenvalues, &eig.eigenvectors, imax, ys[k], q, k);
         if sigma < self.upper {
             self.upper = sigma;
             self.t_upper = t;
         }
-        // x = conj(row imax of Vᴴ), unscaled by D_r⁻¹.
-        let mut x = DVector::from_fn(q + 1, |j, _| vt[(imax, j)].conj());
+        // Unscale by D_r⁻¹.
+        let mut x = xs.into_owned();
         x[q] /= t.exp();
         self.offer(x);
-        Some(Eval { sigma, h })
+        Some(Eval { sigma, h, curv })
     }
 
     /// Repeated-`σ̄` candidate at the best `t`: combines the top two right singular vectors
@@ -240,7 +273,9 @@ impl Search<'_> {
     fn kink_candidate(&mut self) {
         let t = self.t_upper;
         let Some(svd) = self.svd(t) else { return };
-        let (Some(u), Some(vt)) = (svd.u.as_ref(), svd.v_t.as_ref()) else { return };
+        let (Some(u), Some(vt)) = (svd.u.as_ref(), svd.v_t.as_ref()) else {
+            return;
+        };
         let mut idx: Vec<usize> = (0..svd.singular_values.len()).collect();
         idx.sort_by(|a, b| svd.singular_values[*b].total_cmp(&svd.singular_values[*a]));
         if idx.len() < 2 {
@@ -291,7 +326,7 @@ impl Search<'_> {
 /// Bounds on `μ_Γ(M)` for `Γ = {diag(Δ̃, w̃)}`, `Δ̃` full `s.rows × s.cols` (eqs. (16)–(17)).
 ///
 /// Algorithm: (i) if `M₁₂ = 0` or `M₂₁ = 0`, `det(I − MΔ_s)` factors and
-/// `μ = max(σ̄(M₁₁), |M₂₂|)` exactly; (ii) otherwise a bracketed Brent root search for
+/// `μ = max(σ̄(M₁₁), |M₂₂|)` exactly; (ii) otherwise a safeguarded Newton search for
 /// `h(t) = 0`, `t = ln d`, started at the balancing point `t₀ = ½·ln(‖M₁₂‖/‖M₂₁‖)` (or
 /// `log_d_hint`), with the bracket grown by doubling steps; every SVD updates the upper bound
 /// (`σ̄` at that `d`) and the lower bound (its singular vector); the search stops as soon as
@@ -336,7 +371,11 @@ pub fn mu_full_scalar_from(
     let done = |upper: f64, lower: f64, log_d, evals, status, witness| MuBounds {
         upper,
         lower,
-        rel_gap: if upper > 0.0 { (upper - lower) / upper } else { 0.0 },
+        rel_gap: if upper > 0.0 {
+            (upper - lower) / upper
+        } else {
+            0.0
+        },
         log_d,
         evaluations: evals,
         status,
@@ -344,7 +383,14 @@ pub fn mu_full_scalar_from(
         structure: s,
     };
     if m.iter().any(|v| !v.is_finite()) {
-        return Ok(done(f64::NAN, f64::NAN, f64::NAN, 0, MuStatus::NonFinite, None));
+        return Ok(done(
+            f64::NAN,
+            f64::NAN,
+            f64::NAN,
+            0,
+            MuStatus::NonFinite,
+            None,
+        ));
     }
     let n12 = m.view((0, q), (k, 1)).norm();
     let n21 = m.view((k, 0), (1, q)).norm();
@@ -366,24 +412,42 @@ pub fn mu_full_scalar_from(
     search.offer(e_last);
     let sigma11 = |search: &mut Search| -> Option<f64> {
         let m11 = m.view((0, 0), (k, q)).into_owned();
-        let svd = SVD::try_new_unordered(m11, false, true, 5.0 * f64::EPSILON, settings.svd_max_iter)?;
+        let svd =
+            SVD::try_new_unordered(m11, false, true, 5.0 * f64::EPSILON, settings.svd_max_iter)?;
         let vt = svd.v_t.as_ref()?;
         let (imax, &sv) = svd
             .singular_values
             .iter()
             .enumerate()
             .max_by(|a, b| a.1.total_cmp(b.1))?;
-        let x = DVector::from_fn(q + 1, |j, _| if j < q { vt[(imax, j)].conj() } else { Complex64::default() });
+        let x = DVector::from_fn(q + 1, |j, _| {
+            if j < q {
+                vt[(imax, j)].conj()
+            } else {
+                Complex64::default()
+            }
+        });
         search.offer(x);
         Some(sv)
     };
     if n12 == 0.0 || n21 == 0.0 {
         // Block triangular: det(I − MΔ_s) = det(I − M₁₁Δ̃)·(1 − M₂₂w̃).
         let Some(s11) = sigma11(&mut search) else {
-            return Ok(done(f64::NAN, search.lower, f64::NAN, 1, MuStatus::SvdFailed, search.witness));
+            return Ok(done(
+                f64::NAN,
+                search.lower,
+                f64::NAN,
+                1,
+                MuStatus::SvdFailed,
+                search.witness,
+            ));
         };
         let upper = s11.max(m[(k, q)].norm());
-        let log_d = if n12 == 0.0 { f64::NEG_INFINITY } else { f64::INFINITY };
+        let log_d = if n12 == 0.0 {
+            f64::NEG_INFINITY
+        } else {
+            f64::INFINITY
+        };
         let witness = if upper > 0.0 { search.witness } else { None };
         let lower = if upper > 0.0 { search.lower } else { 0.0 };
         return Ok(done(upper, lower, log_d, 1, MuStatus::Converged, witness));
@@ -391,7 +455,7 @@ pub fn mu_full_scalar_from(
     let t0 = log_d_hint
         .filter(|t| t.is_finite())
         .unwrap_or(0.5 * (n12 / n21).ln());
-    brent_search(&mut search, t0);
+    newton_search(&mut search, t0);
     if !search.gap_ok() && !search.svd_failed {
         search.kink_candidate();
         if !search.gap_ok() {
@@ -409,88 +473,84 @@ pub fn mu_full_scalar_from(
     Ok(done(upper, lower, t, search.evals, status, search.witness))
 }
 
-/// Bracketed root search for `h(t) = 0` (Brent 1973, "zeroin"), stopping early when the gap
-/// closes.  `h` has a single sign change because `σ̄(M_d)` is convex in `t`.
-fn brent_search(s: &mut Search, t0: f64) {
+/// Second derivative of `f(t) = ln λ₁(t)`, `λ₁ = σ̄²(M_d)`, `M_d = A(t)`, from the full
+/// eigen-decomposition of `G = AᴴA` (`A' = PA − AQ`, `A'' = PA − 2PAQ + AQ`, `P`, `Q` the
+/// projectors on the last row and the last column):
+/// `λ₁'' = v₁ᴴG''v₁ + 2Σ_{j≠1}|v_jᴴG'v₁|²/(λ₁ − λ_j)`, with `w_j = Av_j`,
+/// `v₁ᴴG''v₁ = 2Re(w₁ᴴA''v₁) + 2‖A'v₁‖²`, `v_jᴴG'v₁ = 2·conj(w_jk)w₁k − (λ_j + λ₁)conj(v_jq)v₁q`;
+/// then `f'' = λ₁''/λ₁ − (λ₁'/λ₁)²` with `λ₁' = 2(|w₁k|² − λ₁|v₁q|²)`.
+fn curvature(
+    a: &DMatrix<Complex64>,
+    lam: &DVector<f64>,
+    vecs: &DMatrix<Complex64>,
+    i1: usize,
+    w1k: Complex64,
+    q: usize,
+    k: usize,
+) -> f64 {
+    let l1 = lam[i1];
+    if l1.is_nan() || l1 <= 0.0 {
+        return f64::NAN;
+    }
+    let v1q = vecs[(q, i1)];
+    let akq = a[(k, q)];
+    let colq = a.column(q).norm_squared();
+    let cross = w1k.conj() * akq * v1q;
+    let wa = w1k.norm_sqr() - 2.0 * cross.re + l1 * v1q.norm_sqr();
+    let apv = w1k.norm_sqr() - 2.0 * cross.re + colq * v1q.norm_sqr();
+    let mut l2 = 2.0 * wa + 2.0 * apv;
+    for j in 0..lam.len() {
+        if j == i1 {
+            continue;
+        }
+        let sep = l1 - lam[j];
+        if sep.is_nan() || sep <= 1e-12 * l1 {
+            return f64::NAN;
+        }
+        let wjk: Complex64 = (0..a.ncols()).map(|c| a[(k, c)] * vecs[(c, j)]).sum();
+        let g = 2.0 * wjk.conj() * w1k - (lam[j] + l1) * vecs[(q, j)].conj() * v1q;
+        l2 += 2.0 * g.norm_sqr() / sep;
+    }
+    let d1 = 2.0 * (w1k.norm_sqr() - l1 * v1q.norm_sqr()) / l1;
+    l2 / l1 - d1 * d1
+}
+
+/// Safeguarded Newton search for the minimum of `ln σ̄(M_d)` over `t = ln d`, i.e. the root of
+/// `h(t)` (`d ln σ̄²/dt = 2h`), stopping as soon as the gap closes.  `h` changes sign once
+/// because `σ̄(M_d)` is convex in `t`; every evaluation narrows the bracket `[lo, hi]`
+/// (`h(lo) < 0 < h(hi)`).  A Newton step is taken when the curvature is positive and the
+/// step stays inside the bracket (and below 2 in length); otherwise the bracket is bisected,
+/// or, while it is still open on one side, grown by doubling steps within `±log_d_range`.
+fn newton_search(s: &mut Search, t0: f64) {
     let cap = s.settings.max_evals;
-    let Some(e0) = s.eval(t0) else { return };
-    if s.gap_ok() || e0.h == 0.0 || e0.sigma == 0.0 {
-        return;
-    }
-    // Grow a bracket [a, b] with h(a) < 0 < h(b).
-    let dir = if e0.h > 0.0 { -1.0 } else { 1.0 };
-    let (mut ta, mut ha) = (t0, e0.h);
-    let mut step = 0.5;
-    let (tb, hb);
-    loop {
-        if s.evals >= cap || step > 2.0 * s.settings.log_d_range {
-            return;
-        }
-        let t = t0 + dir * step;
-        let Some(e) = s.eval(t) else { return };
-        if s.gap_ok() {
-            return;
-        }
-        if e.h.signum() != ha.signum() || e.h == 0.0 {
-            (tb, hb) = (t, e.h);
-            break;
-        }
-        (ta, ha) = (t, e.h);
-        step *= 2.0;
-    }
-    // Brent's method on [ta, tb].
-    let (mut a, mut fa, mut b, mut fb) = (ta, ha, tb, hb);
-    let (mut c, mut fc) = (a, fa);
-    let (mut d, mut e) = (b - a, b - a);
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut t = t0;
+    let mut grow = 0.5;
     while s.evals < cap {
-        if fb.signum() == fc.signum() && fb != 0.0 {
-            (c, fc) = (a, fa);
-            d = b - a;
-            e = d;
-        }
-        if fc.abs() < fb.abs() {
-            (a, fa) = (b, fb);
-            (b, fb) = (c, fc);
-            (c, fc) = (a, fa);
-        }
-        let tol = 2.0 * f64::EPSILON * b.abs().max(1.0);
-        let xm = 0.5 * (c - b);
-        if xm.abs() <= tol || fb == 0.0 {
+        let Some(e) = s.eval(t) else { return };
+        if s.gap_ok() || e.h == 0.0 || e.sigma == 0.0 {
             return;
         }
-        if e.abs() >= tol && fa.abs() > fb.abs() {
-            let s_ = fb / fa;
-            let (mut p, mut qq);
-            if a == c {
-                p = 2.0 * xm * s_;
-                qq = 1.0 - s_;
-            } else {
-                let q_ = fa / fc;
-                let r = fb / fc;
-                p = s_ * (2.0 * xm * q_ * (q_ - r) - (b - a) * (r - 1.0));
-                qq = (q_ - 1.0) * (r - 1.0) * (s_ - 1.0);
-            }
-            if p > 0.0 {
-                qq = -qq;
-            }
-            p = p.abs();
-            if 2.0 * p < (3.0 * xm * qq - (tol * qq).abs()).min((e * qq).abs()) {
-                e = d;
-                d = p / qq;
-            } else {
-                d = xm;
-                e = d;
-            }
+        if e.h > 0.0 {
+            hi = hi.min(t);
         } else {
-            d = xm;
-            e = d;
+            lo = lo.max(t);
         }
-        (a, fa) = (b, fb);
-        b += if d.abs() > tol { d } else { tol.copysign(xm) };
-        let Some(ev) = s.eval(b) else { return };
-        fb = ev.h;
-        if s.gap_ok() {
+        if hi - lo <= 4.0 * f64::EPSILON * t.abs().max(1.0) {
             return;
         }
+        let newton = t - 2.0 * e.h / e.curv;
+        t = if e.curv > 0.0 && newton > lo && newton < hi && (newton - t).abs() <= 2.0 {
+            newton
+        } else if lo.is_finite() && hi.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            let next = if e.h > 0.0 { t - grow } else { t + grow };
+            grow *= 2.0;
+            if (next - t0).abs() > s.settings.log_d_range {
+                return;
+            }
+            next
+        };
     }
 }

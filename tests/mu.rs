@@ -31,7 +31,10 @@ fn sigma_min(a: &DMatrix<Complex64>) -> f64 {
 
 /// Spectral radius through a capped complex Schur form.
 fn spectral_radius(a: &DMatrix<Complex64>) -> f64 {
-    let schur = a.clone().try_schur(1e-14, 10_000).expect("Schur form converges");
+    let schur = a
+        .clone()
+        .try_schur(1e-14, 10_000)
+        .expect("Schur form converges");
     let (_, t) = schur.unpack();
     (0..t.nrows()).map(|i| t[(i, i)].norm()).fold(0.0, f64::max)
 }
@@ -42,7 +45,12 @@ fn check_bounds(m: &DMatrix<Complex64>, n: usize) -> Result<(), TestCaseError> {
     let r = mu_full_scalar(m, s, &MuSettings::default()).unwrap();
     prop_assert_eq!(r.status, MuStatus::Converged, "{:?}", r);
     // Both bounds are computed in floating point: allow rounding only (a few ulps).
-    prop_assert!(r.lower <= r.upper * (1.0 + 1e-13), "lower {} > upper {}", r.lower, r.upper);
+    prop_assert!(
+        r.lower <= r.upper * (1.0 + 1e-13),
+        "lower {} > upper {}",
+        r.lower,
+        r.upper
+    );
     prop_assert!(r.rel_gap <= 1e-9, "gap {}", r.rel_gap);
     prop_assert!((r.upper - r.lower) / r.upper <= 1e-9);
     // The certificate: structured, ‖Δ‖ = 1/lower, I − MΔ singular.
@@ -55,10 +63,17 @@ fn check_bounds(m: &DMatrix<Complex64>, n: usize) -> Result<(), TestCaseError> {
         prop_assert_eq!(delta[(n, j)], c(0.0, 0.0));
     }
     let norm = sigma_max(&delta);
-    prop_assert!((norm * r.lower - 1.0).abs() <= 1e-12, "‖Δ‖·lower = {}", norm * r.lower);
+    prop_assert!(
+        (norm * r.lower - 1.0).abs() <= 1e-12,
+        "‖Δ‖·lower = {}",
+        norm * r.lower
+    );
     let sing = DMatrix::<Complex64>::identity(n + 2, n + 2) - m * &delta;
     let smin = sigma_min(&sing);
-    prop_assert!(smin <= 1e-12 * (1.0 + sigma_max(m) * norm), "σ_min(I − MΔ) = {smin}");
+    prop_assert!(
+        smin <= 1e-12 * (1.0 + sigma_max(m) * norm),
+        "σ_min(I − MΔ) = {smin}"
+    );
     Ok(())
 }
 
@@ -118,8 +133,16 @@ fn two_scalars_closed_form() {
     let r = mu_full_scalar(&m, s, &MuSettings::default()).unwrap();
     let exact = (b * cc).norm().sqrt();
     assert_eq!(r.status, MuStatus::Converged);
-    assert!((r.upper - exact).abs() <= 1e-9 * exact, "{} vs {exact}", r.upper);
-    assert!((r.lower - exact).abs() <= 1e-9 * exact, "{} vs {exact}", r.lower);
+    assert!(
+        (r.upper - exact).abs() <= 1e-9 * exact,
+        "{} vs {exact}",
+        r.upper
+    );
+    assert!(
+        (r.lower - exact).abs() <= 1e-9 * exact,
+        "{} vs {exact}",
+        r.lower
+    );
 }
 
 /// `M₁₂ = 0`: block triangular, `μ = max(σ̄(M₁₁), |M₂₂|)`, for either maximizer.

@@ -37,13 +37,10 @@ fn nominal(at: &FactorsAt) -> Complex64 {
     at.plant().unwrap()[(0, 0)]
 }
 
-/// Theorem 3 closed form (noise free) for the scalar datum `ψ`; `+∞` where A5 fails
-/// approached from outside is not needed: A5 fails only at `ψ = g`, where the answer is 0.
+/// Theorem 3 closed form (noise free) for the scalar datum `ψ`.  A5 fails only at `ψ = g`
+/// (the nominal model), where the smallest `|r|` is 0.
 fn theorem3(at: &FactorsAt, psi: Complex64) -> f64 {
-    match r_min_special(at, &DMatrix::from_element(1, 1, psi)) {
-        Ok(r) => r,
-        Err(_) => 0.0,
-    }
+    r_min_special(at, &DMatrix::from_element(1, 1, psi)).unwrap_or(0.0)
 }
 
 /// Independent characterization of the noisy envelope: `min over |ψ − φ| ≤ L_a` of the
@@ -57,7 +54,7 @@ fn disk_minimum(at: &FactorsAt, phi: Complex64, la: f64) -> f64 {
     }
     let f = |psi: Complex64| theorem3(at, psi);
     let angles = 720;
-    let (mut best, mut best_psi, mut best_th) = (f(phi), phi, 0.0);
+    let (mut best, mut best_psi) = (f(phi), phi);
     let mut best_edge = (f64::INFINITY, 0.0);
     for ri in 1..=8 {
         let rad = la * ri as f64 / 8.0;
@@ -66,14 +63,13 @@ fn disk_minimum(at: &FactorsAt, phi: Complex64, la: f64) -> f64 {
             let psi = phi + Complex64::from_polar(rad, th);
             let v = f(psi);
             if v < best {
-                (best, best_psi, best_th) = (v, psi, th);
+                (best, best_psi) = (v, psi);
             }
             if ri == 8 && v < best_edge.0 {
                 best_edge = (v, th);
             }
         }
     }
-    let _ = best_th;
     // Golden section on the boundary around the best boundary angle.
     let h = TAU / angles as f64;
     let (mut a, mut b) = (best_edge.1 - h, best_edge.1 + h);
@@ -106,7 +102,17 @@ fn disk_minimum(at: &FactorsAt, phi: Complex64, la: f64) -> f64 {
     };
     let (mut p, mut fp) = (best_psi, f(best_psi));
     let mut step = la / 8.0;
-    let dirs = [c(1.0, 0.0), c(-1.0, 0.0), c(0.0, 1.0), c(0.0, -1.0), c(0.7071, 0.7071), c(-0.7071, 0.7071), c(0.7071, -0.7071), c(-0.7071, -0.7071)];
+    const H: f64 = std::f64::consts::FRAC_1_SQRT_2;
+    let dirs = [
+        c(1.0, 0.0),
+        c(-1.0, 0.0),
+        c(0.0, 1.0),
+        c(0.0, -1.0),
+        c(H, H),
+        c(-H, H),
+        c(H, -H),
+        c(-H, -H),
+    ];
     let mut evals = 0;
     while step > 1e-13 * la && evals < 20_000 {
         let mut improved = false;
@@ -156,17 +162,31 @@ fn cross_check_against_disk_minimum_robot() {
         let want = disk_minimum(&at, phi, la);
         if got.r_min.is_finite() {
             finite += 1;
-            assert!(got.r_min > 0.0, "ω = {omega}: datum outside the noise must need r > 0");
+            assert!(
+                got.r_min > 0.0,
+                "ω = {omega}: datum outside the noise must need r > 0"
+            );
             let e = rel(got.r_min, want);
             worst = worst.max(e);
-            assert!(e <= 1e-4, "ω = {omega}: μ envelope {} vs disk minimum {want} (rel {e:.2e})", got.r_min);
+            assert!(
+                e <= 1e-4,
+                "ω = {omega}: μ envelope {} vs disk minimum {want} (rel {e:.2e})",
+                got.r_min
+            );
         } else {
             infinite += 1;
-            assert!(want >= got.a1_limit * (1.0 - 1e-4), "ω = {omega}: inf but disk minimum {want} < A1 limit {}", got.a1_limit);
+            assert!(
+                want >= got.a1_limit * (1.0 - 1e-4),
+                "ω = {omega}: inf but disk minimum {want} < A1 limit {}",
+                got.a1_limit
+            );
         }
     }
     eprintln!("cross-check: {finite} finite, {infinite} inf, worst rel. difference {worst:.2e}");
-    assert!(finite >= 20, "only {finite} frequencies with a finite positive r_min");
+    assert!(
+        finite >= 20,
+        "only {finite} frequencies with a finite positive r_min"
+    );
 }
 
 /// The same cross-check on the shipped data set with the configured L_a = 0.06.
@@ -175,7 +195,13 @@ fn cross_check_on_robot_dataset() {
     let cfg = robot();
     let data = robot_data(&cfg);
     let la = cfg.raw.noise.radius.unwrap();
-    let rep = noisy_envelope_report(&cfg.factorization, &data, &vec![la; data.len()], &BisectionSettings::default()).unwrap();
+    let rep = noisy_envelope_report(
+        &cfg.factorization,
+        &data,
+        &vec![la; data.len()],
+        &BisectionSettings::default(),
+    )
+    .unwrap();
     let (mut compared, mut zero, mut finite, mut inf, mut worst) = (0, 0, 0, 0, 0.0f64);
     for (k, omega) in data.omega.iter().enumerate() {
         if k % 5 != 0 && rep.envelope.r_min[k] == 0.0 {
@@ -199,7 +225,10 @@ fn cross_check_on_robot_dataset() {
         compared += 1;
     }
     eprintln!("robot data, L_a = {la}: {compared} compared: {zero} zero, {finite} finite (worst rel. {worst:.2e}), {inf} inf");
-    assert!(compared >= 40 && finite >= 5, "{compared} compared, {finite} finite");
+    assert!(
+        compared >= 40 && finite >= 5,
+        "{compared} compared, {finite} finite"
+    );
 }
 
 /// With `L_a = 0` the noisy envelope equals the noise-free Theorem 3 closed form where it is
@@ -208,14 +237,24 @@ fn cross_check_on_robot_dataset() {
 fn zero_noise_equals_theorem3() {
     let cfg = robot();
     let data = robot_data(&cfg);
-    let env = noisy_envelope(&cfg.factorization, &data, &vec![0.0; data.len()], &BisectionSettings::default()).unwrap();
+    let env = noisy_envelope(
+        &cfg.factorization,
+        &data,
+        &vec![0.0; data.len()],
+        &BisectionSettings::default(),
+    )
+    .unwrap();
     let (mut eq, mut inf) = (0, 0);
     for (k, omega) in data.omega.iter().enumerate() {
         let at = cfg.factorization.at(*omega);
         let t3 = r_min_special(&at, &data.response[k]).unwrap();
         let a1 = env.a1_limit.as_ref().unwrap()[k];
         if t3 < a1 * (1.0 - 1e-6) {
-            assert!(rel(env.r_min[k], t3) <= 1e-8, "ω = {omega}: {} vs {t3}", env.r_min[k]);
+            assert!(
+                rel(env.r_min[k], t3) <= 1e-8,
+                "ω = {omega}: {} vs {t3}",
+                env.r_min[k]
+            );
             eq += 1;
         } else if t3 > a1 * (1.0 + 1e-6) {
             assert!(env.r_min[k].is_infinite(), "ω = {omega}");
@@ -230,8 +269,13 @@ fn zero_noise_equals_theorem3() {
 #[test]
 fn scalar_factorization_zero_noise_equals_theorem2() {
     // g = (1/(s+1)) / ((s+2)/(s+1)) = 1/(s+2); r-independent checks at a few frequencies.
-    let m = TfMatrix::from_rows(vec![vec![TransferFunction::new(vec![1.0, 2.0], vec![1.0, 1.0])]]).unwrap();
-    let n = TfMatrix::from_rows(vec![vec![TransferFunction::new(vec![1.0], vec![1.0, 1.0])]]).unwrap();
+    let m = TfMatrix::from_rows(vec![vec![TransferFunction::new(
+        vec![1.0, 2.0],
+        vec![1.0, 1.0],
+    )]])
+    .unwrap();
+    let n =
+        TfMatrix::from_rows(vec![vec![TransferFunction::new(vec![1.0], vec![1.0, 1.0])]]).unwrap();
     let f = Factorization::standard(m, n).unwrap();
     for omega in [0.1, 1.0, 3.0, 10.0] {
         let at = f.at(omega);
@@ -240,12 +284,20 @@ fn scalar_factorization_zero_noise_equals_theorem2() {
         let t2 = r_min_standard(&at, &DMatrix::from_element(1, 1, phi)).unwrap();
         let got = r_min_noisy(&at, phi, 0.0, &BisectionSettings::default()).unwrap();
         assert!(t2 < got.a1_limit);
-        assert!(rel(got.r_min, t2) <= 1e-8, "ω = {omega}: {} vs {t2}", got.r_min);
+        assert!(
+            rel(got.r_min, t2) <= 1e-8,
+            "ω = {omega}: {} vs {t2}",
+            got.r_min
+        );
         // With noise, the disk minimum again.
         let la = 0.5 * (phi - g).norm();
         let got = r_min_noisy(&at, phi, la, &BisectionSettings::default()).unwrap();
         let want = disk_minimum(&at, phi, la);
-        assert!(rel(got.r_min, want) <= 1e-4, "ω = {omega}: {} vs {want}", got.r_min);
+        assert!(
+            rel(got.r_min, want) <= 1e-4,
+            "ω = {omega}: {} vs {want}",
+            got.r_min
+        );
     }
 }
 
@@ -296,9 +348,15 @@ fn certificate_reproduces_the_datum() {
     // F_U(V, Δ) = V₂₂ + V₂₁Δ(I − V₁₁Δ)⁻¹V₁₂.
     let (v11, v12) = (v.view((0, 0), (7, 6)), v.view((0, 6), (7, 1)));
     let (v21, v22) = (v.view((7, 0), (1, 6)), v[(7, 6)]);
-    let inner = (DMatrix::identity(6, 6) - &delta * v11).lu().solve(&(&delta * v12)).unwrap();
+    let inner = (DMatrix::identity(6, 6) - &delta * v11)
+        .lu()
+        .solve(&(&delta * v12))
+        .unwrap();
     let fu = v22 + (v21 * inner)[(0, 0)];
-    assert!((fu - phi).norm() <= 1e-9 * phi.norm(), "F_U = {fu}, φ = {phi}");
+    assert!(
+        (fu - phi).norm() <= 1e-9 * phi.norm(),
+        "F_U = {fu}, φ = {phi}"
+    );
 }
 
 /// Inside the noise disk of the nominal model the answer is 0; outside, positive.
@@ -308,9 +366,21 @@ fn within_noise_is_zero() {
     let at = cfg.factorization.at(12.0);
     let g = nominal(&at);
     let la = 0.06;
-    let inside = r_min_noisy(&at, g + c(0.0, 0.99 * la), la, &BisectionSettings::default()).unwrap();
+    let inside = r_min_noisy(
+        &at,
+        g + c(0.0, 0.99 * la),
+        la,
+        &BisectionSettings::default(),
+    )
+    .unwrap();
     assert_eq!(inside.r_min, 0.0);
-    let outside = r_min_noisy(&at, g + c(0.0, 1.01 * la), la, &BisectionSettings::default()).unwrap();
+    let outside = r_min_noisy(
+        &at,
+        g + c(0.0, 1.01 * la),
+        la,
+        &BisectionSettings::default(),
+    )
+    .unwrap();
     assert!(outside.r_min > 0.0);
 }
 
@@ -320,8 +390,14 @@ fn assumptions_a6_a7() {
     let cfg = robot();
     let at = cfg.factorization.at(2.0);
     let s = BisectionSettings::default();
-    assert_eq!(r_min_noisy(&at, c(0.0, 0.0), 0.06, &s).unwrap_err(), NoisyFailure::A6);
-    assert_eq!(r_min_noisy(&at, nominal(&at), 0.06, &s).unwrap_err(), NoisyFailure::A7);
+    assert_eq!(
+        r_min_noisy(&at, c(0.0, 0.0), 0.06, &s).unwrap_err(),
+        NoisyFailure::A6
+    );
+    assert_eq!(
+        r_min_noisy(&at, nominal(&at), 0.06, &s).unwrap_err(),
+        NoisyFailure::A7
+    );
     let mut data = robot_data(&cfg);
     data.response[3][(0, 0)] = c(0.0, 0.0);
     let err = noisy_envelope(&cfg.factorization, &data, &vec![0.06; data.len()], &s).unwrap_err();
@@ -339,7 +415,13 @@ fn assumptions_a6_a7() {
 fn a1_violations_are_reported() {
     let cfg = robot();
     let data = robot_data(&cfg);
-    let env = noisy_envelope(&cfg.factorization, &data, &vec![0.06; data.len()], &BisectionSettings::default()).unwrap();
+    let env = noisy_envelope(
+        &cfg.factorization,
+        &data,
+        &vec![0.06; data.len()],
+        &BisectionSettings::default(),
+    )
+    .unwrap();
     let r = cfg.r.as_ref().unwrap();
     let rep = check(r, &env);
     let expected: Vec<f64> = data
@@ -365,8 +447,14 @@ fn r_min_nonincreasing_in_noise() {
         let phi = data.response[k][(0, 0)];
         let mut prev = f64::INFINITY;
         for la in [0.0, 0.005, 0.01, 0.02, 0.04, 0.06] {
-            let r = r_min_noisy(&at, phi, la, &BisectionSettings::default()).unwrap().r_min;
-            assert!(r <= prev * (1.0 + 1e-9), "ω = {}: r_min({la}) = {r} > {prev}", data.omega[k]);
+            let r = r_min_noisy(&at, phi, la, &BisectionSettings::default())
+                .unwrap()
+                .r_min;
+            assert!(
+                r <= prev * (1.0 + 1e-9),
+                "ω = {}: r_min({la}) = {r} > {prev}",
+                data.omega[k]
+            );
             prev = r;
         }
     }
@@ -405,14 +493,28 @@ proptest! {
 /// the disk of radius M about A_m lies in the annular sector, a 1 % larger one does not.
 #[test]
 fn linf_radius_is_largest_inscribed_disk() {
-    for (m, am) in [(0.06, 0.07), (0.06, 0.1), (0.06, 0.3), (1.0, 50.0), (0.5, 0.8)] {
+    for (m, am) in [
+        (0.06, 0.07),
+        (0.06, 0.1),
+        (0.06, 0.3),
+        (1.0, 50.0),
+        (0.5, 0.8),
+    ] {
         let la = linf_disk_radius(m, am).unwrap();
-        assert!((la - m).abs() <= 1e-15 * m, "M = {m}, A_m = {am}: L_a = {la}");
+        assert!(
+            (la - m).abs() <= 1e-15 * m,
+            "M = {m}, A_m = {am}: L_a = {la}"
+        );
         let lt = m / (am - m);
-        let inside = |p: Complex64| (p.norm() - am).abs() <= m * (1.0 + 1e-12) && p.arg().abs() <= lt + 1e-12;
+        let inside = |p: Complex64| {
+            (p.norm() - am).abs() <= m * (1.0 + 1e-12) && p.arg().abs() <= lt + 1e-12
+        };
         for k in 0..3600 {
             let p = c(am, 0.0) + Complex64::from_polar(la, TAU * k as f64 / 3600.0);
-            assert!(inside(p), "M = {m}, A_m = {am}: boundary point {p} outside U");
+            assert!(
+                inside(p),
+                "M = {m}, A_m = {am}: boundary point {p} outside U"
+            );
         }
         // No disk of radius 1.01·M fits anywhere (it would not fit radially).
         assert!(1.01 * m > m);
@@ -425,7 +527,10 @@ fn siso_data(values: &[Complex64], noise: Option<Vec<f64>>) -> FrfData {
     FrfData {
         path: PathBuf::from("t.csv"),
         omega: (1..=values.len()).map(|k| k as f64).collect(),
-        response: values.iter().map(|v| DMatrix::from_element(1, 1, *v)).collect(),
+        response: values
+            .iter()
+            .map(|v| DMatrix::from_element(1, 1, *v))
+            .collect(),
         noise_radius: noise,
         lines: (2..values.len() + 2).collect(),
     }
@@ -435,31 +540,68 @@ fn siso_data(values: &[Complex64], noise: Option<Vec<f64>>) -> FrfData {
 #[test]
 fn noise_precedence_and_output_bound() {
     let data = siso_data(&[c(0.3, 0.0), c(0.0, 2.0)], Some(vec![0.01, 0.02]));
-    let cfg = NoiseSection { radius: Some(0.05), ..Default::default() };
-    assert_eq!(noise_radii(Some(0.07), Some(&cfg), &data).unwrap(), Some(vec![0.07, 0.07]));
-    assert_eq!(noise_radii(None, Some(&cfg), &data).unwrap(), Some(vec![0.05, 0.05]));
-    let r = resolve_noise(None, Some(&NoiseSection::default()), &data).unwrap().unwrap();
-    assert_eq!((r.radii, r.source), (vec![0.01, 0.02], NoiseSource::DataColumn));
-    assert_eq!(noise_radii(None, None, &siso_data(&[c(1.0, 0.0)], None)).unwrap(), None);
-    let ob = NoiseSection { output_bound: Some(0.1), input_amplitude: Some(2.0), ..Default::default() };
+    let cfg = NoiseSection {
+        radius: Some(0.05),
+        ..Default::default()
+    };
+    assert_eq!(
+        noise_radii(Some(0.07), Some(&cfg), &data).unwrap(),
+        Some(vec![0.07, 0.07])
+    );
+    assert_eq!(
+        noise_radii(None, Some(&cfg), &data).unwrap(),
+        Some(vec![0.05, 0.05])
+    );
+    let r = resolve_noise(None, Some(&NoiseSection::default()), &data)
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        (r.radii, r.source),
+        (vec![0.01, 0.02], NoiseSource::DataColumn)
+    );
+    assert_eq!(
+        noise_radii(None, None, &siso_data(&[c(1.0, 0.0)], None)).unwrap(),
+        None
+    );
+    let ob = NoiseSection {
+        output_bound: Some(0.1),
+        input_amplitude: Some(2.0),
+        ..Default::default()
+    };
     // A_m = 2·|φ| = 0.6 and 4.0, both > M: L_a = M/U = 0.05.
-    assert_eq!(noise_radii(None, Some(&ob), &data).unwrap(), Some(vec![0.05, 0.05]));
-    let too_big = NoiseSection { output_bound: Some(0.7), ..Default::default() };
-    assert!(matches!(noise_radii(None, Some(&too_big), &data), Err(Error::Assumption { omega, .. }) if omega == 1.0));
+    assert_eq!(
+        noise_radii(None, Some(&ob), &data).unwrap(),
+        Some(vec![0.05, 0.05])
+    );
+    let too_big = NoiseSection {
+        output_bound: Some(0.7),
+        ..Default::default()
+    };
+    assert!(
+        matches!(noise_radii(None, Some(&too_big), &data), Err(Error::Assumption { omega, .. }) if omega == 1.0)
+    );
     assert!(noise_radii(Some(-1.0), None, &data).is_err());
 }
 
 /// The `[noise]` keys parse; radius with output_bound is an error; unknown keys are errors.
 #[test]
 fn noise_config_keys() {
-    let base = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml")).unwrap();
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
     let p = Path::new("x.toml");
-    let ob = base.replace("radius = 0.06", "output_bound = 0.05\ninput_amplitude = 2.0");
+    let ob = base.replace(
+        "radius = 0.06",
+        "output_bound = 0.05\ninput_amplitude = 2.0",
+    );
     let cfg = Config::parse(&ob, p).unwrap();
     assert_eq!(cfg.raw.noise.output_bound, Some(0.05));
     assert_eq!(cfg.raw.noise.input_amplitude, Some(2.0));
     let both = base.replace("radius = 0.06", "radius = 0.06\noutput_bound = 0.05");
-    assert!(Config::parse(&both, p).unwrap_err().to_string().contains("not both"));
+    assert!(Config::parse(&both, p)
+        .unwrap_err()
+        .to_string()
+        .contains("not both"));
     let typo = base.replace("radius = 0.06", "raduis = 0.06");
     assert!(Config::parse(&typo, p).is_err());
 }

@@ -6,4 +6,6 @@ pub mod noisy;
 
 pub use check::{check, CheckReport, CheckRow};
 pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};
-pub use noisy::{noisy_envelope, noisy_envelope_report, BisectionSettings, NoisyDatum, NoisyReport};
+pub use noisy::{
+    noisy_envelope, noisy_envelope_report, BisectionSettings, NoisyDatum, NoisyReport,
+};

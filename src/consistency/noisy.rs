@@ -12,7 +12,6 @@
 use super::envelope::{check_sizes, Envelope, EnvelopeMethod};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
-use crate::model::factorization::sigma_min;
 use crate::model::{Factorization, FactorsAt};
 use crate::mu::{mu_full_scalar_from, FullPlusScalar, MuSettings, MuStatus};
 use nalgebra::DMatrix;
@@ -70,22 +69,35 @@ fn parts(at: &FactorsAt) -> std::result::Result<Parts, NoisyFailure> {
     let mut rhs = DMatrix::zeros(n, n + 1);
     rhs.view_mut((0, 0), (n, 1)).copy_from(&(&at.n * j));
     rhs.view_mut((0, 1), (n, n)).fill_with_identity();
-    let smin = sigma_min(&at.m);
-    if !(smin > 1e-13 * at.m.norm()) {
+    if at.m_singular() {
         return Err(NoisyFailure::MSingular);
     }
-    let sol = at.m.clone().lu().solve(&rhs).ok_or(NoisyFailure::MSingular)?;
+    let sol =
+        at.m.clone()
+            .lu()
+            .solve(&rhs)
+            .ok_or(NoisyFailure::MSingular)?;
     let minv_nj = sol.columns(0, 1).into_owned();
     let minv = sol.columns(1, n).into_owned();
     let c_minv = &at.c * &minv;
     let v22 = (&at.c * &minv_nj)[(0, 0)];
-    Ok(Parts { minv, minv_nj, c_minv, v22, j })
+    Ok(Parts {
+        minv,
+        minv_nj,
+        c_minv,
+        v22,
+        j,
+    })
 }
 
 /// `V(jω)` of eq. (14), `(n+3)×(n+2)`, partitioned with `V₁₁` `(n+2)×(n+1)`:
 /// `V₁₁ = [0; r·M̃⁻¹ 0; 0]`, `V₁₂ = [r·J; r·M̃⁻¹ÑJ; 1]`, `V₂₁ = [C·M̃⁻¹  L_a]`,
 /// `V₂₂ = C·M̃⁻¹·Ñ·J` (`J = 1` gives the paper's eq. (14)).
-pub fn v_matrix(at: &FactorsAt, r: Complex64, la: f64) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+pub fn v_matrix(
+    at: &FactorsAt,
+    r: Complex64,
+    la: f64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
     let p = parts(at)?;
     let n = at.m.nrows();
     let mut v = DMatrix::zeros(n + 3, n + 2);
@@ -101,14 +113,17 @@ pub fn v_matrix(at: &FactorsAt, r: Complex64, la: f64) -> std::result::Result<DM
 
 /// `F_L(V, φ⁻¹) = V₁₁ + V₁₂(φ − V₂₂)⁻¹V₂₁` (eq. (15) and Lemma 1), `(n+2)×(n+1)`, for a
 /// `V` from [`v_matrix`].  Checks A6 (`φ ≠ 0`) and A7 (`φ − V₂₂ ≠ 0`).
-pub fn lower_lft(v: &DMatrix<Complex64>, phi: Complex64) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+pub fn lower_lft(
+    v: &DMatrix<Complex64>,
+    phi: Complex64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
     let (rows, cols) = (v.nrows() - 1, v.ncols() - 1);
     if !(phi.norm() > 0.0 && phi.is_finite()) {
         return Err(NoisyFailure::A6);
     }
     let v22 = v[(rows, cols)];
     let k = phi - v22;
-    if !(k.norm() > A7_RTOL * phi.norm().max(v22.norm())) {
+    if k.norm().is_nan() || k.norm() <= A7_RTOL * phi.norm().max(v22.norm()) {
         return Err(NoisyFailure::A7);
     }
     let v11 = v.view((0, 0), (rows, cols));
@@ -119,7 +134,12 @@ pub fn lower_lft(v: &DMatrix<Complex64>, phi: Complex64) -> std::result::Result<
 
 /// `F_L[V(jω), φ⁻¹]` at `r` and `L_a` (eqs. (14)–(15)): the matrix whose `μ_Γ` decides
 /// consistency (Theorem 4).
-pub fn gamma_lft(at: &FactorsAt, phi: Complex64, r: Complex64, la: f64) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+pub fn gamma_lft(
+    at: &FactorsAt,
+    phi: Complex64,
+    r: Complex64,
+    la: f64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
     lower_lft(&v_matrix(at, r, la)?, phi)
 }
 
@@ -158,6 +178,8 @@ pub struct NoisyDatum {
     pub mu_at_a1: f64,
     /// Number of `μ` computations.
     pub mu_evaluations: usize,
+    /// Total number of matrix decompositions inside those `μ` computations.
+    pub decompositions: usize,
     /// Largest relative gap of the `μ` bounds met in the search.
     pub worst_mu_gap: f64,
     /// Worst `μ` status met (`Converged` unless something went wrong).
@@ -184,10 +206,15 @@ fn status_rank(s: MuStatus) -> u8 {
 /// `[0, σ_min(M̃)]` and found by Brent's method (bisection safeguarded by secant and inverse
 /// quadratic steps, valid because `μ` is continuous and nondecreasing, Proposition 1), to
 /// `settings.rel_tol` relative.  Each `μ` is warm-started at the previous optimal `ln d`.
-pub fn r_min_noisy(at: &FactorsAt, phi: Complex64, la: f64, settings: &BisectionSettings) -> std::result::Result<NoisyDatum, NoisyFailure> {
+pub fn r_min_noisy(
+    at: &FactorsAt,
+    phi: Complex64,
+    la: f64,
+    settings: &BisectionSettings,
+) -> std::result::Result<NoisyDatum, NoisyFailure> {
     let m1 = gamma_lft(at, phi, Complex64::new(1.0, 0.0), la)?;
     let n = at.m.nrows();
-    let a1 = sigma_min(&at.m);
+    let a1 = at.a1_limit();
     let s = FullPlusScalar::gamma(n);
     let mu0 = m1[(n + 1, n)].norm();
     let mut out = NoisyDatum {
@@ -196,6 +223,7 @@ pub fn r_min_noisy(at: &FactorsAt, phi: Complex64, la: f64, settings: &Bisection
         mu_at_zero: mu0,
         mu_at_a1: f64::NAN,
         mu_evaluations: 0,
+        decompositions: 0,
         worst_mu_gap: 0.0,
         mu_status: MuStatus::Converged,
         hit_iteration_cap: false,
@@ -211,8 +239,10 @@ pub fn r_min_noisy(at: &FactorsAt, phi: Complex64, la: f64, settings: &Bisection
                 scaled[(i, j)] = m1[(i, j)] * rho;
             }
         }
-        let b = mu_full_scalar_from(&scaled, s, &settings.mu, hint).expect("shape of F_L matches Γ");
+        let b =
+            mu_full_scalar_from(&scaled, s, &settings.mu, hint).expect("shape of F_L matches Γ");
         out.mu_evaluations += 1;
+        out.decompositions += b.evaluations;
         out.worst_mu_gap = out.worst_mu_gap.max(b.rel_gap);
         if status_rank(b.status) > status_rank(out.mu_status) {
             out.mu_status = b.status;
@@ -224,7 +254,7 @@ pub fn r_min_noisy(at: &FactorsAt, phi: Complex64, la: f64, settings: &Bisection
     };
     let mu_hi = mu_of(a1, &mut out);
     out.mu_at_a1 = mu_hi;
-    if !(mu_hi > 1.0) {
+    if mu_hi.is_nan() || mu_hi <= 1.0 {
         out.r_min = f64::INFINITY;
         return Ok(out);
     }
@@ -301,7 +331,12 @@ pub struct NoisyReport {
 }
 
 /// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].
-pub fn noisy_envelope_report(f: &Factorization, data: &FrfData, radius: &[f64], settings: &BisectionSettings) -> Result<NoisyReport> {
+pub fn noisy_envelope_report(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+) -> Result<NoisyReport> {
     check_sizes(f, data)?;
     if data.outputs() != 1 || data.inputs() != 1 {
         return Err(Error::Invalid(format!(
@@ -323,7 +358,10 @@ pub fn noisy_envelope_report(f: &Factorization, data: &FrfData, radius: &[f64], 
         if !(la.is_finite() && la >= 0.0) {
             return Err(Error::Assumption {
                 omega,
-                msg: format!("noise radius {la} must be finite and ≥ 0 ({})", data.path.display()),
+                msg: format!(
+                    "noise radius {la} must be finite and ≥ 0 ({})",
+                    data.path.display()
+                ),
             });
         }
         let at = f.at(omega);
@@ -339,7 +377,10 @@ pub fn noisy_envelope_report(f: &Factorization, data: &FrfData, radius: &[f64], 
         a1_limit: Some(rows.iter().map(|r| r.a1_limit).collect()),
         method: EnvelopeMethod::Theorem4Mu,
     };
-    Ok(NoisyReport { envelope, data: rows })
+    Ok(NoisyReport {
+        envelope,
+        data: rows,
+    })
 }
 
 /// The noisy SISO envelope (Theorem 4): per datum, the smallest `|r(jω_i)|` with
@@ -348,13 +389,21 @@ pub fn noisy_envelope_report(f: &Factorization, data: &FrfData, radius: &[f64], 
 /// (`|r| < σ_min(M̃)`, A1) explains the datum.  Errors: non-SISO data or model, a radius
 /// count that does not match, A6/A7 or a singular `M̃` at a datum (naming its frequency), and
 /// a `μ` computation that failed numerically (SVD cap or non-finite entries).
-pub fn noisy_envelope(f: &Factorization, data: &FrfData, radius: &[f64], settings: &BisectionSettings) -> Result<Envelope> {
+pub fn noisy_envelope(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+) -> Result<Envelope> {
     let rep = noisy_envelope_report(f, data, radius, settings)?;
     for (w, d) in rep.envelope.omega.iter().zip(&rep.data) {
         if matches!(d.mu_status, MuStatus::SvdFailed | MuStatus::NonFinite) {
             return Err(Error::Assumption {
                 omega: *w,
-                msg: format!("the μ computation failed ({:?}); check the model and the datum", d.mu_status),
+                msg: format!(
+                    "the μ computation failed ({:?}); check the model and the datum",
+                    d.mu_status
+                ),
             });
         }
     }

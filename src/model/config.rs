@@ -293,17 +293,23 @@ impl NoiseSection {
     pub fn validate(&self) -> std::result::Result<(), String> {
         if let Some(la) = self.radius {
             if !(la.is_finite() && la >= 0.0) {
-                return Err(format!("[noise] radius = {la}: must be a finite number ≥ 0"));
+                return Err(format!(
+                    "[noise] radius = {la}: must be a finite number ≥ 0"
+                ));
             }
         }
         if let Some(m) = self.output_bound {
             if !(m.is_finite() && m >= 0.0) {
-                return Err(format!("[noise] output_bound = {m}: must be a finite number ≥ 0"));
+                return Err(format!(
+                    "[noise] output_bound = {m}: must be a finite number ≥ 0"
+                ));
             }
         }
         if let Some(u) = self.input_amplitude {
             if !(u.is_finite() && u > 0.0) {
-                return Err(format!("[noise] input_amplitude = {u}: must be a finite number > 0"));
+                return Err(format!(
+                    "[noise] input_amplitude = {u}: must be a finite number > 0"
+                ));
             }
             if self.output_bound.is_none() {
                 return Err("[noise] input_amplitude is only used with output_bound; add output_bound or remove it".into());

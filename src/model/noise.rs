@@ -69,13 +69,21 @@ pub fn linf_disk_radius(output_bound: f64, measured_amplitude: f64) -> Option<f6
     }
     let lt = phase_bound(m, am)?;
     let s = lt.min(std::f64::consts::FRAC_PI_2).sin();
-    Some(if am * s >= m { m } else { (am + m) * s / (1.0 + s) })
+    Some(if am * s >= m {
+        m
+    } else {
+        (am + m) * s / (1.0 + s)
+    })
 }
 
 /// Per-datum radii from the `L∞` output bound `M` (Sec. III): `L_a,i = R(M, U·|φ_i|)/U`, with
 /// `R` = [`linf_disk_radius`] and `U` the input amplitude (the measured output amplitude is
 /// `A_m = U·|φ_i|`; dividing by `U` brings the disk back to the units of `φ`).  SISO only.
-pub fn radii_from_output_bound(output_bound: f64, input_amplitude: f64, data: &FrfData) -> Result<Vec<f64>> {
+pub fn radii_from_output_bound(
+    output_bound: f64,
+    input_amplitude: f64,
+    data: &FrfData,
+) -> Result<Vec<f64>> {
     if data.outputs() != 1 || data.inputs() != 1 {
         return Err(Error::Invalid(format!(
             "{}: [noise] output_bound (Sec. III) is defined for SISO data; these are {}×{}",
@@ -104,18 +112,30 @@ pub fn radii_from_output_bound(output_bound: f64, input_amplitude: f64, data: &F
 
 /// Resolves the noise model with precedence CLI flag > config > data column (see the module
 /// documentation).  `Ok(None)` when no noise is given anywhere.
-pub fn resolve_noise(cli_radius: Option<f64>, config: Option<&NoiseSection>, data: &FrfData) -> Result<Option<ResolvedNoise>> {
+pub fn resolve_noise(
+    cli_radius: Option<f64>,
+    config: Option<&NoiseSection>,
+    data: &FrfData,
+) -> Result<Option<ResolvedNoise>> {
     let all = |r: f64| vec![r; data.len()];
     if let Some(r) = cli_radius {
         if !(r.is_finite() && r >= 0.0) {
-            return Err(Error::Invalid(format!("--noise-radius {r}: must be a finite number ≥ 0")));
+            return Err(Error::Invalid(format!(
+                "--noise-radius {r}: must be a finite number ≥ 0"
+            )));
         }
-        return Ok(Some(ResolvedNoise { radii: all(r), source: NoiseSource::CliFlag }));
+        return Ok(Some(ResolvedNoise {
+            radii: all(r),
+            source: NoiseSource::CliFlag,
+        }));
     }
     if let Some(sec) = config {
         sec.validate().map_err(Error::Invalid)?;
         if let Some(r) = sec.radius {
-            return Ok(Some(ResolvedNoise { radii: all(r), source: NoiseSource::ConfigRadius }));
+            return Ok(Some(ResolvedNoise {
+                radii: all(r),
+                source: NoiseSource::ConfigRadius,
+            }));
         }
         if let Some(m) = sec.output_bound {
             let u = sec.input_amplitude.unwrap_or(1.0);
@@ -134,13 +154,20 @@ pub fn resolve_noise(cli_radius: Option<f64>, config: Option<&NoiseSection>, dat
                 data.len()
             )));
         }
-        return Ok(Some(ResolvedNoise { radii: col.clone(), source: NoiseSource::DataColumn }));
+        return Ok(Some(ResolvedNoise {
+            radii: col.clone(),
+            source: NoiseSource::DataColumn,
+        }));
     }
     Ok(None)
 }
 
 /// The per-datum radii only (see [`resolve_noise`]): CLI flag > config > data column;
 /// `Ok(None)` when there is no noise model.
-pub fn noise_radii(cli_radius: Option<f64>, config: Option<&NoiseSection>, data: &FrfData) -> Result<Option<Vec<f64>>> {
+pub fn noise_radii(
+    cli_radius: Option<f64>,
+    config: Option<&NoiseSection>,
+    data: &FrfData,
+) -> Result<Option<Vec<f64>>> {
     Ok(resolve_noise(cli_radius, config, data)?.map(|r| r.radii))
 }
