@@ -251,10 +251,14 @@ impl Search<'_> {
         let sigma = lambda.max(0.0).sqrt();
         let xs = eig.eigenvectors.column(imax);
         let ys = &md * xs;
-        let h = if sigma > 0.0 {
-            ys[k].norm_sqr() / (sigma * sigma) - xs[q].norm_sqr()
-        } else {
+        // h = |y_k|² − |x_q|² = ‖x₁‖² − ‖y₁‖² (unit x, y): use the form built from the
+        // smaller parts, which avoids cancellation when one block carries almost everything.
+        let h = if sigma == 0.0 {
             0.0
+        } else if xs[q].norm_sqr() > 0.5 {
+            xs.rows(0, q).norm_squared() - ys.rows(0, k).norm_squared() / (sigma * sigma)
+        } else {
+            ys[k].norm_sqr() / (sigma * sigma) - xs[q].norm_sqr()
         };
         let curv = curvature(&md, &eig.eigenvalues, &eig.eigenvectors, imax, ys[k], q, k);
         if sigma < self.upper {
@@ -266,6 +270,45 @@ impl Search<'_> {
         x[q] /= t.exp();
         self.offer(x);
         Some(Eval { sigma, h, curv })
+    }
+
+    /// Rebalancing of the witness `x = (x₁, x₂)`: at the precision limit of the search the
+    /// two ratios of [`lower_of`] differ slightly (most when one part of `x` is tiny, which
+    /// amplifies rounding in `h`).  Rescaling `x₂` by a real `α` moves them in opposite
+    /// directions; bisection on `ln α ∈ [−0.1, 0.1]` for the sign of `r₁ − r₂` equalizes them.
+    fn balance_candidate(&mut self) {
+        let Some(x0) = self.witness.clone() else {
+            return;
+        };
+        let q = self.q;
+        if x0.rows(0, q).norm() == 0.0 || x0[q].norm() == 0.0 {
+            return;
+        }
+        let at = |s: f64| {
+            let mut x = x0.clone();
+            x[q] *= s.exp();
+            x
+        };
+        let diff = |x: &DVector<Complex64>| {
+            let z = self.m * x;
+            z.rows(0, self.k).norm() / x.rows(0, q).norm() - z[self.k].norm() / x[q].norm()
+        };
+        let (mut lo, mut hi) = (-0.1, 0.1);
+        let (dlo, dhi) = (diff(&at(lo)), diff(&at(hi)));
+        if dlo.signum() == dhi.signum() {
+            return;
+        }
+        let rising = dhi > dlo;
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if (diff(&at(mid)) > 0.0) == rising {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        self.offer(at(lo));
+        self.offer(at(hi));
     }
 
     /// Repeated-`σ̄` candidate at the best `t`: combines the top two right singular vectors
@@ -294,16 +337,15 @@ impl Search<'_> {
         if !(lp >= 0.0 && lm <= 0.0) || lp - lm <= 0.0 {
             return;
         }
-        // Eigenvectors of [[a, c], [c̄, b]].
+        // Eigenvectors of [[a, c], [c̄, b]]: (c, l − a) or (l − b, c̄), whichever is longer
+        // (the other can cancel catastrophically).
         let ev = |l: f64| -> [Complex64; 2] {
-            let v = if c.norm() > 0.0 {
-                [c, Complex64::new(l - a, 0.0)]
-            } else if (l - a).abs() <= (l - b).abs() {
-                [Complex64::new(1.0, 0.0), Complex64::new(0.0, 0.0)]
-            } else {
-                [Complex64::new(0.0, 0.0), Complex64::new(1.0, 0.0)]
-            };
-            let n = (v[0].norm_sqr() + v[1].norm_sqr()).sqrt();
+            let v1 = [c, Complex64::new(l - a, 0.0)];
+            let v2 = [Complex64::new(l - b, 0.0), c.conj()];
+            let n1 = v1[0].norm_sqr() + v1[1].norm_sqr();
+            let n2 = v2[0].norm_sqr() + v2[1].norm_sqr();
+            let (v, n) = if n1 >= n2 { (v1, n1) } else { (v2, n2) };
+            let n = n.sqrt();
             [v[0] / n, v[1] / n]
         };
         let (ep, em) = (ev(lp), ev(lm));
@@ -456,6 +498,9 @@ pub fn mu_full_scalar_from(
         .filter(|t| t.is_finite())
         .unwrap_or(0.5 * (n12 / n21).ln());
     newton_search(&mut search, t0);
+    if !search.gap_ok() && !search.svd_failed {
+        search.balance_candidate();
+    }
     if !search.gap_ok() && !search.svd_failed {
         search.kink_candidate();
         if !search.gap_ok() {

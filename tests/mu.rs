@@ -94,6 +94,34 @@ proptest! {
         check_bounds(&m, n)?;
     }
 
+    /// Nearly block-triangular matrices (`M₁₂` or `M₂₁` scaled by 1e-12): the optimal `d`
+    /// runs off towards 0 or ∞.
+    #[test]
+    fn bounds_meet_nearly_triangular(seed in any::<u64>(), n in 1usize..=5, which in 0usize..2) {
+        let mut m = random_m(seed, n, 0.0);
+        if which == 0 {
+            for i in 0..=n {
+                m[(i, n)] *= 1e-12;
+            }
+        } else {
+            for j in 0..n {
+                m[(n + 1, j)] *= 1e-12;
+            }
+        }
+        check_bounds(&m, n)?;
+    }
+
+    /// Zero-diagonal two-scalar matrices have a repeated `σ̄` at the optimal `d` (a kink).
+    #[test]
+    fn bounds_meet_at_a_kink(b_re in -3.0f64..3.0, b_im in -3.0f64..3.0, c_re in -3.0f64..3.0, c_im in 0.01f64..3.0) {
+        let m = DMatrix::from_row_slice(2, 2, &[c(0.0, 0.0), c(b_re, b_im), c(c_re, c_im), c(0.0, 0.0)]);
+        let r = mu_full_scalar(&m, FullPlusScalar { rows: 1, cols: 1 }, &MuSettings::default()).unwrap();
+        let exact = (c(b_re, b_im) * c(c_re, c_im)).norm().sqrt();
+        prop_assume!(exact > 1e-6);
+        prop_assert_eq!(r.status, MuStatus::Converged);
+        prop_assert!((r.upper - exact).abs() <= 1e-9 * exact && (r.lower - exact).abs() <= 1e-9 * exact);
+    }
+
     /// The upper bound is a true bound: no structured Δ with ‖Δ‖ < 1/upper destabilizes,
     /// i.e. ρ(MΔ) ≤ 1 for random structured Δ scaled to ‖Δ‖ = 1/upper.
     #[test]
