@@ -108,7 +108,11 @@ pub struct MuBounds {
     pub rel_gap: f64,
     /// `ln d` at the best upper bound (`±∞` when the optimum is at `d → 0` or `∞`).
     pub log_d: f64,
-    /// Number of SVDs of `M_d` performed.
+    /// Sensitivity `d ln μ / d ln s` when the first `k` rows of `M` (those feeding `Δ̃`) are
+    /// scaled by `s`: `‖y₁‖²` of the top left singular vector at the optimal `d` (envelope
+    /// theorem; exact where `σ̄` is simple).  In `[0, 1]`; NaN when unknown.
+    pub row_share: f64,
+    /// Number of matrix decompositions performed.
     pub evaluations: usize,
     /// How the computation ended.
     pub status: MuStatus,
@@ -212,9 +216,10 @@ pub fn mu_full_scalar_from(
         )));
     }
     let (q, k) = (s.rows, s.cols);
-    let done = |upper: f64, lower: f64, log_d, evals, status, witness| MuBounds {
+    let done = |upper: f64, lower: f64, log_d, evals, status, witness, row_share| MuBounds {
         upper,
         lower,
+        row_share,
         rel_gap: if upper > 0.0 {
             (upper - lower) / upper
         } else {
@@ -234,6 +239,7 @@ pub fn mu_full_scalar_from(
             0,
             MuStatus::NonFinite,
             None,
+            f64::NAN,
         ));
     }
     let n12 = m.view((0, q), (k, 1)).norm();
@@ -246,6 +252,7 @@ pub fn mu_full_scalar_from(
         evals: 0,
         upper: f64::INFINITY,
         t_upper: f64::NAN,
+        share_upper: f64::NAN,
         lower: 0.0,
         witness: None,
         svd_failed: false,
@@ -284,6 +291,7 @@ pub fn mu_full_scalar_from(
                 1,
                 MuStatus::SvdFailed,
                 search.witness,
+                f64::NAN,
             ));
         };
         let upper = s11.max(m[(k, q)].norm());
@@ -294,7 +302,17 @@ pub fn mu_full_scalar_from(
         };
         let witness = if upper > 0.0 { search.witness } else { None };
         let lower = if upper > 0.0 { search.lower } else { 0.0 };
-        return Ok(done(upper, lower, log_d, 1, MuStatus::Converged, witness));
+        // μ = σ̄(M₁₁) scales with the rows, μ = |M₂₂| does not.
+        let share = if s11 > m[(k, q)].norm() { 1.0 } else { 0.0 };
+        return Ok(done(
+            upper,
+            lower,
+            log_d,
+            1,
+            MuStatus::Converged,
+            witness,
+            share,
+        ));
     }
     let t0 = log_d_hint
         .filter(|t| t.is_finite())
@@ -317,5 +335,13 @@ pub fn mu_full_scalar_from(
         MuStatus::GapAboveTolerance
     };
     let (upper, lower, t) = (search.upper, search.lower, search.t_upper);
-    Ok(done(upper, lower, t, search.evals, status, search.witness))
+    Ok(done(
+        upper,
+        lower,
+        t,
+        search.evals,
+        status,
+        search.witness,
+        search.share_upper,
+    ))
 }

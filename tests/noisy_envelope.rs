@@ -486,3 +486,43 @@ proptest! {
         prop_assert!(a.upper <= b.upper * (1.0 + 1e-9));
     }
 }
+
+/// The envelope is the crossing of Theorem 4's test: just above `r_min`, `μ > 1` (certified
+/// by the lower bound); just below, `μ ≤ 1` (certified by the upper bound).
+#[test]
+fn r_min_is_the_mu_crossing() {
+    let cfg = robot();
+    let data = robot_data(&cfg);
+    let s = FullPlusScalar::gamma(5);
+    let mut checked = 0;
+    for la in [0.0, 0.005, 0.02] {
+        for k in (0..data.len()).step_by(7) {
+            let at = cfg.factorization.at(data.omega[k]);
+            let phi = data.response[k][(0, 0)];
+            let d = r_min_noisy(&at, phi, la, &BisectionSettings::default()).unwrap();
+            if !(d.r_min > 0.0 && d.r_min.is_finite()) {
+                continue;
+            }
+            let mu = |rho: f64| {
+                let m = gamma_lft(&at, phi, c(rho, 0.0), la).unwrap();
+                mu_full_scalar(&m, s, &MuSettings::default()).unwrap()
+            };
+            let above = mu(d.r_min * (1.0 + 1e-8));
+            let below = mu(d.r_min * (1.0 - 1e-8));
+            assert!(
+                above.lower > 1.0,
+                "ω = {}, L_a = {la}: μ above r_min ≥ {}",
+                data.omega[k],
+                above.lower
+            );
+            assert!(
+                below.upper <= 1.0,
+                "ω = {}, L_a = {la}: μ below r_min ≤ {}",
+                data.omega[k],
+                below.upper
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 30, "{checked}");
+}

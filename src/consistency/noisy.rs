@@ -146,7 +146,7 @@ pub fn gamma_lft(
 /// Settings of the search on `|r|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BisectionSettings {
-    /// Stop when the bracket on `|r|` is narrower than `rel_tol·|r|` (plus a few ulps).
+    /// Stop when the bracket on `|r|`, or the Newton step, is smaller than `rel_tol·|r|`.
     pub rel_tol: f64,
     /// Maximum number of `μ` evaluations per datum (besides the one at the A1 limit).
     pub max_iter: usize,
@@ -203,9 +203,14 @@ fn status_rank(s: MuStatus) -> u8 {
 /// `r` and its phase is absorbed into `Δ̃`.  `μ(0) = L_a/|φ − V₂₂|`; if it exceeds 1 the
 /// answer is 0.  Otherwise `μ` is evaluated at the A1 limit `σ_min(M̃)`; if it is at most 1
 /// the answer is `inf`.  Otherwise the crossing `μ(|r|) = 1` is bracketed in
-/// `[0, σ_min(M̃)]` and found by Brent's method (bisection safeguarded by secant and inverse
-/// quadratic steps, valid because `μ` is continuous and nondecreasing, Proposition 1), to
-/// `settings.rel_tol` relative.  Each `μ` is warm-started at the previous optimal `ln d`.
+/// `[0, σ_min(M̃)]`: every evaluation moves one end of the bracket (`μ > 1`: upper end,
+/// else lower end), which is valid because `μ` is continuous and nondecreasing in `|r|`
+/// (Proposition 1).  The next point is a Newton step on `ln μ` against `ln |r|`, whose slope
+/// is [`MuBounds::row_share`](crate::mu::MuBounds::row_share), when it falls inside the
+/// bracket, and the bracket midpoint otherwise (bisection).  The search stops when the
+/// bracket is narrower than `settings.rel_tol·|r|` or the Newton step is smaller than that
+/// (quadratic convergence: the remaining error is far below the step).  Each `μ` is
+/// warm-started at the previous optimal `ln d`.
 pub fn r_min_noisy(
     at: &FactorsAt,
     phi: Complex64,
@@ -233,7 +238,8 @@ pub fn r_min_noisy(
     }
     let mut scaled = m1.clone();
     let mut hint: Option<f64> = None;
-    let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> f64 {
+    // μ(ρ) and d ln μ/d ln ρ.
+    let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
         for i in 0..=n {
             for j in 0..=n {
                 scaled[(i, j)] = m1[(i, j)] * rho;
@@ -250,74 +256,51 @@ pub fn r_min_noisy(
         if b.log_d.is_finite() {
             hint = Some(b.log_d);
         }
-        b.upper
+        (b.upper, b.row_share)
     };
-    let mu_hi = mu_of(a1, &mut out);
+    let (mu_hi, share_hi) = mu_of(a1, &mut out);
     out.mu_at_a1 = mu_hi;
     if mu_hi.is_nan() || mu_hi <= 1.0 {
         out.r_min = f64::INFINITY;
         return Ok(out);
     }
-    // Brent's method on f(ρ) = μ(ρ) − 1 over [0, a1]: f(0) ≤ 0 < f(a1).
-    let (mut a, mut fa, mut b, mut fb) = (0.0, mu0 - 1.0, a1, mu_hi - 1.0);
-    let (mut c, mut fc) = (a, fa);
-    let (mut d, mut e) = (b - a, b - a);
+    // Bracket [lo, hi] with μ(lo) ≤ 1 < μ(hi).
+    let (mut lo, mut hi) = (0.0, a1);
+    let (mut rho, mut mu, mut share) = (a1, mu_hi, share_hi);
     let mut iters = 0;
     loop {
-        if fb > 0.0 && fc > 0.0 || fb <= 0.0 && fc <= 0.0 {
-            (c, fc) = (a, fa);
-            d = b - a;
-            e = d;
+        let newton = rho * (-mu.ln() / share).exp();
+        let tol = settings.rel_tol * hi;
+        if share > 0.0 && newton.is_finite() && (newton - rho).abs() <= tol {
+            out.r_min = newton.clamp(lo, hi);
+            break;
         }
-        if fc.abs() < fb.abs() {
-            (a, fa) = (b, fb);
-            (b, fb) = (c, fc);
-            (c, fc) = (a, fa);
-        }
-        let tol = 4.0 * f64::EPSILON * b.abs() + 0.5 * settings.rel_tol * b.abs().max(c.abs());
-        let xm = 0.5 * (c - b);
-        if xm.abs() <= tol || fb == 0.0 {
+        if hi - lo <= tol {
+            out.r_min = hi;
             break;
         }
         if iters >= settings.max_iter {
             out.hit_iteration_cap = true;
+            out.r_min = hi;
             break;
         }
-        if e.abs() >= tol && fa.abs() > fb.abs() {
-            let s_ = fb / fa;
-            let (mut p, mut q);
-            if a == c {
-                p = 2.0 * xm * s_;
-                q = 1.0 - s_;
-            } else {
-                let q_ = fa / fc;
-                let r = fb / fc;
-                p = s_ * (2.0 * xm * q_ * (q_ - r) - (b - a) * (r - 1.0));
-                q = (q_ - 1.0) * (r - 1.0) * (s_ - 1.0);
-            }
-            if p > 0.0 {
-                q = -q;
-            }
-            p = p.abs();
-            if 2.0 * p < (3.0 * xm * q - (tol * q).abs()).min((e * q).abs()) {
-                e = d;
-                d = p / q;
-            } else {
-                d = xm;
-                e = d;
-            }
+        let next = if share > 0.0 && newton > lo && newton < hi {
+            newton
         } else {
-            d = xm;
-            e = d;
-        }
-        (a, fa) = (b, fb);
-        b += if d.abs() > tol { d } else { tol.copysign(xm) };
-        fb = mu_of(b, &mut out) - 1.0;
+            0.5 * (lo + hi)
+        };
+        (mu, share) = mu_of(next, &mut out);
+        rho = next;
         iters += 1;
+        if mu > 1.0 {
+            hi = rho;
+        } else if mu == 1.0 {
+            out.r_min = rho;
+            break;
+        } else {
+            lo = rho;
+        }
     }
-    // Report the end of the final bracket where μ > 1 (the smallest verified |r|); when
-    // μ(b) = 1 exactly, b itself is the infimum.
-    out.r_min = if fb >= 0.0 { b } else { c };
     Ok(out)
 }
 

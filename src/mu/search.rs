@@ -21,6 +21,8 @@ pub(super) struct Search<'a> {
     pub(super) evals: usize,
     pub(super) upper: f64,
     pub(super) t_upper: f64,
+    /// `‖y₁‖²` of the top left singular vector at `t_upper`.
+    pub(super) share_upper: f64,
     pub(super) lower: f64,
     pub(super) witness: Option<DVector<Complex64>>,
     pub(super) svd_failed: bool,
@@ -105,6 +107,11 @@ impl Search<'_> {
         if sigma < self.upper {
             self.upper = sigma;
             self.t_upper = t;
+            self.share_upper = if sigma > 0.0 {
+                ys.rows(0, k).norm_squared() / (sigma * sigma)
+            } else {
+                f64::NAN
+            };
         }
         // Unscale by D_r⁻¹.
         let mut x = xs.into_owned();
