@@ -68,7 +68,7 @@ pub struct MuSettings {
     pub max_evals: usize,
     /// The search over `t = ln d` stays within `t₀ ± log_d_range` (`t₀` the starting point).
     pub log_d_range: f64,
-    /// Iteration cap of each SVD (nalgebra `try_new_unordered`).
+    /// Iteration cap of each matrix decomposition (Hermitian eigenproblem or SVD).
     pub svd_max_iter: usize,
 }
 
@@ -91,7 +91,8 @@ pub enum MuStatus {
     Converged,
     /// The iteration cap was reached first; both bounds are valid, the gap is reported.
     GapAboveTolerance,
-    /// An SVD did not converge within its cap; the bounds found so far are reported.
+    /// A decomposition (eigen or SVD) did not converge within its cap; the bounds found so
+    /// far are reported.
     SvdFailed,
     /// `M` has a non-finite entry; the bounds are NaN.
     NonFinite,
@@ -176,7 +177,7 @@ fn lower_of(x: &DVector<Complex64>, z: &DVector<Complex64>, q: usize, k: usize) 
 /// Algorithm: (i) if `M₁₂ = 0` or `M₂₁ = 0`, `det(I − MΔ_s)` factors and
 /// `μ = max(σ̄(M₁₁), |M₂₂|)` exactly; (ii) otherwise a safeguarded Newton search for
 /// `h(t) = 0`, `t = ln d`, started at the balancing point `t₀ = ½·ln(‖M₁₂‖/‖M₂₁‖)` (or
-/// `log_d_hint`), with the bracket grown by doubling steps; every SVD updates the upper bound
+/// `log_d_hint`), with the bracket grown by doubling steps; every evaluation updates the upper bound
 /// (`σ̄` at that `d`) and the lower bound (its singular vector); the search stops as soon as
 /// the relative gap is at most `settings.rel_gap`; (iii) if it is not met within the caps,
 /// the candidates `|M₂₂|`, `σ̄(M₁₁)` and the repeated-`σ̄` combination are tried.

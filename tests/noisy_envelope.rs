@@ -526,3 +526,47 @@ fn r_min_is_the_mu_crossing() {
     }
     assert!(checked >= 30, "{checked}");
 }
+
+/// An input factor `J(s)` (here `(s + 3)/(s + 5)`) enters `V₁₂` and `V₂₂`: the zero-noise
+/// envelope equals Theorem 3 (which uses `Φ̂ = ΦJ⁻¹`), and the noisy one the disk minimum.
+#[test]
+fn input_factor_j_is_handled() {
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let text = text.replace(
+        "c = [[-3.30e-3",
+        "j = [{ num = [1.0, 3.0], den = [1.0, 5.0] }]\nc = [[-3.30e-3",
+    );
+    let cfg = Config::parse(&text, Path::new("j.toml")).unwrap();
+    assert!((cfg.factorization.j[0].freq(2.0) - c(1.0, 0.0)).norm() > 0.05);
+    let settings = BisectionSettings::default();
+    let mut compared = 0;
+    for omega in [1.5, 3.0, 5.0, 11.0, 20.0, 40.0] {
+        let at = cfg.factorization.at(omega);
+        let g = nominal(&at);
+        let phi = g * c(1.3, 0.2);
+        let t3 = r_min_special(&at, &DMatrix::from_element(1, 1, phi)).unwrap();
+        let got = r_min_noisy(&at, phi, 0.0, &settings).unwrap();
+        if t3 < got.a1_limit {
+            assert!(
+                rel(got.r_min, t3) <= 1e-8,
+                "ω = {omega}: {} vs {t3}",
+                got.r_min
+            );
+            compared += 1;
+        }
+        let la = 0.4 * (phi - g).norm();
+        let got = r_min_noisy(&at, phi, la, &settings).unwrap();
+        let want = disk_minimum(&at, phi, la);
+        if got.r_min.is_finite() {
+            assert!(
+                rel(got.r_min, want) <= 1e-4,
+                "ω = {omega}: {} vs {want}",
+                got.r_min
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 6, "{compared}");
+}
