@@ -177,10 +177,11 @@ fn lower_of(x: &DVector<Complex64>, z: &DVector<Complex64>, q: usize, k: usize) 
 /// Algorithm: (i) if `M₁₂ = 0` or `M₂₁ = 0`, `det(I − MΔ_s)` factors and
 /// `μ = max(σ̄(M₁₁), |M₂₂|)` exactly; (ii) otherwise a safeguarded Newton search for
 /// `h(t) = 0`, `t = ln d`, started at the balancing point `t₀ = ½·ln(‖M₁₂‖/‖M₂₁‖)` (or
-/// `log_d_hint`), with the bracket grown by doubling steps; every evaluation updates the upper bound
-/// (`σ̄` at that `d`) and the lower bound (its singular vector); the search stops as soon as
-/// the relative gap is at most `settings.rel_gap`; (iii) if it is not met within the caps,
-/// the candidates `|M₂₂|`, `σ̄(M₁₁)` and the repeated-`σ̄` combination are tried.
+/// `log_d_hint`), bisecting a bracket once one is known and growing it by doubling steps
+/// before; every evaluation updates the upper bound (`σ̄` at that `d`) and the lower bound
+/// (its singular vector); the search stops as soon as the relative gap is at most
+/// `settings.rel_gap`; (iii) if it is not met within the caps, a rebalanced witness, the
+/// repeated-`σ̄` combination, `|M₂₂|` and `σ̄(M₁₁)` are tried.
 ///
 /// Errors only on a shape mismatch; numerical trouble is reported in [`MuBounds::status`].
 pub fn mu_full_scalar(
