@@ -15,6 +15,7 @@
 pub mod cli;
 pub mod consistency;
 pub mod data;
+pub mod diagnose;
 pub mod error;
 pub mod model;
 pub mod mu;

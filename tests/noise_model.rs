@@ -4,7 +4,6 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rshape::data::FrfData;
-use rshape::model::config::NoiseSection;
 use rshape::model::noise::{linf_disk_radius, noise_radii, resolve_noise, NoiseSource};
 use rshape::model::Config;
 use rshape::Error;
@@ -62,14 +61,19 @@ fn siso_data(values: &[Complex64], noise: Option<Vec<f64>>) -> FrfData {
     }
 }
 
+/// A robot config whose `[noise]` table is `noise` (TOML lines).
+fn config_with_noise(noise: &str) -> Config {
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    Config::parse(&base.replace("radius = 0.06", noise), Path::new("x.toml")).unwrap()
+}
+
 /// Precedence CLI flag > config > data column; output_bound gives L_a = M/U per datum.
 #[test]
 fn noise_precedence_and_output_bound() {
     let data = siso_data(&[c(0.3, 0.0), c(0.0, 2.0)], Some(vec![0.01, 0.02]));
-    let cfg = NoiseSection {
-        radius: Some(0.05),
-        ..Default::default()
-    };
+    let cfg = config_with_noise("radius = 0.05");
     assert_eq!(
         noise_radii(Some(0.07), Some(&cfg), &data).unwrap(),
         Some(vec![0.07, 0.07])
@@ -78,35 +82,74 @@ fn noise_precedence_and_output_bound() {
         noise_radii(None, Some(&cfg), &data).unwrap(),
         Some(vec![0.05, 0.05])
     );
-    let r = resolve_noise(None, Some(&NoiseSection::default()), &data)
-        .unwrap()
-        .unwrap();
+    let none = config_with_noise("");
+    let r = resolve_noise(None, Some(&none), &data).unwrap().unwrap();
     assert_eq!(
         (r.radii, r.source),
         (vec![0.01, 0.02], NoiseSource::DataColumn)
     );
     assert_eq!(
+        noise_radii(None, Some(&none), &siso_data(&[c(1.0, 0.0)], None)).unwrap(),
+        None
+    );
+    assert_eq!(
         noise_radii(None, None, &siso_data(&[c(1.0, 0.0)], None)).unwrap(),
         None
     );
-    let ob = NoiseSection {
-        output_bound: Some(0.1),
-        input_amplitude: Some(2.0),
-        ..Default::default()
-    };
+    let ob = config_with_noise("output_bound = 0.1\ninput_amplitude = 2.0");
     // A_m = 2·|φ| = 0.6 and 4.0, both > M: L_a = M/U = 0.05.
+    let r = resolve_noise(None, Some(&ob), &data).unwrap().unwrap();
     assert_eq!(
-        noise_radii(None, Some(&ob), &data).unwrap(),
-        Some(vec![0.05, 0.05])
+        (r.radii, r.source),
+        (vec![0.05, 0.05], NoiseSource::ConfigOutputBound)
     );
-    let too_big = NoiseSection {
-        output_bound: Some(0.7),
-        ..Default::default()
-    };
+    let too_big = config_with_noise("output_bound = 0.7");
     assert!(
         matches!(noise_radii(None, Some(&too_big), &data), Err(Error::Assumption { omega, .. }) if omega == 1.0)
     );
     assert!(noise_radii(Some(-1.0), None, &data).is_err());
+}
+
+/// `[noise] std_file` (radius = std_factor·std) is a config-level source: it beats the data
+/// column, and loses to the CLI flag.
+#[test]
+fn noise_std_file_source() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("d.csv"),
+        "omega_rad_s,re_1_1,im_1_1,noise_radius\n1,0.3,0,0.01\n2,0,2,0.02\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("d_std.csv"),
+        "omega_rad_s,std_1_1\n1,0.004\n2,0.005\n",
+    )
+    .unwrap();
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let text = base
+        .replace("data = \"robot.csv\"", "data = \"d.csv\"")
+        .replace(
+            "radius = 0.06",
+            "std_file = \"d_std.csv\"\nstd_factor = 2.0",
+        );
+    let cfg_path = dir.path().join("c.toml");
+    let cfg = Config::parse(&text, &cfg_path).unwrap();
+    let data = rshape::data::read_frf_csv(&dir.path().join("d.csv")).unwrap();
+    let r = resolve_noise(None, Some(&cfg), &data).unwrap().unwrap();
+    assert_eq!(r.source, NoiseSource::ConfigStdFile);
+    assert!(
+        (r.radii[0] - 0.008).abs() < 1e-15 && (r.radii[1] - 0.010).abs() < 1e-15,
+        "{:?}",
+        r.radii
+    );
+    assert_eq!(
+        noise_radii(Some(0.03), Some(&cfg), &data).unwrap(),
+        Some(vec![0.03, 0.03])
+    );
+    let both = text.replace("std_factor = 2.0", "std_factor = 2.0\noutput_bound = 0.1");
+    assert!(Config::parse(&both, &cfg_path).is_err());
 }
 
 /// The `[noise]` keys parse; radius with output_bound is an error; unknown keys are errors.

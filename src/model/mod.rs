@@ -2,6 +2,7 @@
 pub mod config;
 pub mod factorization;
 pub mod noise;
+pub mod physical;
 
 pub use config::Config;
 pub use factorization::{Factorization, FactorizationKind, FactorsAt};

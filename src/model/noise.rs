@@ -6,12 +6,15 @@
 //! 1. a global radius `L_a`: the CLI flag `--noise-radius X`, or `[noise] radius = X`;
 //! 2. the time-domain `L∞` model of Sec. III, `[noise] output_bound = M`: every datum gets the
 //!    radius of the largest disk inside its uncertainty set `U` ([`linf_disk_radius`]);
-//! 3. a per-frequency `noise_radius` column in the data file.
+//! 3. per-frequency radii: `[noise] std_file` (radius `std_factor·std`, default 3σ) or a
+//!    `noise_radius` column in the data file.
 //!
-//! **Precedence** ([`resolve_noise`]): CLI flag > config (`radius` or `output_bound`) > data
-//! column.  When none is given there is no noise model (use the noise-free theorems).
+//! **Precedence** ([`resolve_noise`]): CLI flag > config (`radius`, `output_bound` or
+//! `std_file`, which exclude each other) > data column.  When none is given there is no
+//! noise model (use the noise-free theorems).
 
-use super::config::NoiseSection;
+use super::Config;
+use crate::data::std_file::read_std_csv;
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 
@@ -25,6 +28,8 @@ pub enum NoiseSource {
     ConfigRadius,
     /// `[noise] output_bound` in the config (Sec. III, per datum).
     ConfigOutputBound,
+    /// `[noise] std_file` × `std_factor` in the config.
+    ConfigStdFile,
     /// The `noise_radius` column of the data file.
     DataColumn,
 }
@@ -112,9 +117,14 @@ pub fn radii_from_output_bound(
 
 /// Resolves the noise model with precedence CLI flag > config > data column (see the module
 /// documentation).  `Ok(None)` when no noise is given anywhere.
+///
+/// `data` must be the SISO data the envelope will use.  The config's `std_file` belongs to
+/// the config's own data file; for other data (`--data`), `<data stem>_std.csv` beside them
+/// is used, as `rshape compare` does.  Its column is `std_i_j` of the config's `[channel]`
+/// (default `std_1_1`).
 pub fn resolve_noise(
     cli_radius: Option<f64>,
-    config: Option<&NoiseSection>,
+    config: Option<&Config>,
     data: &FrfData,
 ) -> Result<Option<ResolvedNoise>> {
     let all = |r: f64| vec![r; data.len()];
@@ -129,7 +139,8 @@ pub fn resolve_noise(
             source: NoiseSource::CliFlag,
         }));
     }
-    if let Some(sec) = config {
+    if let Some(cfg) = config {
+        let sec = &cfg.raw.noise;
         sec.validate().map_err(Error::Invalid)?;
         if let Some(r) = sec.radius {
             return Ok(Some(ResolvedNoise {
@@ -142,6 +153,38 @@ pub fn resolve_noise(
             return Ok(Some(ResolvedNoise {
                 radii: radii_from_output_bound(m, u, data)?,
                 source: NoiseSource::ConfigOutputBound,
+            }));
+        }
+        if let Some((file, k)) = &cfg.noise_std {
+            let own = cfg.data.as_ref().is_some_and(|d| {
+                d == &data.path
+                    || d.canonicalize()
+                        .ok()
+                        .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
+            });
+            let file = if own {
+                file.clone()
+            } else {
+                let stem = data
+                    .path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().to_string())
+                    .unwrap_or_default();
+                let sib = data.path.with_file_name(format!("{stem}_std.csv"));
+                if !sib.exists() {
+                    return Err(Error::Invalid(format!(
+                        "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
+                        data.path.display(),
+                        sib.display()
+                    )));
+                }
+                sib
+            };
+            let (out, inp) = cfg.raw.channel.map_or((1, 1), |c| (c.output, c.input));
+            let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
+            return Ok(Some(ResolvedNoise {
+                radii,
+                source: NoiseSource::ConfigStdFile,
             }));
         }
     }
@@ -166,7 +209,7 @@ pub fn resolve_noise(
 /// `Ok(None)` when there is no noise model.
 pub fn noise_radii(
     cli_radius: Option<f64>,
-    config: Option<&NoiseSection>,
+    config: Option<&Config>,
     data: &FrfData,
 ) -> Result<Option<Vec<f64>>> {
     Ok(resolve_noise(cli_radius, config, data)?.map(|r| r.radii))
