@@ -34,6 +34,20 @@ pub enum NoiseSource {
     DataColumn,
 }
 
+impl NoiseSource {
+    /// A short human-readable description.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::CliFlag => "--noise-radius",
+            Self::ConfigRadius => "[noise] radius",
+            Self::ConfigOutputBound => "[noise] output_bound (Sec. III)",
+            Self::ConfigStdFile => "[noise] std_file × std_factor",
+            Self::DataColumn => "noise_radius column of the data",
+        }
+        .to_string()
+    }
+}
+
 /// Resolved per-datum noise radii `L_a,i`.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ResolvedNoise {
@@ -127,6 +141,21 @@ pub fn resolve_noise(
     config: Option<&Config>,
     data: &FrfData,
 ) -> Result<Option<ResolvedNoise>> {
+    let channel = config
+        .and_then(|c| c.raw.channel)
+        .map_or((1, 1), |c| (c.output, c.input));
+    resolve_noise_for_channel(cli_radius, config, data, channel)
+}
+
+/// [`resolve_noise`] for the SISO channel `(output, input)` (1-based) of the data: the
+/// channel selects the `std_<out>_<in>` column of a `[noise] std_file`.  Used by `compare`
+/// and `diagnose`, which may select the channel with `--channel`.
+pub fn resolve_noise_for_channel(
+    cli_radius: Option<f64>,
+    config: Option<&Config>,
+    data: &FrfData,
+    (out, inp): (usize, usize),
+) -> Result<Option<ResolvedNoise>> {
     let all = |r: f64| vec![r; data.len()];
     if let Some(r) = cli_radius {
         if !(r.is_finite() && r >= 0.0) {
@@ -180,7 +209,6 @@ pub fn resolve_noise(
                 }
                 sib
             };
-            let (out, inp) = cfg.raw.channel.map_or((1, 1), |c| (c.output, c.input));
             let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
             return Ok(Some(ResolvedNoise {
                 radii,
