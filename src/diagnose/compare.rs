@@ -163,7 +163,7 @@ pub fn prepare(
     let resolved = resolve_noise_for_channel(noise_override, Some(config), data, chan)?;
     let radius_source = resolved.as_ref().map_or_else(
         || "none (misfit relative to |G_d|)".to_string(),
-        |r| r.source.describe(),
+        |r| r.description.clone(),
     );
     let radius = resolved.map(|r| r.radii);
     if let Some(r) = &radius {

@@ -34,20 +34,6 @@ pub enum NoiseSource {
     DataColumn,
 }
 
-impl NoiseSource {
-    /// A short human-readable description.
-    pub fn describe(&self) -> String {
-        match self {
-            Self::CliFlag => "--noise-radius",
-            Self::ConfigRadius => "[noise] radius",
-            Self::ConfigOutputBound => "[noise] output_bound (Sec. III)",
-            Self::ConfigStdFile => "[noise] std_file × std_factor",
-            Self::DataColumn => "noise_radius column of the data",
-        }
-        .to_string()
-    }
-}
-
 /// Resolved per-datum noise radii `L_a,i`.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ResolvedNoise {
@@ -55,6 +41,8 @@ pub struct ResolvedNoise {
     pub radii: Vec<f64>,
     /// Where they came from.
     pub source: NoiseSource,
+    /// The source in words, with its numbers (for reports).
+    pub description: String,
 }
 
 /// The phase-noise bound of Sec. III, `L_θ = M/(A_m − M)` (radians), for an output-noise
@@ -166,6 +154,7 @@ pub fn resolve_noise_for_channel(
         return Ok(Some(ResolvedNoise {
             radii: all(r),
             source: NoiseSource::CliFlag,
+            description: format!("--noise-radius {r}"),
         }));
     }
     if let Some(cfg) = config {
@@ -175,6 +164,7 @@ pub fn resolve_noise_for_channel(
             return Ok(Some(ResolvedNoise {
                 radii: all(r),
                 source: NoiseSource::ConfigRadius,
+                description: format!("[noise] radius = {r}"),
             }));
         }
         if let Some(m) = sec.output_bound {
@@ -182,6 +172,7 @@ pub fn resolve_noise_for_channel(
             return Ok(Some(ResolvedNoise {
                 radii: radii_from_output_bound(m, u, data)?,
                 source: NoiseSource::ConfigOutputBound,
+                description: format!("[noise] output_bound = {m} (Sec. III: L_a = M)"),
             }));
         }
         if let Some((file, k)) = &cfg.noise_std {
@@ -211,6 +202,7 @@ pub fn resolve_noise_for_channel(
             };
             let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
             return Ok(Some(ResolvedNoise {
+                description: format!("{k} × std_{out}_{inp} of {}", file.display()),
                 radii,
                 source: NoiseSource::ConfigStdFile,
             }));
@@ -228,6 +220,7 @@ pub fn resolve_noise_for_channel(
         return Ok(Some(ResolvedNoise {
             radii: col.clone(),
             source: NoiseSource::DataColumn,
+            description: "noise_radius column of the data".into(),
         }));
     }
     Ok(None)
