@@ -19,6 +19,7 @@ pub mod data;
 pub mod diagnose;
 pub mod error;
 pub mod model;
+pub mod mu;
 pub mod pipeline;
 pub mod plot;
 pub mod report;

@@ -14,9 +14,9 @@
 //!   this one is conservative (it may flag a datum that noise and `r` together explain).
 
 use crate::consistency::noise_free_envelope;
-use crate::data::std_file::read_std_csv;
 use crate::data::FrfData;
 use crate::error::{Error, Result};
+use crate::model::noise::resolve_noise_for_channel;
 use crate::model::physical::PhysicalModel;
 use crate::model::{Config, Factorization};
 use nalgebra::DMatrix;
@@ -113,9 +113,9 @@ impl Siso {
     }
 }
 
-/// Selects the SISO channel and resolves the noise radius: `--noise-radius`, else the data's
-/// `noise_radius` column, else `[noise] std_file × std_factor` (for data other than the
-/// config's own, `<data stem>_std.csv` beside the data), else `[noise] radius`.
+/// Selects the SISO channel and resolves the noise radius with the precedence of
+/// [`crate::model::noise::resolve_noise`]: `--noise-radius`, else the config's `[noise]`
+/// (radius, output bound, std file), else the data's `noise_radius` column.
 pub fn prepare(
     config: &Config,
     data: &FrfData,
@@ -160,47 +160,12 @@ pub fn prepare(
         )));
     }
     let ch = data.channel(out - 1, inp - 1);
-    let (radius, radius_source) = if let Some(x) = noise_override {
-        (Some(vec![x; ch.len()]), format!("--noise-radius {x}"))
-    } else if let Some(r) = &data.noise_radius {
-        (Some(r.clone()), "noise_radius column of the data".into())
-    } else if let Some((cfg_file, k)) = &config.noise_std {
-        // The config's std file belongs to the config's data.  With other data (--data),
-        // use `<data stem>_std.csv` beside them.
-        let same = config.data.as_ref().is_some_and(|d| {
-            d == &data.path
-                || d.canonicalize()
-                    .ok()
-                    .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
-        });
-        let file = if same {
-            cfg_file.clone()
-        } else {
-            let stem = data
-                .path
-                .file_stem()
-                .map(|s| s.to_string_lossy().to_string())
-                .unwrap_or_default();
-            let sib = data.path.with_file_name(format!("{stem}_std.csv"));
-            if !sib.exists() {
-                return Err(Error::Invalid(format!(
-                    "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
-                    data.path.display(),
-                    sib.display()
-                )));
-            }
-            sib
-        };
-        let sd = read_std_csv(&file)?;
-        (
-            Some(sd.radius_at(&file, &ch.omega, out, inp, *k)?),
-            format!("{k} × std_{out}_{inp} of {}", file.display()),
-        )
-    } else if let Some(x) = config.raw.noise.radius {
-        (Some(vec![x; ch.len()]), format!("[noise] radius = {x}"))
-    } else {
-        (None, "none (misfit relative to |G_d|)".into())
-    };
+    let resolved = resolve_noise_for_channel(noise_override, Some(config), data, chan)?;
+    let radius_source = resolved.as_ref().map_or_else(
+        || "none (misfit relative to |G_d|)".to_string(),
+        |r| r.description.clone(),
+    );
+    let radius = resolved.map(|r| r.radii);
     if let Some(r) = &radius {
         if let Some(k) = r.iter().position(|x| x.is_nan() || *x <= 0.0) {
             return Err(Error::Invalid(format!(

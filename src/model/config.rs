@@ -100,13 +100,33 @@ pub struct RSection {
     pub den: Vec<f64>,
 }
 
-/// The `[noise]` table.
+/// The `[noise]` table (see [`crate::model::noise`] for how the keys are resolved).
+///
+/// ```toml
+/// [noise]
+/// radius = 0.06            # global disk radius L_a of eq. (5), in data units
+/// # or, the time-domain L∞ model of Sec. III (not together with `radius`):
+/// # output_bound = 0.05    # M: bound on the output noise, in output units
+/// # input_amplitude = 1.0  # amplitude of the input sinusoid (default 1)
+/// # or, per-frequency standard deviations (radius = std_factor·std):
+/// # std_file = "data_std.csv"
+/// # std_factor = 3.0
+/// ```
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NoiseSection {
     /// Global noise-disk radius `L_a` (eq. (5)), in the units of the data.
     #[serde(default)]
     pub radius: Option<f64>,
+    /// Bound `M` on the time-domain output noise, `‖n‖_∞ < M` (eq. (4)), in output units;
+    /// the disk radius of each datum follows from Sec. III
+    /// ([`crate::model::noise::linf_disk_radius`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_bound: Option<f64>,
+    /// Amplitude of the input sinusoid of the experiment (default 1), used with
+    /// `output_bound`: the measured output amplitude is `A_m = input_amplitude·|φ|`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input_amplitude: Option<f64>,
     /// A file of FRF standard deviations (`freq_hz` or `omega_rad_s`, then `std_i_j`
     /// columns), relative to the config; the noise radius is `std_factor·std`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -259,13 +279,7 @@ impl Config {
             }
             None => None,
         };
-        if let Some(la) = raw.noise.radius {
-            if !(la.is_finite() && la >= 0.0) {
-                return Err(err(format!(
-                    "[noise] radius = {la}: must be a finite number ≥ 0"
-                )));
-            }
-        }
+        raw.noise.validate().map_err(err)?;
         let base = path.parent().unwrap_or(Path::new("."));
         let data = raw.data.as_ref().map(|d| base.join(d));
         let noise_std = match (&raw.noise.std_file, raw.noise.std_factor) {
@@ -341,5 +355,42 @@ impl Config {
                 Factorization::special(c, mm, nn, j).map_err(|e| format!("[model]: {e}"))
             }
         }
+    }
+}
+
+impl NoiseSection {
+    /// Checks the values and that `radius` and `output_bound` are not both given.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        if let Some(la) = self.radius {
+            if !(la.is_finite() && la >= 0.0) {
+                return Err(format!(
+                    "[noise] radius = {la}: must be a finite number ≥ 0"
+                ));
+            }
+        }
+        if let Some(m) = self.output_bound {
+            if !(m.is_finite() && m >= 0.0) {
+                return Err(format!(
+                    "[noise] output_bound = {m}: must be a finite number ≥ 0"
+                ));
+            }
+        }
+        if let Some(u) = self.input_amplitude {
+            if !(u.is_finite() && u > 0.0) {
+                return Err(format!(
+                    "[noise] input_amplitude = {u}: must be a finite number > 0"
+                ));
+            }
+            if self.output_bound.is_none() {
+                return Err("[noise] input_amplitude is only used with output_bound; add output_bound or remove it".into());
+            }
+        }
+        if self.radius.is_some() && self.output_bound.is_some() {
+            return Err("[noise]: give either radius (L_a) or output_bound (M), not both".into());
+        }
+        if self.std_file.is_some() && self.output_bound.is_some() {
+            return Err("[noise]: give either std_file or output_bound (M), not both".into());
+        }
+        Ok(())
     }
 }

@@ -1,40 +1,27 @@
-//! The points where the pipeline meets the μ module (Theorem 4, branch `mu`) and the fit of
-//! `r` (branch `fit`).  Everything that depends on those modules goes through the functions
-//! here, so that landing them changes this file only.
+//! The points where the pipeline meets the noise model and the μ test (Theorem 4,
+//! [`crate::model::noise`], [`crate::consistency::noisy`], [`crate::mu`]) and the fit of `r`
+//! (branch `fit`).  Everything that depends on those modules goes through the functions here.
 //!
-//! Status: see the `INTEGRATION` markers.  Until the modules land:
-//! - the noisy envelope falls back to the noise-free one (Theorem 2/3) with a warning;
-//! - `μ_Γ` per datum is not available (no `mu.svg`);
-//! - the "fit" is a constant unit `r = 1.05·max r_min` (a valid unit of RH∞ that covers
-//!   every finite datum), clearly labelled as a placeholder in every output.
+//! Status: noise and μ are integrated.  Until the fit lands (`INTEGRATION(fit)` markers),
+//! the "fit" is a constant unit `r = 1.05·max r_min` (a valid unit of RH∞ that covers every
+//! finite datum), clearly labelled as a placeholder in every output.
 
+use crate::consistency::noisy::{gamma_lft, noisy_envelope, BisectionSettings};
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::{Config, Factorization};
+use crate::mu::{mu_full_scalar, FullPlusScalar, MuSettings};
 use crate::system::TransferFunction;
 use serde::Serialize;
 use serde_json::{json, Value};
 
-/// Per-datum noise radii, in priority order: `--noise-radius` (or a manifest's per-dataset
-/// radius), the config's `[noise] radius`, the data file's `noise_radius` column.  `None`
-/// (noise-free) when none is given or all radii are zero.
-// INTEGRATION(mu): replace with `model::noise::noise_radii` once it lands (same precedence).
+/// Per-datum noise radii with the precedence of [`crate::model::noise::resolve_noise`]:
+/// `--noise-radius` (or a manifest's per-dataset radius) > the config's `[noise]` > the data
+/// file's `noise_radius` column.  `None` (noise-free) when none is given or all are zero.
 pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<Option<Vec<f64>>> {
-    if let Some(x) = cli {
-        if !(x.is_finite() && x >= 0.0) {
-            return Err(Error::Invalid(format!(
-                "noise radius {x}: must be a finite number ≥ 0"
-            )));
-        }
-    }
-    let radii = match (cli, config.raw.noise.radius, &data.noise_radius) {
-        (Some(x), _, _) => vec![x; data.len()],
-        (None, Some(x), _) => vec![x; data.len()],
-        (None, None, Some(col)) => col.clone(),
-        (None, None, None) => return Ok(None),
-    };
-    Ok(radii.iter().any(|r| *r > 0.0).then_some(radii))
+    let radii = crate::model::noise::noise_radii(cli, Some(config), data)?;
+    Ok(radii.filter(|r| r.iter().any(|x| *x > 0.0)))
 }
 
 /// The envelope of the data: noise-free (Theorem 2 / Theorem 3) when `radii` is `None`,
@@ -47,27 +34,47 @@ pub fn envelope(
 ) -> Result<(Envelope, Vec<String>)> {
     match radii {
         None => Ok((noise_free_envelope(f, data)?, Vec::new())),
-        Some(_) => {
-            // INTEGRATION(mu): `consistency::noisy::noisy_envelope(f, data, radii, settings)`.
-            let env = noise_free_envelope(f, data)?;
-            Ok((
-                env,
-                vec!["the noisy envelope (Theorem 4) is not available in this build: the noise radius was ignored and the noise-free envelope (Theorem 2/3) is used".into()],
-            ))
+        Some(r) => {
+            let env = noisy_envelope(f, data, r, &BisectionSettings::default())?;
+            let inf = env.r_min.iter().filter(|x| x.is_infinite()).count();
+            let w = if inf > 0 {
+                vec![format!("{inf} datum(s) have r_min = ∞: no r explains them with this noise level and model")]
+            } else {
+                Vec::new()
+            };
+            Ok((env, w))
         }
     }
 }
 
-/// `μ_Γ{F_L[V(jω_i), φ_i⁻¹]}` per datum for the configured `r` (Fig. 8), for noisy data.
-/// `None` when not available.
+/// `μ_Γ{F_L[V(jω_i), φ_i⁻¹]}` per datum for the configured `r` (Theorem 4, Fig. 8), for
+/// noisy SISO data; a datum is consistent iff its `μ_Γ > 1`.  `None` for MIMO data.
 pub fn mu_per_datum(
-    _f: &Factorization,
-    _data: &FrfData,
-    _radii: &[f64],
-    _r: &TransferFunction,
+    f: &Factorization,
+    data: &FrfData,
+    radii: &[f64],
+    r: &TransferFunction,
 ) -> Option<Result<Vec<f64>>> {
-    // INTEGRATION(mu): call the μ module here.
-    None
+    if data.outputs() != 1 || data.inputs() != 1 {
+        return None;
+    }
+    let settings = MuSettings::default();
+    let out = data
+        .omega
+        .iter()
+        .zip(&data.response)
+        .zip(radii)
+        .map(|((w, phi), la)| {
+            let at = f.at(*w);
+            let m =
+                gamma_lft(&at, phi[(0, 0)], r.freq(*w), *la).map_err(|e| Error::Assumption {
+                    omega: *w,
+                    msg: e.message().to_string(),
+                })?;
+            Ok(mu_full_scalar(&m, FullPlusScalar::gamma(at.m.nrows()), &settings)?.upper)
+        })
+        .collect();
+    Some(out)
 }
 
 /// A fitted unit `r` with its certificate, ready to be written as `r.json`.
