@@ -159,15 +159,10 @@ pub fn print_summary(
     );
     match (&rep.r_fitted, &rep.fit_error) {
         (Some(j), _) => outln!(
-            "  fitted r covering all datasets: num = {}, den = {} [order {}, certificate {}]",
+            "  fitted r covering all datasets: num = {}, den = {} [{}]",
             j.get("num").map_or("?".into(), |v| v.to_string()),
             j.get("den").map_or("?".into(), |v| v.to_string()),
-            j.get("order").map_or("?".into(), |v| v.to_string()),
-            match j.pointer("/certificate/passed").and_then(|p| p.as_bool()) {
-                Some(true) => "passed",
-                Some(false) => "FAILED",
-                None => "-",
-            }
+            super::run::fit_tag(j)
         ),
         (None, Some(e)) => outln!("  fit failed: {e}"),
         _ => {}

@@ -20,6 +20,22 @@ pub struct RunArgs {
     pub out: PathBuf,
 }
 
+/// `order N, certificate passed` for a fit, or its `method` (the placeholder).
+pub fn fit_tag(j: &serde_json::Value) -> String {
+    if let Some(m) = j.get("method").and_then(|m| m.as_str()) {
+        return m.to_string();
+    }
+    format!(
+        "order {}, certificate {}",
+        j.get("order").map_or("?".into(), |o| o.to_string()),
+        match j.pointer("/certificate/passed").and_then(|p| p.as_bool()) {
+            Some(true) => "passed",
+            Some(false) => "FAILED",
+            None => "-",
+        }
+    )
+}
+
 /// At most 8 frequencies, then how many in all.
 fn list(v: &[f64]) -> String {
     let head = v
@@ -98,15 +114,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
                 .map(|c| fmt_g(*c))
                 .collect::<Vec<_>>()
                 .join(", "),
-            format!(
-                "order {}, certificate {}",
-                j.get("order").map_or("?".into(), |o| o.to_string()),
-                match j.pointer("/certificate/passed").and_then(|p| p.as_bool()) {
-                    Some(true) => "passed",
-                    Some(false) => "FAILED",
-                    None => "-",
-                }
-            )
+            fit_tag(j)
         ),
         _ => outln!(
             "  fit       failed: {}",
