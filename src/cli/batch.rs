@@ -103,6 +103,12 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     let combined = combine(results.iter().filter_map(|r| r.envelope.as_ref()));
     timings.insert("combine".to_string(), t.elapsed().as_secs_f64() * 1e3);
     let rows: Vec<SummaryRow> = results.iter().map(SummaryRow::from).collect();
+    if let (true, Some(c)) = (std::io::stderr().is_terminal(), &combined) {
+        eprintln!(
+            "fitting one r above the combined envelope ({} frequencies)…",
+            c.len()
+        );
+    }
     let rep = batch::finish(
         &a.out,
         &rows,

@@ -156,7 +156,9 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             let s = C_GREY.stroke_width(1);
             mag.draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
                 .map_err(plot_err)?
-                .label("error bar: noise disk |Φ − G_p| ≤ L (eq. 5); down to the floor if it holds 0")
+                .label(
+                    "error bar: noise disk |Φ − G_p| ≤ L (eq. 5); down to the floor if it holds 0",
+                )
                 .legend(move |(x, y)| PathElement::new(vec![(x + 12, y - 7), (x + 12, y + 7)], s));
         }
         legend(&mut mag, SeriesLabelPosition::LowerLeft)?;
