@@ -144,12 +144,12 @@ pub fn print_summary(
         String::new()
     };
     outln!(
-        "rshape batch: {} of {} dataset(s) processed{shard}, {} ok, {} failed, in {} s",
+        "rshape batch: {} of {} dataset(s) processed{shard}, {} ok, {} failed, in {:.2} s",
         rep.n_datasets,
         rep.n_total,
         rep.n_ok,
         rep.n_failed,
-        fmt_g(secs)
+        secs
     );
     if rep.r_configured.is_some() {
         outln!(

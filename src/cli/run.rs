@@ -125,8 +125,8 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         outln!("  warning   {w}");
     }
     outln!(
-        "  time      {} ms",
-        fmt_g(rep.timings_ms.get("total").copied().unwrap_or(0.0))
+        "  time      {:.1} ms",
+        rep.timings_ms.get("total").copied().unwrap_or(0.0)
     );
     outln!("  wrote     {}", a.out.display());
     for f in &files {
