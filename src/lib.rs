@@ -16,6 +16,7 @@ pub mod cli;
 pub mod consistency;
 pub mod data;
 pub mod error;
+pub mod fit;
 pub mod model;
 pub mod report;
 pub mod system;
