@@ -12,7 +12,9 @@
 //! run goes on with the others.
 
 use super::basis::{reference_poles, GridPoint, PointKind};
-use super::problem::{area_fixed_poles, max_slack, SolverEvent, SolverStatus};
+use super::problem::{
+    area_fixed_poles, basis_rows, initial_points, max_slack, SolverEvent, SolverStatus,
+};
 use super::spectral::{stable_roots, RootKind, Zpk};
 use super::{FitSettings, Objective};
 use num_complex::Complex64;
@@ -125,6 +127,7 @@ pub(crate) fn fit_order(
     n: usize,
     prev: Option<&Scored>,
     set: &FitSettings,
+    masks: &mut (Vec<bool>, Vec<bool>),
 ) -> OrderFit {
     let q = reference_poles(n, prep.band.0, prep.band.1);
     let mut events = Vec::new();
@@ -137,57 +140,85 @@ pub(crate) fn fit_order(
         action: action.into(),
     };
 
-    // 1. Minimax bisection on t (in log), bracket from the previous order when known.
-    let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
-    let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
-    let mut lo = 0.0f64; // ln t_lo, t ≥ 1 always (upper = lower at the data)
-    let mut tries = 0;
-    while best.is_none() && tries < 12 {
-        tries += 1;
-        let (st, s, a, b, _) = max_slack(&q, &prep.grid, t_hi, set.max_solver_iter);
-        lp_solves += 1;
+    // 1. Minimax: bracket the level t (from the previous order when known), then a
+    //    safeguarded false-position (Illinois) search on the max-slack s(ln t).  The
+    //    max-slack solutions are centred: they keep away from the floor, so the poles and
+    //    zeros keep away from the axis (a Dinkelbach iteration, tried, converged to boundary
+    //    solutions with poles on the axis).
+    let phi = basis_rows(&q, &prep.grid);
+    let init = initial_points(&prep.grid, 40);
+    // Working sets (per row) carried from order to order: the row layout depends only on
+    // the grid, and the rows that bind at order N mostly bind at order N+1.
+    let (mut mask, mut area_mask) = std::mem::take(masks);
+    let solve = |t: f64,
+                 stage: &str,
+                 events: &mut Vec<SolverEvent>,
+                 lp: &mut usize,
+                 mask: &mut Vec<bool>| {
+        let (st, s, a, b, rounds) =
+            max_slack(&phi, &prep.grid, t, &init, mask, set.max_solver_iter);
+        *lp += rounds;
         if st != SolverStatus::Solved {
             events.push(event(
-                format!("minimax bracket t={t_hi:.4e}"),
+                format!("{stage} t={t:.4e}"),
                 st,
                 if st.has_solution() {
                     "used the reduced-accuracy solution; verified below"
                 } else {
-                    "treated the level as not feasible; raised t"
+                    "treated the level as not feasible"
                 },
             ));
         }
-        if st.has_solution() && s >= 0.0 {
+        let s = if st.has_solution() { s } else { f64::NEG_INFINITY };
+        (s, a, b)
+    };
+    let tol = 2.0 * (1.0 + set.bisection_tol).ln();
+    let (mut lo, mut s_lo) = (0.0f64, None::<f64>); // ln t ≥ 0: upper = lower at the data
+    let mut s_hi = 0.0;
+    let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
+    let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
+    for _ in 0..12 {
+        let (s, a, b) = solve(t_hi, "minimax bracket", &mut events, &mut lp_solves, &mut mask);
+        if s >= 0.0 {
             best = Some((t_hi, a, b));
-        } else {
-            lo = t_hi.ln();
-            t_hi *= 100.0;
+            s_hi = s;
+            break;
         }
+        lo = t_hi.ln();
+        s_lo = s.is_finite().then_some(s);
+        t_hi *= 100.0;
     }
     if let Some((t0, _, _)) = &best {
+        // Safeguarded false position (Illinois) on the max-slack s(ln t).
         let mut hi = t0.ln();
+        let mut side = 0i8;
         while hi - lo > tol {
-            let mid = 0.5 * (lo + hi);
+            let w = hi - lo;
+            let mid = match s_lo {
+                Some(sl) if s_hi > sl => {
+                    (hi - s_hi * w / (s_hi - sl)).clamp(lo + 0.02 * w, hi - 0.02 * w)
+                }
+                _ => 0.5 * (lo + hi),
+            };
+            // Aim a little above the estimate so that a good estimate closes the bracket.
+            let mid = (mid + 0.3 * tol).min(hi - 0.3 * tol).max(lo + 0.3 * tol);
             let t = mid.exp();
-            let (st, s, a, b, _) = max_slack(&q, &prep.grid, t, set.max_solver_iter);
-            lp_solves += 1;
-            if st != SolverStatus::Solved {
-                events.push(event(
-                    format!("minimax t={t:.4e}"),
-                    st,
-                    if st.has_solution() {
-                        "used the reduced-accuracy solution; verified below"
-                    } else {
-                        "treated the level as not feasible"
-                    },
-                ));
-            }
-            if st.has_solution() && s >= 0.0 {
+            let (s, a, b) = solve(t, "minimax", &mut events, &mut lp_solves, &mut mask);
+            if s >= 0.0 {
                 hi = mid;
+                s_hi = s;
                 best = Some((t, a, b));
+                if side == 1 {
+                    s_lo = s_lo.map(|v| 0.5 * v);
+                }
+                side = 1;
             } else {
                 lo = mid;
+                s_lo = s.is_finite().then_some(s);
+                if side == -1 {
+                    s_hi *= 0.5;
+                }
+                side = -1;
             }
         }
     } else {
@@ -268,23 +299,27 @@ pub(crate) fn fit_order(
         .collect();
     for (name, poles) in pole_sets {
         let kp = kappa(&prep.grid, &q, &poles);
-        let (st, a, _, _) = area_fixed_poles(
-            &q,
+        let (st, a, _, rounds) = area_fixed_poles(
+            &phi,
             &prep.grid,
             &kp,
             &weights,
             t_cap,
+            &init,
+            &mut area_mask,
             set.max_solver_iter,
         );
-        lp_solves += 1;
+        lp_solves += rounds;
         if st != SolverStatus::Solved {
             events.push(event(
                 format!("area with {name}"),
                 st,
-                if st.has_solution() {
-                    "used the reduced-accuracy solution; verified below"
-                } else {
-                    "candidate discarded, others tried"
+                match st {
+                    s if s.has_solution() => "used the reduced-accuracy solution; verified below",
+                    SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                        "these poles cannot meet the bounds at this level; candidate skipped, others tried"
+                    }
+                    _ => "candidate discarded, others tried",
                 },
             ));
         }
@@ -351,6 +386,7 @@ pub(crate) fn fit_order(
             c.zpk.zeros.push(Complex64::new(-1.0, 0.0));
         }
     }
+    *masks = (mask, area_mask);
     OrderFit {
         ranked: cands,
         events,

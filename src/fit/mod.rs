@@ -426,11 +426,12 @@ pub fn fit_unit(
     let ctx = prepare(env, a1, settings)?;
     let start = if settings.chain { 0 } else { settings.order };
     let mut prev: Option<Scored> = None;
+    let mut masks = (Vec::new(), Vec::new());
     let mut all_events = Vec::new();
     let mut solves = 0;
     let mut last = None;
     for n in start..=settings.order {
-        let of = fit_order(&ctx.prep, n, prev.as_ref(), settings);
+        let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         all_events.extend(of.events);
         solves += of.lp_solves;
         match ctx.certify_ranked(n, &of.ranked, all_events.clone(), solves, settings) {

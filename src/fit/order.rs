@@ -32,13 +32,14 @@ pub fn fit_auto(
 ) -> Result<(FitResult, Vec<OrderRow>), FitError> {
     let ctx = prepare(env, a1, settings)?;
     let mut prev: Option<Scored> = None;
+    let mut masks = (Vec::new(), Vec::new());
     let mut rows = Vec::new();
     let mut fits: Vec<Option<FitResult>> = Vec::new();
     let mut events = Vec::new();
     let mut solves = 0;
     let mut last_err = None;
     for n in 0..=n_max {
-        let of = fit_order(&ctx.prep, n, prev.as_ref(), settings);
+        let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         let ne = of.events.len();
         events.extend(of.events);
         solves += of.lp_solves;

@@ -94,7 +94,6 @@ pub(crate) struct Lp {
 pub(crate) struct LpOut {
     pub status: SolverStatus,
     pub x: Vec<f64>,
-    pub iterations: u32,
 }
 
 impl Lp {
@@ -140,12 +139,13 @@ impl Lp {
         let fail = LpOut {
             status: SolverStatus::SetupError,
             x: Vec::new(),
-            iterations: 0,
         };
         let Ok(settings) = DefaultSettingsBuilder::default()
             .verbose(false)
             .max_iter(max_iter)
             .presolve_enable(false)
+            .tol_gap_abs(1e-7)
+            .tol_gap_rel(1e-7)
             .build()
         else {
             return fail;
@@ -153,12 +153,15 @@ impl Lp {
         let Ok(mut solver) = DefaultSolver::new(&p, &self.c, &a, &b, &cones, settings) else {
             return fail;
         };
+        let t0 = std::time::Instant::now();
         solver.solve();
         let sol = &solver.solution;
+        if std::env::var("FIT_PROFILE").is_ok() {
+            eprintln!("LP m={} n={} iters={} status={:?} {:?}", m, self.n, sol.iterations, sol.status, t0.elapsed());
+        }
         LpOut {
             status: SolverStatus::from_clarabel(sol.status),
             x: sol.x.clone(),
-            iterations: sol.iterations,
         }
     }
 }
@@ -176,16 +179,126 @@ fn normalized(mut row: Vec<f64>, rhs: f64) -> (Vec<f64>, f64) {
 /// Floor on `B/D` (the scaled denominator over the reference polynomial, `b₀ = 1`).
 pub const B_FLOOR: f64 = 1e-12;
 
-/// The minimax step at level `t`: returns `(status, s*, a, b)`.  Variables `[a; b; s]`.
+/// Initial working set: every point at a stride chosen so that about `target` points are
+/// kept, plus the point at infinity.
+pub(crate) fn initial_points(grid: &[GridPoint], target: usize) -> Vec<bool> {
+    let stride = grid.len().div_ceil(target.max(1)).max(1);
+    grid.iter()
+        .enumerate()
+        .map(|(i, p)| i % stride == 0 || p.x.is_infinite())
+        .collect()
+}
+
+/// Cutting-plane solve of `min cᵀv` s.t. `rows·v ≥ rhs`, `eq`: the LP is solved on a
+/// working set of rows; rows violated by its solution are added (the local maxima of the
+/// violation along each group, and the worst ones) until none is violated, so the solution
+/// is optimal for the full LP.  With 1000 data the working set stays a few hundred rows.
+fn active_set_solve(
+    n: usize,
+    c: &[f64],
+    rows: &[(Vec<f64>, f64)],
+    group: &[u32],
+    point: &[usize],
+    eq: &[(Vec<f64>, f64)],
+    init: &[bool],
+    mask: &mut Vec<bool>,
+    max_iter: u32,
+) -> (LpOut, usize) {
+    if mask.len() != rows.len() {
+        // Rows of the initial points; the floor rows of B only at every fourth of them.
+        *mask = (0..rows.len())
+            .map(|i| {
+                point[i] == usize::MAX
+                    || (init[point[i]] && (group[i] < 6 || point[i] % 4 == 0))
+            })
+            .collect();
+    }
+    let mut rounds = 0;
+    let mut all = false;
+    let on = |mask: &[bool], i: usize| mask[i];
+    loop {
+        rounds += 1;
+        let ge: Vec<(Vec<f64>, f64)> = (0..rows.len())
+            .filter(|i| all || on(mask, *i))
+            .map(|i| rows[i].clone())
+            .collect();
+        let lp = Lp {
+            n,
+            c: c.to_vec(),
+            ge,
+            eq: eq.to_vec(),
+        };
+        let out = lp.solve(max_iter);
+        if !out.status.has_solution() || rounds > 40 {
+            // A working set can leave the objective unbounded or the LP ill-posed: retry
+            // once with every row before reporting the status.  An infeasible working set
+            // proves the full LP infeasible: no retry.
+            if all
+                || matches!(
+                    out.status,
+                    SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
+                )
+            {
+                return (out, rounds);
+            }
+            all = true;
+            continue;
+        }
+        if all {
+            return (out, rounds);
+        }
+        let scale = 1.0 + out.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let viol: Vec<f64> = rows
+            .iter()
+            .map(|(r, h)| h - r.iter().zip(&out.x).map(|(a, b)| a * b).sum::<f64>())
+            .collect();
+        let tol = 1e-9 * scale;
+        let mut add: Vec<usize> = Vec::new();
+        let mut worst: Vec<usize> = Vec::new();
+        for i in 0..rows.len() {
+            if on(mask, i) || viol[i] <= tol {
+                continue;
+            }
+            let same = |j: usize| group[j] == group[i];
+            let left = i == 0 || !same(i - 1) || viol[i - 1] <= viol[i];
+            let right = i + 1 == rows.len() || !same(i + 1) || viol[i + 1] < viol[i];
+            if left && right {
+                add.push(i);
+            } else {
+                worst.push(i);
+            }
+        }
+        worst.sort_by(|a, b| viol[*b].total_cmp(&viol[*a]));
+        add.extend(worst.into_iter().take(10));
+        if add.is_empty() {
+            return (out, rounds);
+        }
+        for i in add {
+            mask[i] = true;
+        }
+    }
+}
+
+/// Basis rows of every grid point (computed once per order).
+pub(crate) fn basis_rows(q: &[f64], grid: &[GridPoint]) -> Vec<Vec<f64>> {
+    grid.iter().map(|p| basis_row(q, p.x)).collect()
+}
+
+/// The minimax step at level `t`: returns `(status, s*, a, b, working-set rounds)`.
+/// Variables `[a; b; s]`.
 pub(crate) fn max_slack(
-    q: &[f64],
+    phi: &[Vec<f64>],
     grid: &[GridPoint],
     t: f64,
+    init: &[bool],
+    mask: &mut Vec<bool>,
     max_iter: u32,
-) -> (SolverStatus, f64, Vec<f64>, Vec<f64>, u32) {
-    let k = q.len() + 1;
+) -> (SolverStatus, f64, Vec<f64>, Vec<f64>, usize) {
+    let k = phi.first().map_or(1, |p| p.len());
     let n = 2 * k + 1;
-    let mut ge = Vec::with_capacity(4 * grid.len() + 1);
+    let mut rows = Vec::with_capacity(4 * grid.len() + 1);
+    let mut group = Vec::with_capacity(rows.capacity());
+    let mut point = Vec::with_capacity(rows.capacity());
     let row_ab = |phi: &[f64], ca: f64, cb: f64| -> Vec<f64> {
         let mut r = vec![0.0; n];
         for j in 0..k {
@@ -194,89 +307,100 @@ pub(crate) fn max_slack(
         }
         r
     };
-    for p in grid {
-        let phi = basis_row(q, p.x);
-        let mut push = |row: Vec<f64>, rhs: f64| {
-            let (mut r, h) = normalized(row, rhs);
-            r[n - 1] = -1.0;
-            ge.push((r, h));
-        };
-        // |r|² ≥ lower:  A − L·B ≥ 0.
-        push(row_ab(&phi, 1.0, -p.lower), 0.0);
-        if let Some(u) = p.upper {
-            push(row_ab(&phi, -1.0, t * u), 0.0);
+    // Group rows by kind (and data vs grid), each group in frequency order.
+    for kind in 0..4u32 {
+        for (i, p) in grid.iter().enumerate() {
+            let row = match kind {
+                0 => Some((row_ab(&phi[i], 1.0, -p.lower), 0.0)),
+                1 => p.upper.map(|u| (row_ab(&phi[i], -1.0, t * u), 0.0)),
+                2 => p.a1.map(|a1| (row_ab(&phi[i], -1.0, a1), 0.0)),
+                _ => Some((row_ab(&phi[i], 0.0, 1.0), B_FLOOR)),
+            };
+            if let Some((row, rhs)) = row {
+                let (mut r, h) = normalized(row, rhs);
+                r[n - 1] = -1.0;
+                rows.push((r, h));
+                group.push(2 * kind + u32::from(p.datum.is_some()));
+                point.push(i);
+            }
         }
-        if let Some(a1) = p.a1 {
-            push(row_ab(&phi, -1.0, a1), 0.0);
-        }
-        push(row_ab(&phi, 0.0, 1.0), B_FLOOR);
     }
     // s ≤ 1.
     let mut cap = vec![0.0; n];
     cap[n - 1] = -1.0;
-    ge.push((cap, -1.0));
+    rows.push((cap, -1.0));
+    group.push(99);
+    point.push(usize::MAX);
     let mut norm = vec![0.0; n];
     norm[k] = 1.0;
     let mut c = vec![0.0; n];
     c[n - 1] = -1.0;
-    let lp = Lp {
+    let (out, rounds) = active_set_solve(
         n,
-        c,
-        ge,
-        eq: vec![(norm, 1.0)],
-    };
-    let out = lp.solve(max_iter);
+        &c,
+        &rows,
+        &group,
+        &point,
+        &[(norm, 1.0)],
+        init,
+        mask,
+        max_iter,
+    );
     if !out.status.has_solution() {
-        return (out.status, f64::NEG_INFINITY, vec![], vec![], out.iterations);
+        return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
     }
     let a = out.x[..k].to_vec();
     let b = out.x[k..2 * k].to_vec();
-    (out.status, out.x[n - 1], a, b, out.iterations)
+    (out.status, out.x[n - 1], a, b, rounds)
 }
 
 /// The area step with fixed poles.  `kappa(x) = D(x)/B(x)` turns the basis value into
 /// `|r̂|²`; `weights[i]` is the objective weight of grid point `i` divided by its bound
 /// (zero for points outside the objective).  `t_cap` scales the upper envelope.
+/// Returns `(status, a, objective, working-set rounds)`.
 pub(crate) fn area_fixed_poles(
-    q: &[f64],
+    phi: &[Vec<f64>],
     grid: &[GridPoint],
     kappa: &[f64],
     weights: &[f64],
     t_cap: f64,
+    init: &[bool],
+    mask: &mut Vec<bool>,
     max_iter: u32,
-) -> (SolverStatus, Vec<f64>, f64, u32) {
-    let k = q.len() + 1;
+) -> (SolverStatus, Vec<f64>, f64, usize) {
+    let k = phi.first().map_or(1, |p| p.len());
     let mut c = vec![0.0; k];
-    let mut ge = Vec::with_capacity(3 * grid.len());
-    for ((p, kp), w) in grid.iter().zip(kappa).zip(weights) {
-        let phi = basis_row(q, p.x);
+    for ((ph, kp), w) in phi.iter().zip(kappa).zip(weights) {
         if *w != 0.0 {
             for j in 0..k {
-                c[j] += w * kp * phi[j];
+                c[j] += w * kp * ph[j];
             }
         }
-        // κ·φ·a ≥ L; κ·φ·a ≤ t·U; κ·φ·a ≤ α  (rows divided by κ, then normalized).
-        ge.push(normalized(phi.clone(), p.lower / kp));
-        if let Some(u) = p.upper {
-            ge.push(normalized(
-                phi.iter().map(|v| -v).collect(),
-                -t_cap * u / kp,
-            ));
-        }
-        if let Some(a1) = p.a1 {
-            ge.push(normalized(phi.iter().map(|v| -v).collect(), -a1 / kp));
+    }
+    let mut rows = Vec::with_capacity(3 * grid.len());
+    let mut group = Vec::with_capacity(rows.capacity());
+    let mut point = Vec::with_capacity(rows.capacity());
+    // κ·φ·a ≥ L; κ·φ·a ≤ t·U; κ·φ·a ≤ α  (rows divided by κ, then normalized).
+    for kind in 0..3u32 {
+        for (i, p) in grid.iter().enumerate() {
+            let neg = || phi[i].iter().map(|v| -v).collect::<Vec<f64>>();
+            let row = match kind {
+                0 => Some((phi[i].clone(), p.lower / kappa[i])),
+                1 => p.upper.map(|u| (neg(), -t_cap * u / kappa[i])),
+                _ => p.a1.map(|a1| (neg(), -a1 / kappa[i])),
+            };
+            if let Some((row, rhs)) = row {
+                rows.push(normalized(row, rhs));
+                group.push(2 * kind + u32::from(p.datum.is_some()));
+                point.push(i);
+            }
         }
     }
-    let lp = Lp {
-        n: k,
-        c,
-        ge,
-        eq: vec![],
-    };
-    let out = lp.solve(max_iter);
+    let (out, rounds) = active_set_solve(k, &c, &rows, &group, &point, &[], init, mask, max_iter);
     if !out.status.has_solution() {
-        return (out.status, vec![], f64::INFINITY, out.iterations);
+        return (out.status, vec![], f64::INFINITY, rounds);
     }
-    let obj: f64 = lp.c.iter().zip(&out.x).map(|(a, b)| a * b).sum();
-    (out.status, out.x, obj, out.iterations)
+    let obj: f64 = c.iter().zip(&out.x).map(|(a, b)| a * b).sum();
+    (out.status, out.x, obj, rounds)
 }
+

@@ -1,0 +1,54 @@
+//! `rshape fit` timing: a 1000-point envelope (smooth and jagged, 4 decades) at orders 2, 4
+//! and 6 with the default settings (chained orders 0..N, minimax objective, certificate).
+//! Target: ≤ 200 ms per fit at order ≤ 6.  Run: `cargo bench --bench fit`.
+
+use rshape::consistency::{Envelope, EnvelopeMethod};
+use rshape::fit::{fit_unit, FitSettings};
+use rshape::system::logspace;
+
+fn main() {
+    divan::main();
+}
+
+fn envelope(jagged: bool) -> Envelope {
+    let omega = logspace(0.1, 1000.0, 1000);
+    let mut seed = 7u64;
+    let r_min = omega
+        .iter()
+        .map(|w| {
+            let mut v = 0.05 * (1.0 + (w / 3.0).powi(2)).sqrt() / (1.0 + (w / 200.0).powi(2)).sqrt()
+                * (1.0 + 2.0 / (1.0 + (4.0 * (w / 30.0).ln()).powi(2)));
+            if jagged {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                v *= 0.5 + 0.5 * ((seed >> 11) as f64 / (1u64 << 53) as f64);
+            }
+            v
+        })
+        .collect();
+    Envelope {
+        omega,
+        r_min,
+        a1_limit: None,
+        method: EnvelopeMethod::File,
+    }
+}
+
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn smooth_1000(bencher: divan::Bencher, order: usize) {
+    let env = envelope(false);
+    let set = FitSettings {
+        order,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn jagged_1000(bencher: divan::Bencher, order: usize) {
+    let env = envelope(true);
+    let set = FitSettings {
+        order,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
