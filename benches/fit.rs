@@ -16,10 +16,13 @@ fn envelope(jagged: bool) -> Envelope {
     let r_min = omega
         .iter()
         .map(|w| {
-            let mut v = 0.05 * (1.0 + (w / 3.0).powi(2)).sqrt() / (1.0 + (w / 200.0).powi(2)).sqrt()
+            let mut v = 0.05 * (1.0 + (w / 3.0).powi(2)).sqrt()
+                / (1.0 + (w / 200.0).powi(2)).sqrt()
                 * (1.0 + 2.0 / (1.0 + (4.0 * (w / 30.0).ln()).powi(2)));
             if jagged {
-                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
                 v *= 0.5 + 0.5 * ((seed >> 11) as f64 / (1u64 << 53) as f64);
             }
             v
@@ -48,6 +51,30 @@ fn jagged_1000(bencher: divan::Bencher, order: usize) {
     let env = envelope(true);
     let set = FitSettings {
         order,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Order N alone (`chain = false`): no carried-over lower orders.
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn jagged_1000_unchained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(true);
+    let set = FitSettings {
+        order,
+        chain: false,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Order N alone (`chain = false`), smooth envelope.
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn smooth_1000_unchained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(false);
+    let set = FitSettings {
+        order,
+        chain: false,
         ..Default::default()
     };
     bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));

@@ -48,7 +48,9 @@ fn robot() -> (Factorization, Envelope) {
         .iter()
         .zip(&a1)
         .map(|(w, a)| {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
             let trend = 0.05 * (1.0 + (w / 8.0).powi(2)).sqrt();
             (trend * (0.4 + 0.6 * u)).min(0.6 * a)
@@ -88,11 +90,23 @@ fn paper_order1_beats_hand_made_r1() {
     let lh = log_ratios(&hand, &env);
     let hand_mean = lh.iter().sum::<f64>() / lh.len() as f64;
     println!("r_min = {:?}", env.r_min);
-    println!("fit r = {:?}/{:?}, zeros {:?} poles {:?}", fit.r.num, fit.r.den, fit.zeros, fit.poles);
-    println!("log ratios {lr:?}\nmean {mean:.5} (hand {hand_mean:.5}), {dt:?}, origin {}", fit.origin);
+    println!(
+        "fit r = {:?}/{:?}, zeros {:?} poles {:?}",
+        fit.r.num, fit.r.den, fit.zeros, fit.poles
+    );
+    println!(
+        "log ratios {lr:?}\nmean {mean:.5} (hand {hand_mean:.5}), {dt:?}, origin {}",
+        fit.origin
+    );
     println!("certificate {:#?}", fit.certificate);
-    assert!((hand_mean - 0.113).abs() < 0.002, "hand r1 scores {hand_mean}");
-    assert!(lr.iter().all(|l| *l >= 0.0), "a datum is not covered: {lr:?}");
+    assert!(
+        (hand_mean - 0.113).abs() < 0.002,
+        "hand r1 scores {hand_mean}"
+    );
+    assert!(
+        lr.iter().all(|l| *l >= 0.0),
+        "a datum is not covered: {lr:?}"
+    );
     assert!(mean <= 0.035, "mean log10 ratio {mean} > 0.035");
     assert!(fit.certificate.passed);
     // `rshape check` logic: every datum consistent, A1 holds.
@@ -119,11 +133,15 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
             ..Default::default()
         };
         let (fit, rows) = fit_auto(env, a1, &set, 6).unwrap();
-        println!("{name} {objective:?}:\n{}", rshape::fit::order::format_table(&rows, fit.order, set.auto_tolerance));
+        println!(
+            "{name} {objective:?}:\n{}",
+            rshape::fit::order::format_table(&rows, fit.order, set.auto_tolerance)
+        );
         for w in rows[1..].windows(2) {
             assert!(w[1].status == "ok" && w[0].status == "ok", "{:?}", w);
             assert!(
-                w[1].mean_log10 <= w[0].mean_log10 + 1e-9 && w[1].max_log10 <= w[0].max_log10 + 1e-9,
+                w[1].mean_log10 <= w[0].mean_log10 + 1e-9
+                    && w[1].max_log10 <= w[0].max_log10 + 1e-9,
                 "{name}: conservatism increased from order {} to {}: {:?}",
                 w[0].order,
                 w[1].order,
@@ -132,11 +150,14 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
         }
         assert!(fit.certificate.passed);
     }
-    // Independent fixed-order fits (chained internally) agree with the sweep's monotonicity.
+    // Independent fixed-order fits with `chain` (orders 0..N carried forward) are monotone
+    // too.  (Without `chain`, the default, a fixed-order fit is 2–5× faster but its mean can
+    // exceed a lower order's by a little: robot order 4 vs 3, 0.1713 vs 0.1697.)
     let mut prev = f64::INFINITY;
     for n in 1..=6 {
         let set = FitSettings {
             order: n,
+            chain: true,
             ..Default::default()
         };
         let fit = fit_unit(env, a1, &set).unwrap();
@@ -167,7 +188,10 @@ fn beyond_a1_is_reported_with_frequencies() {
     env.r_min[2] = a1[2] * 1.5;
     let e = fit_unit(&env, None, &FitSettings::default()).unwrap_err();
     let msg = e.to_string();
-    assert!(msg.contains("model must change") && msg.contains("1.000000e0"), "{msg}");
+    assert!(
+        msg.contains("model must change") && msg.contains("1.000000e0"),
+        "{msg}"
+    );
     env.r_min[2] = f64::INFINITY;
     let e = fit_unit(&env, None, &FitSettings::default()).unwrap_err();
     assert!(e.to_string().contains("r_min = inf"), "{e}");

@@ -29,7 +29,8 @@ fn random_envelope(rng: &mut ChaCha8Rng, k: usize) -> Envelope {
         .iter()
         .map(|w| {
             let u = (w / lo).log10() / decades - 0.5;
-            let mut v = scale * 10f64.powf(c1 * u * decades * 0.3 + c2 * (u * decades).powi(2) * 0.3);
+            let mut v =
+                scale * 10f64.powf(c1 * u * decades * 0.3 + c2 * (u * decades).powi(2) * 0.3);
             v *= 1.0 + bump * 3.0 / (1.0 + ((w / bw).ln() * 4.0).powi(2));
             if jagged {
                 v *= rng.gen_range(0.3..1.0);
@@ -48,7 +49,12 @@ fn random_envelope(rng: &mut ChaCha8Rng, k: usize) -> Envelope {
     }
 }
 
-fn check_unit(r: &TransferFunction, zeros: &[num_complex::Complex64], poles: &[num_complex::Complex64], tag: &str) {
+fn check_unit(
+    r: &TransferFunction,
+    zeros: &[num_complex::Complex64],
+    poles: &[num_complex::Complex64],
+    tag: &str,
+) {
     assert_eq!(r.num.degree(), r.den.degree(), "{tag}: not biproper");
     assert_eq!(zeros.len(), poles.len(), "{tag}");
     assert!(r.at_infinity() > 0.0, "{tag}: r(∞) = {}", r.at_infinity());
@@ -59,7 +65,10 @@ fn check_unit(r: &TransferFunction, zeros: &[num_complex::Complex64], poles: &[n
         let roots = p.roots();
         assert!(roots.converged, "{tag}");
         for z in roots.roots {
-            assert!(z.re < 0.0, "{tag}: recomputed {what} {z} not in the open LHP");
+            assert!(
+                z.re < 0.0,
+                "{tag}: recomputed {what} {z} not in the open LHP"
+            );
         }
     }
 }
@@ -73,14 +82,26 @@ fn random_envelopes_give_certified_units() {
         let order = 1 + k % 6;
         let set = FitSettings {
             order,
-            objective: if k % 3 == 0 { Objective::Area } else { Objective::Minimax },
+            objective: if k % 3 == 0 {
+                Objective::Area
+            } else {
+                Objective::Minimax
+            },
             ..Default::default()
         };
-        let tag = format!("envelope {k} ({} points, {:.1} decades, order {order})", env.omega.len(), (env.omega[env.omega.len() - 1] / env.omega[0]).log10());
+        let tag = format!(
+            "envelope {k} ({} points, {:.1} decades, order {order})",
+            env.omega.len(),
+            (env.omega[env.omega.len() - 1] / env.omega[0]).log10()
+        );
         let t0 = std::time::Instant::now();
         let fit = fit_unit(&env, None, &set).unwrap_or_else(|e| panic!("{tag}: {e}"));
         worst_time = worst_time.max(t0.elapsed().as_secs_f64());
-        assert!(fit.certificate.passed, "{tag}: {:?}", fit.certificate.failures);
+        assert!(
+            fit.certificate.passed,
+            "{tag}: {:?}",
+            fit.certificate.failures
+        );
         check_unit(&fit.r, &fit.zeros, &fit.poles, &tag);
         // Independent dense re-evaluation from the coefficients.
         let n = env.omega.len();
@@ -95,12 +116,18 @@ fn random_envelopes_give_certified_units() {
             for j in 1..8 {
                 let w = env.omega[i] * (env.omega[i + 1] / env.omega[i]).powf(j as f64 / 8.0);
                 let m = fit.r.freq(w).norm();
-                assert!(m >= bound * (1.0 - 1e-6), "{tag}: dips to {m} < {bound} at {w}");
+                assert!(
+                    m >= bound * (1.0 - 1e-6),
+                    "{tag}: dips to {m} < {bound} at {w}"
+                );
             }
         }
         // Strict positivity far outside the band and at infinity.
         for w in logspace(env.omega[0] * 1e-4, env.omega[n - 1] * 1e4, 400) {
-            assert!(fit.r.freq(w).norm() >= fit.floor * (1.0 - 1e-6), "{tag}: |r| below floor at {w}");
+            assert!(
+                fit.r.freq(w).norm() >= fit.floor * (1.0 - 1e-6),
+                "{tag}: |r| below floor at {w}"
+            );
         }
         if k == 10 && std::env::var("FIT_DEBUG").is_ok() {
             for e in &fit.solver_events {
@@ -108,7 +135,14 @@ fn random_envelopes_give_certified_units() {
             }
         }
         if k % 10 == 0 {
-            println!("{tag}: mean {:.4} max {:.4}, {:?}, {} LPs, {} events", fit.certificate.mean_log10_ratio, fit.certificate.max_log10_ratio, t0.elapsed(), fit.lp_solves, fit.solver_events.len());
+            println!(
+                "{tag}: mean {:.4} max {:.4}, {:?}, {} LPs, {} events",
+                fit.certificate.mean_log10_ratio,
+                fit.certificate.max_log10_ratio,
+                t0.elapsed(),
+                fit.lp_solves,
+                fit.solver_events.len()
+            );
         }
     }
     println!("slowest fit {worst_time:.3} s (test profile)");

@@ -7,6 +7,7 @@
 pub mod check;
 pub mod common;
 pub mod envelope;
+pub mod fit;
 
 use clap::{Parser, Subcommand};
 
@@ -27,6 +28,8 @@ pub enum Command {
     Envelope(envelope::EnvelopeArgs),
     /// Check the configured r (or --r-num/--r-den) against every datum.
     Check(check::CheckArgs),
+    /// Fit the smallest certified unit r(s) above the envelope (or an envelope file).
+    Fit(fit::FitArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -42,6 +45,7 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Envelope(a) => envelope::run(&a),
         Command::Check(a) => check::run(&a),
+        Command::Fit(a) => fit::run(&a),
     };
     match result {
         Ok(code) => code,

@@ -41,7 +41,10 @@ pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
         .map(|(k, l)| (k + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
     let (hline, header) = rows.next().ok_or_else(|| {
-        err(1, "empty file: expected the header `omega_rad_s,r_min[,a1_limit]`".into())
+        err(
+            1,
+            "empty file: expected the header `omega_rad_s,r_min[,a1_limit]`".into(),
+        )
     })?;
     let (mut cw, mut cr, mut ca) = (None, None, None);
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
@@ -53,7 +56,9 @@ pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
             other => {
                 return Err(err(
                     hline,
-                    format!("unknown column `{other}`: expected omega_rad_s, r_min and optionally a1_limit"),
+                    format!(
+                    "unknown column `{other}`: expected omega_rad_s, r_min and optionally a1_limit"
+                ),
                 ))
             }
         };
@@ -97,7 +102,10 @@ pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
                     .ok_or_else(|| {
                         err(
                             line,
-                            format!("a1_limit `{}` must be a finite number > 0 (or empty)", cells[c]),
+                            format!(
+                                "a1_limit `{}` must be a finite number > 0 (or empty)",
+                                cells[c]
+                            ),
                         )
                     })?,
             ),
@@ -113,7 +121,8 @@ pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
         let line = data.iter().find(|d| d.2.is_none()).map_or(hline, |d| d.3);
         return Err(err(
             line,
-            "a1_limit is empty on this row but given on others: give it everywhere or nowhere".into(),
+            "a1_limit is empty on this row but given on others: give it everywhere or nowhere"
+                .into(),
         ));
     }
     data.sort_by(|a, b| a.0.total_cmp(&b.0));

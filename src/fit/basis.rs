@@ -200,7 +200,11 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             }
             let (a, b) = (spec.lower[j], spec.lower[k]);
             let lower = if spec.no_dip { a.min(b) } else { 0.0 };
-            (lower.max(spec.floor), a.max(b).max(spec.floor), PointKind::Band)
+            (
+                lower.max(spec.floor),
+                a.max(b).max(spec.floor),
+                PointKind::Band,
+            )
         };
         pts.push(GridPoint {
             w,

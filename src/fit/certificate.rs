@@ -245,10 +245,7 @@ pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
         }
     }
     // Positivity and units.
-    let min_abs = grid
-        .iter()
-        .map(|w| r.mag(*w))
-        .fold(r.gain.abs(), f64::min);
+    let min_abs = grid.iter().map(|w| r.mag(*w)).fold(r.gain.abs(), f64::min);
     count += grid.len();
     if !(min_abs >= inp.floor * (1.0 - 1e-6)) {
         failures.push(format!(

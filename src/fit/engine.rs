@@ -169,7 +169,11 @@ pub(crate) fn fit_order(
                 },
             ));
         }
-        let s = if st.has_solution() { s } else { f64::NEG_INFINITY };
+        let s = if st.has_solution() {
+            s
+        } else {
+            f64::NEG_INFINITY
+        };
         (s, a, b)
     };
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
@@ -178,7 +182,13 @@ pub(crate) fn fit_order(
     let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
     let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
     for _ in 0..12 {
-        let (s, a, b) = solve(t_hi, "minimax bracket", &mut events, &mut lp_solves, &mut mask);
+        let (s, a, b) = solve(
+            t_hi,
+            "minimax bracket",
+            &mut events,
+            &mut lp_solves,
+            &mut mask,
+        );
         if s >= 0.0 {
             best = Some((t_hi, a, b));
             s_hi = s;

@@ -69,7 +69,10 @@ pub fn fit_auto(
         }
     }
     let ok = rows.iter().filter(|r| r.status == "ok");
-    let best_mean = ok.clone().map(|r| r.mean_log10).fold(f64::INFINITY, f64::min);
+    let best_mean = ok
+        .clone()
+        .map(|r| r.mean_log10)
+        .fold(f64::INFINITY, f64::min);
     let best_max = ok.map(|r| r.max_log10).fold(f64::INFINITY, f64::min);
     let tol = settings.auto_tolerance;
     let chosen = rows.iter().position(|r| {

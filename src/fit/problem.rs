@@ -157,7 +157,14 @@ impl Lp {
         solver.solve();
         let sol = &solver.solution;
         if std::env::var("FIT_PROFILE").is_ok() {
-            eprintln!("LP m={} n={} iters={} status={:?} {:?}", m, self.n, sol.iterations, sol.status, t0.elapsed());
+            eprintln!(
+                "LP m={} n={} iters={} status={:?} {:?}",
+                m,
+                self.n,
+                sol.iterations,
+                sol.status,
+                t0.elapsed()
+            );
         }
         LpOut {
             status: SolverStatus::from_clarabel(sol.status),
@@ -193,6 +200,7 @@ pub(crate) fn initial_points(grid: &[GridPoint], target: usize) -> Vec<bool> {
 /// working set of rows; rows violated by its solution are added (the local maxima of the
 /// violation along each group, and the worst ones) until none is violated, so the solution
 /// is optimal for the full LP.  With 1000 data the working set stays a few hundred rows.
+#[allow(clippy::too_many_arguments)]
 fn active_set_solve(
     n: usize,
     c: &[f64],
@@ -209,7 +217,7 @@ fn active_set_solve(
         *mask = (0..rows.len())
             .map(|i| {
                 point[i] == usize::MAX
-                    || (init[point[i]] && (group[i] < 6 || point[i] % 4 == 0))
+                    || (init[point[i]] && (group[i] < 6 || point[i].is_multiple_of(4)))
             })
             .collect();
     }
@@ -358,6 +366,7 @@ pub(crate) fn max_slack(
 /// `|r̂|²`; `weights[i]` is the objective weight of grid point `i` divided by its bound
 /// (zero for points outside the objective).  `t_cap` scales the upper envelope.
 /// Returns `(status, a, objective, working-set rounds)`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn area_fixed_poles(
     phi: &[Vec<f64>],
     grid: &[GridPoint],
@@ -403,4 +412,3 @@ pub(crate) fn area_fixed_poles(
     let obj: f64 = c.iter().zip(&out.x).map(|(a, b)| a * b).sum();
     (out.status, out.x, obj, rounds)
 }
-

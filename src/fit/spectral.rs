@@ -229,8 +229,15 @@ mod tests {
     #[test]
     fn complex_pair() {
         // (s² + 0.2 s + 1): |.|² = x² − 1.96 x + 1 (roots complex); q = [0.5, 2].
-        let roots = [Complex64::new(-0.1, 0.99498743710662), Complex64::new(-0.1, -0.99498743710662)];
-        let zp = Zpk { gain: 1.0, zeros: roots.to_vec(), poles: vec![] };
+        let roots = [
+            Complex64::new(-0.1, 0.99498743710662),
+            Complex64::new(-0.1, -0.99498743710662),
+        ];
+        let zp = Zpk {
+            gain: 1.0,
+            zeros: roots.to_vec(),
+            poles: vec![],
+        };
         // Fit c by sampling 3 points.
         let q = [0.5, 2.0];
         let xs = [0.3, 1.0, 5.0];
