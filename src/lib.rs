@@ -15,9 +15,11 @@
 pub mod cli;
 pub mod consistency;
 pub mod data;
+pub mod diagnose;
 pub mod error;
 pub mod fit;
 pub mod model;
+pub mod mu;
 pub mod report;
 pub mod system;
 pub mod util;

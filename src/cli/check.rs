@@ -1,6 +1,6 @@
 //! `rshape check CONFIG [--r-num a,b,.. --r-den c,d,..]`: exit 0 when consistent, 1 when not.
 
-use super::common::{fmt_g, InputArgs};
+use super::common::{fmt_g, fmt_omegas, InputArgs};
 use crate::consistency::check;
 use crate::system::TransferFunction;
 use anyhow::{anyhow, Result};
@@ -84,7 +84,7 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
                 }
             );
         }
-        let list = |v: &[f64]| v.iter().map(|w| fmt_g(*w)).collect::<Vec<_>>().join(", ");
+        let list = |v: &[f64]| fmt_omegas(&env.omega, v);
         if !rep.a1_violations.is_empty() {
             println!(
                 "A1 violated (|r| >= sigma_min(M~)) at {} datum(s): omega = {} rad/s; the perturbed plants need not all be stable there",

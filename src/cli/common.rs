@@ -1,7 +1,9 @@
 //! Arguments and loading shared by the subcommands that read a model and data.
 
-use crate::consistency::{noise_free_envelope, Envelope};
+use crate::consistency::noisy::BisectionSettings;
+use crate::consistency::{noise_free_envelope, noisy_envelope, Envelope};
 use crate::data::{read_frf_csv, FrfData};
+use crate::model::noise::noise_radii;
 use crate::model::Config;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -42,7 +44,19 @@ impl InputArgs {
                     self.config.display()
                 )
             })?;
-        let data = read_frf_csv(&path)?;
+        let mut data = read_frf_csv(&path)?;
+        let f = &config.factorization;
+        if let Some(ch) = config.raw.channel {
+            let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
+            if !fits
+                && ch.output >= 1
+                && ch.input >= 1
+                && ch.output <= data.outputs()
+                && ch.input <= data.inputs()
+            {
+                data = data.channel(ch.output - 1, ch.input - 1);
+            }
+        }
         if let Some(x) = self.noise_radius {
             if !(x.is_finite() && x >= 0.0) {
                 return Err(anyhow!("--noise-radius {x}: must be a finite number ≥ 0"));
@@ -52,11 +66,39 @@ impl InputArgs {
     }
 
     /// Loads inputs and computes the envelope that fits them: noise-free (Theorem 2 or 3),
-    /// or noisy SISO (Theorem 4) when a noise radius is known.
+    /// or noisy SISO (Theorem 4) when a nonzero noise radius is known (`--noise-radius`,
+    /// else the config's `[noise]`, else the data's `noise_radius` column).
     pub fn envelope(&self) -> Result<(Inputs, Envelope)> {
         let inputs = self.load()?;
-        let env = noise_free_envelope(&inputs.config.factorization, &inputs.data)?;
+        let env = envelope_for(&inputs, self.noise_radius)?;
         Ok((inputs, env))
+    }
+}
+
+/// The envelope of loaded inputs: Theorem 4 (μ bisection) when the resolved noise radii are
+/// not all zero, else Theorem 2 or 3.  Noisy MIMO data are an error: the paper's noisy test
+/// is SISO; select a channel (`[channel]`) or drop the noise (`--noise-radius 0`).
+pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope> {
+    let f = &inputs.config.factorization;
+    let data = &inputs.data;
+    match noise_radii(cli_noise, Some(&inputs.config), data)? {
+        Some(radii) if radii.iter().any(|r| *r > 0.0) => {
+            if data.outputs() != 1 || data.inputs() != 1 {
+                return Err(anyhow!(
+                    "{}: noisy consistency (Theorem 4) is for SISO data, these are {}×{}; select a channel with [channel] or pass --noise-radius 0",
+                    data.path.display(),
+                    data.outputs(),
+                    data.inputs()
+                ));
+            }
+            Ok(noisy_envelope(
+                f,
+                data,
+                &radii,
+                &BisectionSettings::default(),
+            )?)
+        }
+        _ => Ok(noise_free_envelope(f, data)?),
     }
 }
 
@@ -74,4 +116,41 @@ pub fn fmt_g(x: f64) -> String {
     } else {
         format!("{x:.4e}")
     }
+}
+
+/// A list of flagged frequencies for the terminal: every value when there are few, else the
+/// bands of consecutive data (`lo–hi`) with their counts.  `all` are the data frequencies
+/// (sorted), `flagged` a subset of them.
+pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
+    if flagged.len() <= 12 {
+        return flagged
+            .iter()
+            .map(|w| fmt_g(*w))
+            .collect::<Vec<_>>()
+            .join(", ");
+    }
+    let mut bands: Vec<(f64, f64, usize)> = Vec::new();
+    let mut prev_idx: Option<usize> = None;
+    for w in flagged {
+        let idx = all.iter().position(|x| x == w);
+        match (bands.last_mut(), prev_idx, idx) {
+            (Some(b), Some(p), Some(i)) if i == p + 1 => {
+                b.1 = *w;
+                b.2 += 1;
+            }
+            _ => bands.push((*w, *w, 1)),
+        }
+        prev_idx = idx;
+    }
+    bands
+        .iter()
+        .map(|(lo, hi, n)| {
+            if n == &1 {
+                fmt_g(*lo)
+            } else {
+                format!("{}–{} ({n} data)", fmt_g(*lo), fmt_g(*hi))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }

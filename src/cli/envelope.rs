@@ -1,6 +1,6 @@
 //! `rshape envelope CONFIG [--data FILE] --out DIR`: writes `DIR/envelope.csv`.
 
-use super::common::{fmt_g, InputArgs};
+use super::common::{fmt_g, fmt_omegas, InputArgs};
 use crate::report::envelope_csv;
 use anyhow::Result;
 use clap::Args;
@@ -32,7 +32,7 @@ pub fn run(a: &EnvelopeArgs) -> Result<i32> {
         println!(
             "warning: r_min reaches the A1 limit at {} datum(s) (omega = {} rad/s): no admissible r explains them; the nominal model must change",
             beyond.len(),
-            beyond.iter().map(|w| fmt_g(*w)).collect::<Vec<_>>().join(", ")
+            fmt_omegas(&env.omega, &beyond)
         );
     }
     println!("wrote {}", path.display());

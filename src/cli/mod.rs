@@ -6,8 +6,11 @@
 
 pub mod check;
 pub mod common;
+pub mod compare;
+pub mod diagnose;
 pub mod envelope;
 pub mod fit;
+pub mod history;
 
 use clap::{Parser, Subcommand};
 
@@ -28,6 +31,12 @@ pub enum Command {
     Envelope(envelope::EnvelopeArgs),
     /// Check the configured r (or --r-num/--r-den) against every datum.
     Check(check::CheckArgs),
+    /// Compare the model with the data: misfit per frequency, failing bands, error measures.
+    Compare(compare::CompareArgs),
+    /// Rank candidate missing effects (delay, lag, mode, …) by how much each lowers the error.
+    Diagnose(diagnose::DiagnoseArgs),
+    /// Error measures across model revisions (table and error-vs-revision SVG).
+    History(history::HistoryArgs),
     /// Fit the smallest certified unit r(s) above the envelope (or an envelope file).
     Fit(fit::FitArgs),
 }
@@ -45,6 +54,9 @@ pub fn main() -> i32 {
     let result = match cli.command {
         Command::Envelope(a) => envelope::run(&a),
         Command::Check(a) => check::run(&a),
+        Command::Compare(a) => compare::run(&a),
+        Command::Diagnose(a) => diagnose::run(&a),
+        Command::History(a) => history::run(&a),
         Command::Fit(a) => fit::run(&a),
     };
     match result {

@@ -93,7 +93,7 @@ pub fn noise_free_envelope(f: &Factorization, data: &FrfData) -> Result<Envelope
             msg: format!("{} ({})", e.message(), data.path.display()),
         })?;
         r_min.push(r);
-        a1.push(crate::model::factorization::sigma_min(&at.m));
+        a1.push(at.a1_limit());
     }
     Ok(Envelope {
         omega: data.omega.clone(),

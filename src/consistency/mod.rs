@@ -2,6 +2,10 @@
 pub mod check;
 pub mod envelope;
 pub mod noise_free;
+pub mod noisy;
 
 pub use check::{check, CheckReport, CheckRow};
 pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};
+pub use noisy::{
+    noisy_envelope, noisy_envelope_report, BisectionSettings, NoisyDatum, NoisyReport,
+};

@@ -9,6 +9,7 @@
 //!   form (Schmidt–Mirsky, Theorem 7).
 
 use crate::model::FactorsAt;
+use crate::system::linalg::{extreme_singular_values, is_singular, spectral_norm};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -40,13 +41,8 @@ impl AssumptionFailure {
     }
 }
 
-/// Relative threshold under which a smallest singular value counts as zero.
-const SINGULAR_RTOL: f64 = 1e-13;
-
 fn singular(a: &DMatrix<Complex64>) -> bool {
-    let sv = a.clone().svd(false, false).singular_values;
-    let max = sv.max();
-    !(sv.min() > SINGULAR_RTOL * max) || !max.is_finite()
+    is_singular(extreme_singular_values(a))
 }
 
 /// Theorem 2, eq. (8): the minimum-norm `Δ_i` solving `Δ_i W_i = U_i`, returned with its norm.
@@ -57,7 +53,7 @@ pub fn min_norm_perturbation(
     f: &FactorsAt,
     phi: &DMatrix<Complex64>,
 ) -> Result<(DMatrix<Complex64>, f64), AssumptionFailure> {
-    if singular(&f.m) {
+    if f.m_singular() {
         return Err(AssumptionFailure::MSingular);
     }
     let m_in = phi.ncols();
@@ -89,8 +85,30 @@ pub fn min_norm_perturbation(
 }
 
 /// Theorem 2: the smallest `|r(jω)|` consistent with the datum, `‖Δ_i‖` of eq. (8).
+///
+/// `‖Δ_i‖² = λ_max(U (W^*W)^{-1} U^*)`, so only `Z = U L^{-*}` (with `W^*W = LL^*`) is
+/// needed: `‖Δ_i‖ = σ_max(Z)`; `Δ_i` itself is not formed.
 pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, AssumptionFailure> {
-    min_norm_perturbation(f, phi).map(|(_, n)| n)
+    if f.m_singular() {
+        return Err(AssumptionFailure::MSingular);
+    }
+    let (zh, _) = cholesky_z(f, phi);
+    Ok(spectral_norm(&zh))
+}
+
+/// `Zᴴ = L^{-1} Uᴴ` with `U = Ñ − M̃Φ` and `I + Φ^*Φ = LL^*`; also returns `L`.
+fn cholesky_z(f: &FactorsAt, phi: &DMatrix<Complex64>) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
+    let m_in = phi.ncols();
+    let u = &f.n - &f.m * phi;
+    let gram = DMatrix::<Complex64>::identity(m_in, m_in) + phi.adjoint() * phi;
+    let l = gram
+        .cholesky()
+        .expect("I + Φ*Φ is Hermitian positive definite")
+        .unpack();
+    let zh = l
+        .solve_lower_triangular(&u.adjoint())
+        .expect("L has a positive diagonal");
+    (zh, l)
 }
 
 /// The matrix `X` of Theorem 3, `F_L(P, Φ̂⁻¹) = r·X`, computed with LU solves.
@@ -102,7 +120,7 @@ pub fn theorem3_x(
     if phi.ncols() != p || f.j.len() != p {
         return Err(AssumptionFailure::NotSquare);
     }
-    if singular(&f.m) {
+    if f.m_singular() {
         return Err(AssumptionFailure::MSingular);
     }
     if singular(phi) {

@@ -153,19 +153,8 @@ impl Lp {
         let Ok(mut solver) = DefaultSolver::new(&p, &self.c, &a, &b, &cones, settings) else {
             return fail;
         };
-        let t0 = std::time::Instant::now();
         solver.solve();
         let sol = &solver.solution;
-        if std::env::var("FIT_PROFILE").is_ok() {
-            eprintln!(
-                "LP m={} n={} iters={} status={:?} {:?}",
-                m,
-                self.n,
-                sol.iterations,
-                sol.status,
-                t0.elapsed()
-            );
-        }
         LpOut {
             status: SolverStatus::from_clarabel(sol.status),
             x: sol.x.clone(),

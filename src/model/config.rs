@@ -100,13 +100,50 @@ pub struct RSection {
     pub den: Vec<f64>,
 }
 
-/// The `[noise]` table.
+/// The `[noise]` table (see [`crate::model::noise`] for how the keys are resolved).
+///
+/// ```toml
+/// [noise]
+/// radius = 0.06            # global disk radius L_a of eq. (5), in data units
+/// # or, the time-domain L∞ model of Sec. III (not together with `radius`):
+/// # output_bound = 0.05    # M: bound on the output noise, in output units
+/// # input_amplitude = 1.0  # amplitude of the input sinusoid (default 1)
+/// # or, per-frequency standard deviations (radius = std_factor·std):
+/// # std_file = "data_std.csv"
+/// # std_factor = 3.0
+/// ```
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NoiseSection {
     /// Global noise-disk radius `L_a` (eq. (5)), in the units of the data.
     #[serde(default)]
     pub radius: Option<f64>,
+    /// Bound `M` on the time-domain output noise, `‖n‖_∞ < M` (eq. (4)), in output units;
+    /// the disk radius of each datum follows from Sec. III
+    /// ([`crate::model::noise::linf_disk_radius`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub output_bound: Option<f64>,
+    /// Amplitude of the input sinusoid of the experiment (default 1), used with
+    /// `output_bound`: the measured output amplitude is `A_m = input_amplitude·|φ|`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input_amplitude: Option<f64>,
+    /// A file of FRF standard deviations (`freq_hz` or `omega_rad_s`, then `std_i_j`
+    /// columns), relative to the config; the noise radius is `std_factor·std`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_file: Option<PathBuf>,
+    /// Factor from standard deviation to noise radius (default 3, i.e. 3σ).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_factor: Option<f64>,
+}
+
+/// The `[channel]` table: the SISO channel of MIMO data to compare with (1-based).
+#[derive(Debug, Clone, Copy, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelSection {
+    /// Output (row), 1-based.
+    pub output: usize,
+    /// Input (column), 1-based.
+    pub input: usize,
 }
 
 /// The whole file as written.
@@ -119,8 +156,15 @@ pub struct RawConfig {
     /// Data file, relative to the config file.
     #[serde(default)]
     pub data: Option<PathBuf>,
-    /// The nominal factorization.
-    pub model: ModelSection,
+    /// The nominal factorization (or give `[physical]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelSection>,
+    /// The model described by its physics (alternative to `[model]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub physical: Option<super::physical::PhysicalModel>,
+    /// The SISO channel of the data to use.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channel: Option<ChannelSection>,
     /// The bound `r(s)`.
     #[serde(default)]
     pub r: Option<RSection>,
@@ -142,6 +186,10 @@ pub struct Config {
     pub r: Option<TransferFunction>,
     /// The data file, resolved relative to the config.
     pub data: Option<PathBuf>,
+    /// The physical description, when the model was given as `[physical]`.
+    pub physical: Option<super::physical::PhysicalModel>,
+    /// The noise std file (resolved) and its factor.
+    pub noise_std: Option<(PathBuf, f64)>,
 }
 
 fn tf_rows(
@@ -197,7 +245,28 @@ impl Config {
                 None => err(msg),
             }
         })?;
-        let factorization = Self::build_factorization(&raw.model).map_err(err)?;
+        let (factorization, physical) = match (&raw.model, &raw.physical) {
+            (Some(m), None) => (Self::build_factorization(m).map_err(err)?, None),
+            (None, Some(ph)) => {
+                ph.validate().map_err(err)?;
+                (ph.to_factorization().map_err(err)?, Some(ph.clone()))
+            }
+            (Some(_), Some(_)) => {
+                return Err(err(
+                    "give the model either as [model] (factors) or as [physical], not both".into(),
+                ))
+            }
+            (None, None) => {
+                return Err(err(
+                    "no model: add a [model] table (factors) or a [physical] table".into(),
+                ))
+            }
+        };
+        if let Some(ch) = &raw.channel {
+            if ch.output == 0 || ch.input == 0 {
+                return Err(err("[channel] output and input are 1-based".into()));
+            }
+        }
         let r = match &raw.r {
             Some(r) => {
                 let tf = TfEntry::Rational(RationalEntry {
@@ -210,21 +279,33 @@ impl Config {
             }
             None => None,
         };
-        if let Some(la) = raw.noise.radius {
-            if !(la.is_finite() && la >= 0.0) {
-                return Err(err(format!(
-                    "[noise] radius = {la}: must be a finite number ≥ 0"
-                )));
-            }
-        }
+        raw.noise.validate().map_err(err)?;
         let base = path.parent().unwrap_or(Path::new("."));
         let data = raw.data.as_ref().map(|d| base.join(d));
+        let noise_std = match (&raw.noise.std_file, raw.noise.std_factor) {
+            (Some(f), k) => {
+                let k = k.unwrap_or(3.0);
+                if !(k.is_finite() && k > 0.0) {
+                    return Err(err(format!("[noise] std_factor = {k}: must be positive")));
+                }
+                if raw.noise.radius.is_some() {
+                    return Err(err("[noise]: give radius or std_file, not both".into()));
+                }
+                Some((base.join(f), k))
+            }
+            (None, Some(_)) => {
+                return Err(err("[noise] std_factor needs std_file".into()));
+            }
+            (None, None) => None,
+        };
         Ok(Self {
             path: path.to_path_buf(),
             raw,
             factorization,
             r,
             data,
+            physical,
+            noise_std,
         })
     }
 
@@ -274,5 +355,42 @@ impl Config {
                 Factorization::special(c, mm, nn, j).map_err(|e| format!("[model]: {e}"))
             }
         }
+    }
+}
+
+impl NoiseSection {
+    /// Checks the values and that `radius` and `output_bound` are not both given.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        if let Some(la) = self.radius {
+            if !(la.is_finite() && la >= 0.0) {
+                return Err(format!(
+                    "[noise] radius = {la}: must be a finite number ≥ 0"
+                ));
+            }
+        }
+        if let Some(m) = self.output_bound {
+            if !(m.is_finite() && m >= 0.0) {
+                return Err(format!(
+                    "[noise] output_bound = {m}: must be a finite number ≥ 0"
+                ));
+            }
+        }
+        if let Some(u) = self.input_amplitude {
+            if !(u.is_finite() && u > 0.0) {
+                return Err(format!(
+                    "[noise] input_amplitude = {u}: must be a finite number > 0"
+                ));
+            }
+            if self.output_bound.is_none() {
+                return Err("[noise] input_amplitude is only used with output_bound; add output_bound or remove it".into());
+            }
+        }
+        if self.radius.is_some() && self.output_bound.is_some() {
+            return Err("[noise]: give either radius (L_a) or output_bound (M), not both".into());
+        }
+        if self.std_file.is_some() && self.output_bound.is_some() {
+            return Err("[noise]: give either std_file or output_bound (M), not both".into());
+        }
+        Ok(())
     }
 }

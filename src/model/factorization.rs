@@ -47,6 +47,8 @@ pub struct FactorsAt {
     pub n: DMatrix<Complex64>,
     /// Diagonal of `J(jω)`.
     pub j: Vec<Complex64>,
+    /// `(σ_max, σ_min)` of `M̃(jω)`: the singularity test and the A1 limit.
+    pub m_sigma: (f64, f64),
 }
 
 impl Factorization {
@@ -169,12 +171,12 @@ impl Factorization {
 
     /// The factors at `s = jω`.
     pub fn at(&self, omega: f64) -> FactorsAt {
-        FactorsAt {
-            c: self.c.map(|x| Complex64::new(x, 0.0)),
-            m: self.m.freq(omega),
-            n: self.n.freq(omega),
-            j: self.j.iter().map(|t| t.freq(omega)).collect(),
-        }
+        FactorsAt::new(
+            self.c.map(|x| Complex64::new(x, 0.0)),
+            self.m.freq(omega),
+            self.n.freq(omega),
+            self.j.iter().map(|t| t.freq(omega)).collect(),
+        )
     }
 
     /// The nominal plant `G(jω) = C·M̃⁻¹·Ñ·J`, by an LU solve with `M̃`.
@@ -190,6 +192,34 @@ impl Factorization {
 }
 
 impl FactorsAt {
+    /// Bundles the factor values at one frequency and computes the extreme singular
+    /// values of `M̃`.
+    pub fn new(
+        c: DMatrix<Complex64>,
+        m: DMatrix<Complex64>,
+        n: DMatrix<Complex64>,
+        j: Vec<Complex64>,
+    ) -> Self {
+        let m_sigma = crate::system::linalg::extreme_singular_values(&m);
+        Self {
+            c,
+            m,
+            n,
+            j,
+            m_sigma,
+        }
+    }
+
+    /// `σ_min(M̃(jω))`, the A1 limit on `|r(jω)|`.
+    pub fn a1_limit(&self) -> f64 {
+        self.m_sigma.1
+    }
+
+    /// True when `M̃(jω)` is singular to working precision.
+    pub fn m_singular(&self) -> bool {
+        crate::system::linalg::is_singular(self.m_sigma)
+    }
+
     /// `C·M̃⁻¹·Ñ·J` at this frequency, `None` where `M̃` is singular.
     pub fn plant(&self) -> Option<DMatrix<Complex64>> {
         let x = self.m.clone().lu().solve(&self.n)?;
@@ -204,5 +234,5 @@ impl FactorsAt {
 
 /// Smallest singular value of a complex matrix.
 pub fn sigma_min(a: &DMatrix<Complex64>) -> f64 {
-    a.clone().svd(false, false).singular_values.min()
+    crate::system::linalg::extreme_singular_values(a).1
 }

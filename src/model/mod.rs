@@ -1,6 +1,8 @@
 //! Nominal models: coprime factorizations, the uncertainty bound `r`, and the TOML config.
 pub mod config;
 pub mod factorization;
+pub mod noise;
+pub mod physical;
 
 pub use config::Config;
 pub use factorization::{Factorization, FactorizationKind, FactorsAt};

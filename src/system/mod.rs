@@ -1,5 +1,6 @@
 //! Linear time-invariant systems: polynomials, transfer functions, transfer-function
 //! matrices and state-space models, all evaluated on the imaginary axis.
+pub mod linalg;
 pub mod polynomial;
 pub mod state_space;
 pub mod tf_matrix;

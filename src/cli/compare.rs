@@ -1,0 +1,130 @@
+//! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
+
+use super::common::{fmt_g, InputArgs};
+use crate::diagnose::compare::{compare, prepare, Band, CompareReport, PlantModel};
+use crate::diagnose::figures::bode_overlay;
+use anyhow::{anyhow, Result};
+use clap::Args;
+use std::path::PathBuf;
+
+/// Arguments of `rshape compare`.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// Model and data.
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// SISO channel of MIMO data, `OUT,IN` (1-based); overrides the config's [channel].
+    #[arg(long, value_delimiter = ',')]
+    pub channel: Option<Vec<usize>>,
+    /// Write the Bode overlay (data and model) to this SVG file.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses `--channel`.
+pub fn channel_arg(c: &Option<Vec<usize>>) -> Result<Option<(usize, usize)>> {
+    match c.as_deref() {
+        None => Ok(None),
+        Some([o, i]) if *o >= 1 && *i >= 1 => Ok(Some((*o, *i))),
+        Some(_) => Err(anyhow!("--channel OUT,IN: two 1-based indices")),
+    }
+}
+
+/// Loads, prepares and compares; used by `compare` and `history`.
+pub fn run_compare(
+    input: &InputArgs,
+    channel: Option<(usize, usize)>,
+) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
+    let inputs = input.load()?;
+    let siso = prepare(&inputs.config, &inputs.data, channel, input.noise_radius)?;
+    let model = PlantModel::from_config(&inputs.config);
+    let rep = compare(&inputs.config, &model, &siso)?;
+    Ok((rep, siso, model))
+}
+
+/// Formats bands for the text report.
+pub fn fmt_bands(b: &[Band]) -> String {
+    if b.is_empty() {
+        return "none".into();
+    }
+    b.iter()
+        .map(|b| {
+            format!(
+                "{}–{} rad/s ({}–{} Hz, {} data, peak misfit {} at {} Hz)",
+                fmt_g(b.omega_lo),
+                fmt_g(b.omega_hi),
+                fmt_g(b.omega_lo / std::f64::consts::TAU),
+                fmt_g(b.omega_hi / std::f64::consts::TAU),
+                b.count,
+                fmt_g(b.peak_misfit),
+                fmt_g(b.omega_peak / std::f64::consts::TAU)
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// Runs `rshape compare`.
+pub fn run(a: &CompareArgs) -> Result<i32> {
+    let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?)?;
+    if let Some(path) = &a.svg {
+        let gm = siso.model_response(&model)?;
+        let invalid: Vec<bool> = rep.rows.iter().map(|r| r.invalid).collect();
+        bode_overlay(
+            path,
+            &format!("{} vs {}", rep.config, rep.data),
+            &siso.omega,
+            &siso.g,
+            &invalid,
+            &[("model".to_string(), gm)],
+        )?;
+        rep.figure = Some(path.display().to_string());
+    }
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&rep)?);
+        return Ok(0);
+    }
+    println!("model:  {}", rep.config);
+    println!(
+        "data:   {} (channel {},{}; {} data)",
+        rep.data,
+        rep.channel[0],
+        rep.channel[1],
+        rep.rows.len()
+    );
+    println!("noise:  {}", rep.noise_source);
+    println!(
+        "misfit_rms = {}   misfit_max = {}   invalid_fraction = {}   r_env_max = {}",
+        fmt_g(rep.misfit_rms),
+        fmt_g(rep.misfit_max),
+        rep.invalid_fraction
+            .map_or("-".into(), |f| format!("{:.1} %", 100.0 * f)),
+        rep.r_env_max.map_or("-".into(), fmt_g)
+    );
+    println!("r_env:  {}", rep.r_env_method);
+    println!("fails (noise only):      {}", fmt_bands(&rep.bands));
+    match &rep.bands_with_r {
+        Some(b) => println!(
+            "fails (with the config's r): {} (invalid_fraction {:.1} %)",
+            fmt_bands(b),
+            100.0 * rep.invalid_fraction_with_r.unwrap_or(0.0)
+        ),
+        None => println!("fails (with the config's r): - (no [r] in the config, or no envelope)"),
+    }
+    println!(
+        "verdict: {}{}",
+        rep.verdict,
+        match rep.verdict.as_str() {
+            "consistent" => " (invalid_fraction ≤ 5 % and misfit_rms ≤ 1: the data are explained within the noise)",
+            "inconsistent" => " (run `rshape diagnose` to find the missing effect)",
+            _ => " (no noise radius: give --noise-radius, a noise_radius column or [noise])",
+        }
+    );
+    if let Some(f) = &rep.figure {
+        println!("figure: {f}");
+    }
+    Ok(0)
+}

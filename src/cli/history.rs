@@ -1,0 +1,111 @@
+//! `rshape history CONFIG... [--data FILE] [--noise-radius X] [--svg FILE] [--json]`: the
+//! error measures across model revisions, as a table and an error-vs-revision SVG.
+
+use super::common::{fmt_g, InputArgs};
+use super::compare::{channel_arg, run_compare};
+use crate::diagnose::figures::error_history;
+use anyhow::Result;
+use clap::Args;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Arguments of `rshape history`.
+#[derive(Debug, Args)]
+pub struct HistoryArgs {
+    /// The revisions, oldest first.
+    #[arg(required = true)]
+    pub configs: Vec<PathBuf>,
+    /// Data file overriding each config's (e.g. a validation experiment).
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Global noise radius overriding the configs'.
+    #[arg(long)]
+    pub noise_radius: Option<f64>,
+    /// SISO channel `OUT,IN`.
+    #[arg(long, value_delimiter = ',')]
+    pub channel: Option<Vec<usize>>,
+    /// Write the error-vs-revision figure here.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One revision.
+#[derive(Debug, Serialize)]
+pub struct Revision {
+    /// Config file.
+    pub config: String,
+    /// Data file.
+    pub data: String,
+    /// `misfit_rms`.
+    pub misfit_rms: f64,
+    /// `invalid_fraction`.
+    pub invalid_fraction: Option<f64>,
+    /// `r_env_max`.
+    pub r_env_max: Option<f64>,
+    /// Verdict.
+    pub verdict: String,
+}
+
+/// Runs `rshape history`.
+pub fn run(a: &HistoryArgs) -> Result<i32> {
+    let ch = channel_arg(&a.channel)?;
+    let mut revs = Vec::new();
+    for c in &a.configs {
+        let input = InputArgs {
+            config: c.clone(),
+            data: a.data.clone(),
+            noise_radius: a.noise_radius,
+        };
+        let (rep, _, _) = run_compare(&input, ch)?;
+        revs.push(Revision {
+            config: c.display().to_string(),
+            data: rep.data,
+            misfit_rms: rep.misfit_rms,
+            invalid_fraction: rep.invalid_fraction,
+            r_env_max: rep.r_env_max,
+            verdict: rep.verdict,
+        });
+    }
+    if let Some(path) = &a.svg {
+        let labels: Vec<String> = (0..revs.len()).map(|k| format!("rev {k}")).collect();
+        error_history(
+            path,
+            &labels,
+            &revs.iter().map(|r| r.misfit_rms).collect::<Vec<_>>(),
+            &revs
+                .iter()
+                .map(|r| r.invalid_fraction.unwrap_or(f64::NAN))
+                .collect::<Vec<_>>(),
+        )?;
+    }
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({ "revisions": revs }))?
+        );
+        return Ok(0);
+    }
+    println!(
+        "{:>4}  {:>12} {:>16} {:>12}  {:<13} config",
+        "rev", "misfit_rms", "invalid_fraction", "r_env_max", "verdict"
+    );
+    for (k, r) in revs.iter().enumerate() {
+        println!(
+            "{:>4}  {:>12} {:>16} {:>12}  {:<13} {}",
+            k,
+            fmt_g(r.misfit_rms),
+            r.invalid_fraction
+                .map_or("-".into(), |f| format!("{:.1} %", 100.0 * f)),
+            r.r_env_max.map_or("-".into(), fmt_g),
+            r.verdict,
+            r.config
+        );
+    }
+    if let Some(p) = &a.svg {
+        println!("figure: {}", p.display());
+    }
+    Ok(0)
+}

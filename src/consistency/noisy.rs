@@ -1,0 +1,394 @@
+//! Noisy SISO consistency (Boulet & Francis 1998, Sec. IV-B): the interconnection `V(jω)` of
+//! eqs. (13)–(14), the lower LFT `F_L(V, φ⁻¹)` of eq. (15), and the envelope of the smallest
+//! `|r(jω_i)|` with `μ_Γ{F_L[V(jω_i), φ_i⁻¹]} > 1` (Theorem 4), found by a bracketed search on
+//! `|r|` that Proposition 1 (monotonicity in `|r|`) makes valid.
+//!
+//! Both factorizations are covered: the scalar one (`n = 1`, `C = 1`) and the special one
+//! (`n` modes, `C` of size `1×n`).  The input factor `J` (a scalar here) is kept where the
+//! model has it, `g = C·M̃⁻¹·Ñ·J`: it multiplies the input of `Ñ + rΔ̃_N`, so it appears in
+//! `V₁₂` and `V₂₂` (for `J = 1` this is exactly eq. (14)).  This equals dividing the datum by
+//! `J` and the noise radius by `|J|`, as Theorem 3 does with `Φ̂ = ΦJ⁻¹`.
+
+use super::envelope::{check_sizes, Envelope, EnvelopeMethod};
+use crate::data::FrfData;
+use crate::error::{Error, Result};
+use crate::model::{Factorization, FactorsAt};
+use crate::mu::{mu_full_scalar_from, FullPlusScalar, MuSettings, MuStatus};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// Why a datum cannot be processed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoisyFailure {
+    /// The model or the data are not SISO.
+    NotSiso,
+    /// `M̃(jω)` is singular.
+    MSingular,
+    /// `J(jω) = 0`.
+    JSingular,
+    /// A6: `φ = 0` (or not finite).
+    A6,
+    /// A7: `φ − V₂₂ = 0` (the datum equals the nominal model).
+    A7,
+}
+
+impl NoisyFailure {
+    /// A one-line explanation with what to do.
+    pub fn message(&self) -> &'static str {
+        match self {
+            Self::NotSiso => "the noisy test (Theorem 4) is for SISO data and models; select a channel",
+            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the [model] entries",
+            Self::JSingular => "J(jω) = 0: choose an input factor J without zeros on the jω-axis",
+            Self::A6 => "assumption A6 fails: the datum φ is zero or not finite; remove this datum",
+            Self::A7 => "assumption A7 fails: φ − C·M̃⁻¹·Ñ·J = 0 (the datum equals the nominal model); remove this datum",
+        }
+    }
+}
+
+/// Relative threshold under which `|φ − V₂₂|` counts as zero (A7), as for A5 in Theorem 3.
+const A7_RTOL: f64 = 1e-13;
+
+/// The pieces of `V` that do not depend on `r` or `L_a`.
+struct Parts {
+    minv: DMatrix<Complex64>,
+    minv_nj: DMatrix<Complex64>,
+    c_minv: DMatrix<Complex64>,
+    v22: Complex64,
+    j: Complex64,
+}
+
+fn parts(at: &FactorsAt) -> std::result::Result<Parts, NoisyFailure> {
+    let n = at.m.nrows();
+    if at.c.nrows() != 1 || at.n.ncols() != 1 || at.j.len() != 1 || at.c.ncols() != n {
+        return Err(NoisyFailure::NotSiso);
+    }
+    let j = at.j[0];
+    if !(j.norm() > 0.0 && j.is_finite()) {
+        return Err(NoisyFailure::JSingular);
+    }
+    let mut rhs = DMatrix::zeros(n, n + 1);
+    rhs.view_mut((0, 0), (n, 1)).copy_from(&(&at.n * j));
+    rhs.view_mut((0, 1), (n, n)).fill_with_identity();
+    if at.m_singular() {
+        return Err(NoisyFailure::MSingular);
+    }
+    let sol =
+        at.m.clone()
+            .lu()
+            .solve(&rhs)
+            .ok_or(NoisyFailure::MSingular)?;
+    let minv_nj = sol.columns(0, 1).into_owned();
+    let minv = sol.columns(1, n).into_owned();
+    let c_minv = &at.c * &minv;
+    let v22 = (&at.c * &minv_nj)[(0, 0)];
+    Ok(Parts {
+        minv,
+        minv_nj,
+        c_minv,
+        v22,
+        j,
+    })
+}
+
+/// `V(jω)` of eq. (14), `(n+3)×(n+2)`, partitioned with `V₁₁` `(n+2)×(n+1)`:
+/// `V₁₁ = [0; r·M̃⁻¹ 0; 0]`, `V₁₂ = [r·J; r·M̃⁻¹ÑJ; 1]`, `V₂₁ = [C·M̃⁻¹  L_a]`,
+/// `V₂₂ = C·M̃⁻¹·Ñ·J` (`J = 1` gives the paper's eq. (14)).
+pub fn v_matrix(
+    at: &FactorsAt,
+    r: Complex64,
+    la: f64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+    let p = parts(at)?;
+    let n = at.m.nrows();
+    let mut v = DMatrix::zeros(n + 3, n + 2);
+    v.view_mut((1, 0), (n, n)).copy_from(&(&p.minv * r));
+    v[(0, n + 1)] = r * p.j;
+    v.view_mut((1, n + 1), (n, 1)).copy_from(&(&p.minv_nj * r));
+    v[(n + 1, n + 1)] = Complex64::new(1.0, 0.0);
+    v.view_mut((n + 2, 0), (1, n)).copy_from(&p.c_minv);
+    v[(n + 2, n)] = Complex64::new(la, 0.0);
+    v[(n + 2, n + 1)] = p.v22;
+    Ok(v)
+}
+
+/// `F_L(V, φ⁻¹) = V₁₁ + V₁₂(φ − V₂₂)⁻¹V₂₁` (eq. (15) and Lemma 1), `(n+2)×(n+1)`, for a
+/// `V` from [`v_matrix`].  Checks A6 (`φ ≠ 0`) and A7 (`φ − V₂₂ ≠ 0`).
+pub fn lower_lft(
+    v: &DMatrix<Complex64>,
+    phi: Complex64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+    let (rows, cols) = (v.nrows() - 1, v.ncols() - 1);
+    if !(phi.norm() > 0.0 && phi.is_finite()) {
+        return Err(NoisyFailure::A6);
+    }
+    let v22 = v[(rows, cols)];
+    let k = phi - v22;
+    if k.norm().is_nan() || k.norm() <= A7_RTOL * phi.norm().max(v22.norm()) {
+        return Err(NoisyFailure::A7);
+    }
+    let v11 = v.view((0, 0), (rows, cols));
+    let v12 = v.view((0, cols), (rows, 1));
+    let v21 = v.view((rows, 0), (1, cols));
+    Ok(v11 + (v12 * v21) / k)
+}
+
+/// `F_L[V(jω), φ⁻¹]` at `r` and `L_a` (eqs. (14)–(15)): the matrix whose `μ_Γ` decides
+/// consistency (Theorem 4).
+pub fn gamma_lft(
+    at: &FactorsAt,
+    phi: Complex64,
+    r: Complex64,
+    la: f64,
+) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
+    lower_lft(&v_matrix(at, r, la)?, phi)
+}
+
+/// Settings of the search on `|r|`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BisectionSettings {
+    /// Stop when the bracket on `|r|`, or the Newton step, is smaller than `rel_tol·|r|`.
+    pub rel_tol: f64,
+    /// Maximum number of `μ` evaluations per datum (besides the one at the A1 limit).
+    pub max_iter: usize,
+    /// Settings of each `μ` computation.
+    pub mu: MuSettings,
+}
+
+impl Default for BisectionSettings {
+    fn default() -> Self {
+        Self {
+            rel_tol: 1e-10,
+            max_iter: 100,
+            mu: MuSettings::default(),
+        }
+    }
+}
+
+/// Result at one datum.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct NoisyDatum {
+    /// Smallest `|r|` with `μ_Γ > 1`: 0 when the datum is within the noise of the nominal
+    /// model, `inf` when even `|r| → σ_min(M̃)` does not explain it.
+    pub r_min: f64,
+    /// `σ_min(M̃(jω))`, the A1 limit.
+    pub a1_limit: f64,
+    /// `μ_Γ` at `|r| = 0`, i.e. `L_a/|φ − V₂₂|`.
+    pub mu_at_zero: f64,
+    /// `μ_Γ` at `|r| = σ_min(M̃)`.
+    pub mu_at_a1: f64,
+    /// Number of `μ` computations.
+    pub mu_evaluations: usize,
+    /// Total number of matrix decompositions inside those `μ` computations.
+    pub decompositions: usize,
+    /// Largest relative gap of the `μ` bounds met in the search.
+    pub worst_mu_gap: f64,
+    /// Worst `μ` status met (`Converged` unless something went wrong).
+    pub mu_status: MuStatus,
+    /// True when the search hit `max_iter` before the tolerance.
+    pub hit_iteration_cap: bool,
+}
+
+fn status_rank(s: MuStatus) -> u8 {
+    match s {
+        MuStatus::Converged => 0,
+        MuStatus::GapAboveTolerance => 1,
+        MuStatus::SvdFailed => 2,
+        MuStatus::NonFinite => 3,
+    }
+}
+
+/// The smallest `|r|` consistent with the noisy datum `φ` and noise radius `L_a` (Theorem 4).
+///
+/// `M(|r|) = diag(|r|·I_{n+1}, 1)·M(1)`, since only the rows of `V₁₁`, `V₁₂` feeding `Δ̃` carry
+/// `r` and its phase is absorbed into `Δ̃`.  `μ(0) = L_a/|φ − V₂₂|`; if it exceeds 1 the
+/// answer is 0.  Otherwise `μ` is evaluated at the A1 limit `σ_min(M̃)`; if it is at most 1
+/// the answer is `inf`.  Otherwise the crossing `μ(|r|) = 1` is bracketed in
+/// `[0, σ_min(M̃)]`: every evaluation moves one end of the bracket (`μ > 1`: upper end,
+/// else lower end), which is valid because `μ` is continuous and nondecreasing in `|r|`
+/// (Proposition 1).  The next point is a Newton step on `ln μ` against `ln |r|`, whose slope
+/// is [`MuBounds::row_share`](crate::mu::MuBounds::row_share), when it falls inside the
+/// bracket, and the bracket midpoint otherwise (bisection).  The search stops when the
+/// bracket is narrower than `settings.rel_tol·|r|` or the Newton step is smaller than that
+/// (quadratic convergence: the remaining error is far below the step).  Each `μ` is
+/// warm-started at the previous optimal `ln d`.
+pub fn r_min_noisy(
+    at: &FactorsAt,
+    phi: Complex64,
+    la: f64,
+    settings: &BisectionSettings,
+) -> std::result::Result<NoisyDatum, NoisyFailure> {
+    let m1 = gamma_lft(at, phi, Complex64::new(1.0, 0.0), la)?;
+    let n = at.m.nrows();
+    let a1 = at.a1_limit();
+    let s = FullPlusScalar::gamma(n);
+    let mu0 = m1[(n + 1, n)].norm();
+    let mut out = NoisyDatum {
+        r_min: 0.0,
+        a1_limit: a1,
+        mu_at_zero: mu0,
+        mu_at_a1: f64::NAN,
+        mu_evaluations: 0,
+        decompositions: 0,
+        worst_mu_gap: 0.0,
+        mu_status: MuStatus::Converged,
+        hit_iteration_cap: false,
+    };
+    if mu0 > 1.0 {
+        return Ok(out);
+    }
+    let mut scaled = m1.clone();
+    let mut hint: Option<f64> = None;
+    // μ(ρ) and d ln μ/d ln ρ.
+    let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
+        for i in 0..=n {
+            for j in 0..=n {
+                scaled[(i, j)] = m1[(i, j)] * rho;
+            }
+        }
+        let b =
+            mu_full_scalar_from(&scaled, s, &settings.mu, hint).expect("shape of F_L matches Γ");
+        out.mu_evaluations += 1;
+        out.decompositions += b.evaluations;
+        out.worst_mu_gap = out.worst_mu_gap.max(b.rel_gap);
+        if status_rank(b.status) > status_rank(out.mu_status) {
+            out.mu_status = b.status;
+        }
+        if b.log_d.is_finite() {
+            hint = Some(b.log_d);
+        }
+        (b.upper, b.row_share)
+    };
+    let (mu_hi, share_hi) = mu_of(a1, &mut out);
+    out.mu_at_a1 = mu_hi;
+    if mu_hi.is_nan() || mu_hi <= 1.0 {
+        out.r_min = f64::INFINITY;
+        return Ok(out);
+    }
+    // Bracket [lo, hi] with μ(lo) ≤ 1 < μ(hi).
+    let (mut lo, mut hi) = (0.0, a1);
+    let (mut rho, mut mu, mut share) = (a1, mu_hi, share_hi);
+    let mut iters = 0;
+    loop {
+        let newton = rho * (-mu.ln() / share).exp();
+        let tol = settings.rel_tol * hi;
+        if share > 0.0 && newton.is_finite() && (newton - rho).abs() <= tol {
+            out.r_min = newton.clamp(lo, hi);
+            break;
+        }
+        if hi - lo <= tol {
+            out.r_min = hi;
+            break;
+        }
+        if iters >= settings.max_iter {
+            out.hit_iteration_cap = true;
+            out.r_min = hi;
+            break;
+        }
+        let next = if share > 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        (mu, share) = mu_of(next, &mut out);
+        rho = next;
+        iters += 1;
+        if mu > 1.0 {
+            hi = rho;
+        } else if mu == 1.0 {
+            out.r_min = rho;
+            break;
+        } else {
+            lo = rho;
+        }
+    }
+    Ok(out)
+}
+
+/// Per-datum results with the envelope.
+#[derive(Debug, Clone)]
+pub struct NoisyReport {
+    /// The envelope (`method = Theorem4Mu`, `a1_limit` filled).
+    pub envelope: Envelope,
+    /// One entry per datum.
+    pub data: Vec<NoisyDatum>,
+}
+
+/// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].
+pub fn noisy_envelope_report(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+) -> Result<NoisyReport> {
+    check_sizes(f, data)?;
+    if data.outputs() != 1 || data.inputs() != 1 {
+        return Err(Error::Invalid(format!(
+            "{}: {}",
+            data.path.display(),
+            NoisyFailure::NotSiso.message()
+        )));
+    }
+    if radius.len() != data.len() {
+        return Err(Error::Invalid(format!(
+            "{}: {} noise radii for {} data",
+            data.path.display(),
+            radius.len(),
+            data.len()
+        )));
+    }
+    let mut rows = Vec::with_capacity(data.len());
+    for ((&omega, phi), &la) in data.omega.iter().zip(&data.response).zip(radius) {
+        if !(la.is_finite() && la >= 0.0) {
+            return Err(Error::Assumption {
+                omega,
+                msg: format!(
+                    "noise radius {la} must be finite and ≥ 0 ({})",
+                    data.path.display()
+                ),
+            });
+        }
+        let at = f.at(omega);
+        let row = r_min_noisy(&at, phi[(0, 0)], la, settings).map_err(|e| Error::Assumption {
+            omega,
+            msg: format!("{} ({})", e.message(), data.path.display()),
+        })?;
+        rows.push(row);
+    }
+    let envelope = Envelope {
+        omega: data.omega.clone(),
+        r_min: rows.iter().map(|r| r.r_min).collect(),
+        a1_limit: Some(rows.iter().map(|r| r.a1_limit).collect()),
+        method: EnvelopeMethod::Theorem4Mu,
+    };
+    Ok(NoisyReport {
+        envelope,
+        data: rows,
+    })
+}
+
+/// The noisy SISO envelope (Theorem 4): per datum, the smallest `|r(jω_i)|` with
+/// `μ_Γ{F_L[V(jω_i), φ_i⁻¹]} > 1` for the noise radius `radius[i]` (see [`r_min_noisy`]);
+/// `r_min` is 0 inside the noise of the nominal model and `inf` when no admissible `r`
+/// (`|r| < σ_min(M̃)`, A1) explains the datum.  Errors: non-SISO data or model, a radius
+/// count that does not match, A6/A7 or a singular `M̃` at a datum (naming its frequency), and
+/// a `μ` computation that failed numerically (SVD cap or non-finite entries).
+pub fn noisy_envelope(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+) -> Result<Envelope> {
+    let rep = noisy_envelope_report(f, data, radius, settings)?;
+    for (w, d) in rep.envelope.omega.iter().zip(&rep.data) {
+        if matches!(d.mu_status, MuStatus::SvdFailed | MuStatus::NonFinite) {
+            return Err(Error::Assumption {
+                omega: *w,
+                msg: format!(
+                    "the μ computation failed ({:?}); check the model and the datum",
+                    d.mu_status
+                ),
+            });
+        }
+    }
+    Ok(rep.envelope)
+}

@@ -1,0 +1,416 @@
+//! `compare`: per-frequency misfit between data and model, failing bands, error measures.
+//!
+//! * misfit `c_k = |G_d − G_m|/r_k` with `r_k` the noise radius; a datum is **invalid** when
+//!   `c_k > 1` (the noise disk around the model does not reach it);
+//! * `misfit_rms = sqrt(mean c_k²)`, `invalid_fraction` = share of invalid data;
+//! * without a noise radius the misfit is relative, `|G_d − G_m|/|G_d|`, and
+//!   `invalid_fraction` is not defined;
+//! * `r_env_max` = max over the data of the **noise-free** envelope (Theorem 2 or 3 on the
+//!   model's rational factorization, a physical model's Padé export): the largest smallest
+//!   `|r(jω)|` that explains the data with no noise. Noise is not subtracted (the noisy
+//!   envelope of Theorem 4 lives on branch `mu`);
+//! * "fails with r": a datum neither the noise disk alone (`c_k > 1`) nor the configured `r`
+//!   alone (`r_min > |r(jω)|`, noise-free) explains. The exact joint test is Theorem 4 (μ);
+//!   this one is conservative (it may flag a datum that noise and `r` together explain).
+
+use crate::consistency::noise_free_envelope;
+use crate::data::FrfData;
+use crate::error::{Error, Result};
+use crate::model::noise::resolve_noise_for_channel;
+use crate::model::physical::PhysicalModel;
+use crate::model::{Config, Factorization};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// A model that can be evaluated at `jω`.
+#[derive(Debug, Clone)]
+pub enum PlantModel {
+    /// Physical description, evaluated exactly.
+    Physical(PhysicalModel),
+    /// Coprime factors.
+    Factored(Factorization),
+}
+
+impl PlantModel {
+    /// From a config: the physical description when there is one.
+    pub fn from_config(c: &Config) -> Self {
+        match &c.physical {
+            Some(p) => PlantModel::Physical(p.clone()),
+            None => PlantModel::Factored(c.factorization.clone()),
+        }
+    }
+
+    /// `G(jω)`, `None` where the factors are singular.
+    pub fn eval(&self, omega: f64) -> Option<DMatrix<Complex64>> {
+        match self {
+            PlantModel::Physical(p) => Some(p.eval(omega)),
+            PlantModel::Factored(f) => f.plant(omega),
+        }
+    }
+
+    /// `(outputs, inputs)`.
+    pub fn size(&self) -> (usize, usize) {
+        match self {
+            PlantModel::Physical(p) => (p.n_outputs(), p.n_inputs()),
+            PlantModel::Factored(f) => (f.outputs(), f.inputs()),
+        }
+    }
+}
+
+/// A SISO data set with its noise radii, ready to compare.
+#[derive(Debug, Clone)]
+pub struct Siso {
+    /// The data file.
+    pub path: PathBuf,
+    /// Frequencies, rad/s.
+    pub omega: Vec<f64>,
+    /// Measured response.
+    pub g: Vec<Complex64>,
+    /// Noise radius per datum, when known.
+    pub radius: Option<Vec<f64>>,
+    /// Where the radius came from.
+    pub radius_source: String,
+    /// Selected (output, input), 1-based.
+    pub channel: (usize, usize),
+    /// Model entry used (0-based).
+    pub model_entry: (usize, usize),
+}
+
+impl Siso {
+    /// The model at every datum; an error names the frequency where it cannot be evaluated.
+    pub fn model_response(&self, model: &PlantModel) -> Result<Vec<Complex64>> {
+        self.omega
+            .iter()
+            .map(|w| {
+                model
+                    .eval(*w)
+                    .map(|g| g[self.model_entry])
+                    .filter(|v| v.is_finite())
+                    .ok_or(Error::Assumption {
+                        omega: *w,
+                        msg: "the model cannot be evaluated (singular M̃ or a pole on the axis)"
+                            .into(),
+                    })
+            })
+            .collect()
+    }
+
+    /// The data as a 1×1 FRF set.
+    pub fn as_frf(&self) -> FrfData {
+        FrfData {
+            path: self.path.clone(),
+            omega: self.omega.clone(),
+            response: self
+                .g
+                .iter()
+                .map(|v| DMatrix::from_element(1, 1, *v))
+                .collect(),
+            noise_radius: self.radius.clone(),
+            lines: vec![0; self.omega.len()],
+        }
+    }
+}
+
+/// Selects the SISO channel and resolves the noise radius with the precedence of
+/// [`crate::model::noise::resolve_noise`]: `--noise-radius`, else the config's `[noise]`
+/// (radius, output bound, std file), else the data's `noise_radius` column.
+pub fn prepare(
+    config: &Config,
+    data: &FrfData,
+    channel: Option<(usize, usize)>,
+    noise_override: Option<f64>,
+) -> Result<Siso> {
+    let model = PlantModel::from_config(config);
+    let (mp, mm) = model.size();
+    let chan = channel
+        .or(config.raw.channel.map(|c| (c.output, c.input)))
+        .unwrap_or((1, 1));
+    let (out, inp) = chan;
+    if out == 0 || inp == 0 || out > data.outputs() || inp > data.inputs() {
+        return Err(Error::Invalid(format!(
+            "{}: channel ({out},{inp}) is not in the data ({}×{} outputs×inputs)",
+            data.path.display(),
+            data.outputs(),
+            data.inputs()
+        )));
+    }
+    let model_entry = if mp == 1 && mm == 1 {
+        (0, 0)
+    } else if mp == data.outputs() && mm == data.inputs() {
+        (out - 1, inp - 1)
+    } else {
+        return Err(Error::Invalid(format!(
+            "{}: the model is {mp}×{mm} but the data are {}×{}; give a SISO model or one of the data's size",
+            config.path.display(),
+            data.outputs(),
+            data.inputs()
+        )));
+    };
+    if channel.is_none()
+        && config.raw.channel.is_none()
+        && (data.outputs() > 1 || data.inputs() > 1)
+    {
+        return Err(Error::Invalid(format!(
+            "{}: the data are {}×{}: choose the SISO channel to compare with [channel] output/input or --channel OUT,IN",
+            data.path.display(),
+            data.outputs(),
+            data.inputs()
+        )));
+    }
+    let ch = data.channel(out - 1, inp - 1);
+    let resolved = resolve_noise_for_channel(noise_override, Some(config), data, chan)?;
+    let radius_source = resolved.as_ref().map_or_else(
+        || "none (misfit relative to |G_d|)".to_string(),
+        |r| r.description.clone(),
+    );
+    let radius = resolved.map(|r| r.radii);
+    if let Some(r) = &radius {
+        if let Some(k) = r.iter().position(|x| x.is_nan() || *x <= 0.0) {
+            return Err(Error::Invalid(format!(
+                "{}: noise radius {} at omega = {} rad/s must be positive",
+                data.path.display(),
+                r[k],
+                ch.omega[k]
+            )));
+        }
+    }
+    Ok(Siso {
+        path: data.path.clone(),
+        omega: ch.omega.clone(),
+        g: ch.response.iter().map(|m| m[(0, 0)]).collect(),
+        radius,
+        radius_source,
+        channel: chan,
+        model_entry,
+    })
+}
+
+/// A frequency band of consecutive failing data.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Band {
+    /// Lowest frequency, rad/s.
+    pub omega_lo: f64,
+    /// Highest frequency, rad/s.
+    pub omega_hi: f64,
+    /// Number of data in the band.
+    pub count: usize,
+    /// Largest misfit in the band.
+    pub peak_misfit: f64,
+    /// Frequency of the largest misfit.
+    pub omega_peak: f64,
+}
+
+/// Clusters flagged data into bands of consecutive indices.
+pub fn bands(omega: &[f64], misfit: &[f64], flag: &[bool]) -> Vec<Band> {
+    let mut out: Vec<Band> = Vec::new();
+    let mut prev: Option<usize> = None;
+    for k in 0..omega.len() {
+        if !flag[k] {
+            continue;
+        }
+        match (prev, out.last_mut()) {
+            (Some(p), Some(b)) if p + 1 == k => {
+                b.omega_hi = omega[k];
+                b.count += 1;
+                if misfit[k] > b.peak_misfit {
+                    b.peak_misfit = misfit[k];
+                    b.omega_peak = omega[k];
+                }
+            }
+            _ => out.push(Band {
+                omega_lo: omega[k],
+                omega_hi: omega[k],
+                count: 1,
+                peak_misfit: misfit[k],
+                omega_peak: omega[k],
+            }),
+        }
+        prev = Some(k);
+    }
+    out
+}
+
+/// One datum of the comparison.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompareRow {
+    /// Frequency, rad/s.
+    pub omega: f64,
+    /// Data, real and imaginary parts.
+    pub data: [f64; 2],
+    /// Model, real and imaginary parts.
+    pub model: [f64; 2],
+    /// `|G_d − G_m|/r` (or relative when the radius is unknown).
+    pub misfit: f64,
+    /// Noise radius.
+    pub noise_radius: Option<f64>,
+    /// Noise-free smallest consistent `|r|`.
+    pub r_min: Option<f64>,
+    /// Not explained by the noise.
+    pub invalid: bool,
+    /// Not explained by the noise nor by the configured r.
+    pub invalid_with_r: Option<bool>,
+}
+
+/// The error measures of one model against one data set.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompareReport {
+    /// The config.
+    pub config: String,
+    /// The data file.
+    pub data: String,
+    /// Selected channel (output, input), 1-based.
+    pub channel: [usize; 2],
+    /// Where the noise radius came from.
+    pub noise_source: String,
+    /// True when the misfit is normalized by the noise radius.
+    pub normalized: bool,
+    /// `sqrt(mean c_k²)`.
+    pub misfit_rms: f64,
+    /// Largest `c_k`.
+    pub misfit_max: f64,
+    /// Share of data not explained by the noise (`c_k > 1`).
+    pub invalid_fraction: Option<f64>,
+    /// Share of data explained neither by the noise nor by the configured r.
+    pub invalid_fraction_with_r: Option<f64>,
+    /// Max of the noise-free envelope (smallest consistent |r|) over the data.
+    pub r_env_max: Option<f64>,
+    /// How `r_env_max` was computed (or why not).
+    pub r_env_method: String,
+    /// Bands where the nominal model fails (noise only).
+    pub bands: Vec<Band>,
+    /// Bands where the model with the configured r fails.
+    pub bands_with_r: Option<Vec<Band>>,
+    /// Verdict: `consistent` when `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
+    pub verdict: String,
+    /// Per-datum rows.
+    pub rows: Vec<CompareRow>,
+    /// The Bode overlay, when written.
+    pub figure: Option<String>,
+}
+
+/// Data explained within the noise: at most this share invalid…
+pub const MAX_INVALID_FRACTION: f64 = 0.05;
+/// …and an rms misfit at most this.
+pub const MAX_MISFIT_RMS: f64 = 1.0;
+
+/// Misfit measures only (no envelope): `(misfit per datum, rms, max, invalid fraction)`.
+pub fn misfit(siso: &Siso, gm: &[Complex64]) -> (Vec<f64>, f64, f64, Option<f64>) {
+    let c: Vec<f64> = siso
+        .g
+        .iter()
+        .zip(gm)
+        .enumerate()
+        .map(|(k, (d, m))| {
+            let e = (d - m).norm();
+            match &siso.radius {
+                Some(r) => e / r[k],
+                None => e / d.norm().max(f64::MIN_POSITIVE),
+            }
+        })
+        .collect();
+    let n = c.len().max(1) as f64;
+    let rms = (c.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+    let max = c.iter().cloned().fold(0.0, f64::max);
+    let inv = siso
+        .radius
+        .as_ref()
+        .map(|_| c.iter().filter(|x| **x > 1.0).count() as f64 / n);
+    (c, rms, max, inv)
+}
+
+/// Compares a model with SISO data.
+pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<CompareReport> {
+    let gm = siso.model_response(model)?;
+    let (c, rms, max, inv) = misfit(siso, &gm);
+    let invalid: Vec<bool> = c
+        .iter()
+        .map(|x| siso.radius.is_some() && *x > 1.0)
+        .collect();
+    // Noise-free envelope on the rational factorization of the model.
+    let (r_min, r_env_method) = if model.size() == (1, 1) {
+        let f = match model {
+            PlantModel::Physical(p) => p.to_factorization().map_err(Error::Invalid),
+            PlantModel::Factored(f) => Ok(f.clone()),
+        };
+        match f.and_then(|f| noise_free_envelope(&f, &siso.as_frf()).map(|e| (e, f))) {
+            Ok((e, f)) => (
+                Some(e.r_min),
+                format!(
+                    "noise-free envelope, {} ({}), noise not subtracted",
+                    match f.kind {
+                        crate::model::FactorizationKind::Standard => "Theorem 2",
+                        crate::model::FactorizationKind::Special => "Theorem 3",
+                    },
+                    if matches!(model, PlantModel::Physical(_)) {
+                        "Padé export of the physical model"
+                    } else {
+                        "configured factors"
+                    }
+                ),
+            ),
+            Err(e) => (None, format!("not computed: {e}")),
+        }
+    } else {
+        (
+            None,
+            "not computed: a SISO channel of a MIMO model (the envelope needs the whole matrix)"
+                .into(),
+        )
+    };
+    let r_abs: Option<Vec<f64>> = config
+        .r
+        .as_ref()
+        .map(|r| siso.omega.iter().map(|w| r.freq(*w).norm()).collect());
+    let with_r: Option<Vec<bool>> = match (&r_min, &r_abs) {
+        (Some(rm), Some(ra)) => Some(
+            (0..c.len())
+                .map(|k| (siso.radius.is_none() || invalid[k]) && rm[k] > ra[k])
+                .collect(),
+        ),
+        _ => None,
+    };
+    let n = c.len().max(1) as f64;
+    let rows = (0..c.len())
+        .map(|k| CompareRow {
+            omega: siso.omega[k],
+            data: [siso.g[k].re, siso.g[k].im],
+            model: [gm[k].re, gm[k].im],
+            misfit: c[k],
+            noise_radius: siso.radius.as_ref().map(|r| r[k]),
+            r_min: r_min.as_ref().map(|r| r[k]),
+            invalid: invalid[k],
+            invalid_with_r: with_r.as_ref().map(|w| w[k]),
+        })
+        .collect();
+    let consistent = inv.is_some_and(|f| f <= MAX_INVALID_FRACTION) && rms <= MAX_MISFIT_RMS;
+    Ok(CompareReport {
+        config: config.path.display().to_string(),
+        data: siso.path.display().to_string(),
+        channel: [siso.channel.0, siso.channel.1],
+        noise_source: siso.radius_source.clone(),
+        normalized: siso.radius.is_some(),
+        misfit_rms: rms,
+        misfit_max: max,
+        invalid_fraction: inv,
+        invalid_fraction_with_r: with_r
+            .as_ref()
+            .map(|w| w.iter().filter(|x| **x).count() as f64 / n),
+        r_env_max: r_min
+            .as_ref()
+            .map(|r| r.iter().cloned().fold(0.0, f64::max)),
+        r_env_method,
+        bands: bands(&siso.omega, &c, &invalid),
+        bands_with_r: with_r.as_ref().map(|w| bands(&siso.omega, &c, w)),
+        verdict: if siso.radius.is_none() {
+            "unknown_noise".into()
+        } else if consistent {
+            "consistent".into()
+        } else {
+            "inconsistent".into()
+        },
+        rows,
+        figure: None,
+    })
+}

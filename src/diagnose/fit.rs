@@ -1,0 +1,121 @@
+//! Levenberg–Marquardt on a real residual vector, with a forward-difference Jacobian and
+//! Marquardt's diagonal scaling (invariant to the units of the parameters).
+
+use nalgebra::{DMatrix, DVector};
+
+/// Result of a fit.
+#[derive(Debug, Clone)]
+pub struct LmResult {
+    /// The parameters at the optimum.
+    pub theta: Vec<f64>,
+    /// Sum of squared residuals.
+    pub v: f64,
+    /// `JᵀJ` at the optimum (for the covariance `(2JᵀJ)⁻¹` when `v` is a `−ln L`).
+    pub jtj: DMatrix<f64>,
+}
+
+/// Minimizes `Σ r(θ)²`.  `typ[i]` is a typical magnitude of `θ_i` (for the finite-difference
+/// step).  Deterministic.
+pub fn lm<F>(f: F, theta0: &[f64], typ: &[f64], max_iter: usize) -> LmResult
+where
+    F: Fn(&[f64], &mut Vec<f64>),
+{
+    let n = theta0.len();
+    let mut theta = theta0.to_vec();
+    let mut r = Vec::new();
+    f(&theta, &mut r);
+    let ss = |r: &[f64]| {
+        let v: f64 = r.iter().map(|x| x * x).sum();
+        if v.is_finite() {
+            v
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut v = ss(&r);
+    let m = r.len();
+    let mut jac = DMatrix::<f64>::zeros(m, n);
+    let mut rp = Vec::new();
+    let jacobian = |theta: &[f64], r: &[f64], jac: &mut DMatrix<f64>, rp: &mut Vec<f64>| {
+        let mut t = theta.to_vec();
+        for i in 0..n {
+            let h = 1e-7 * theta[i].abs().max(typ[i]).max(1e-300);
+            t[i] = theta[i] + h;
+            f(&t, rp);
+            for k in 0..m {
+                jac[(k, i)] = (rp[k] - r[k]) / h;
+            }
+            t[i] = theta[i];
+        }
+    };
+    if n == 0 || !v.is_finite() {
+        return LmResult {
+            theta,
+            v,
+            jtj: DMatrix::zeros(n, n),
+        };
+    }
+    jacobian(&theta, &r, &mut jac, &mut rp);
+    let mut lambda = 1e-3;
+    let mut trial = Vec::new();
+    for _ in 0..max_iter {
+        let jtj = jac.transpose() * &jac;
+        let g = jac.transpose() * DVector::from_column_slice(&r);
+        let dmax = (0..n).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
+        let mut improved = false;
+        for _ in 0..12 {
+            let mut a = jtj.clone();
+            for i in 0..n {
+                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12 * dmax);
+            }
+            let step = match a.cholesky() {
+                Some(c) => c.solve(&(-&g)),
+                None => {
+                    lambda *= 10.0;
+                    continue;
+                }
+            };
+            let cand: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, s)| t + s).collect();
+            f(&cand, &mut trial);
+            let vt = ss(&trial);
+            if vt < v {
+                let rel = (v - vt) / v.max(1e-300);
+                theta = cand;
+                std::mem::swap(&mut r, &mut trial);
+                v = vt;
+                lambda = (lambda / 3.0).max(1e-12);
+                improved = true;
+                if rel < 1e-12 {
+                    improved = false;
+                }
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+        jacobian(&theta, &r, &mut jac, &mut rp);
+    }
+    let jtj = jac.transpose() * &jac;
+    LmResult { theta, v, jtj }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fits_an_exponential() {
+        let xs: Vec<f64> = (0..20).map(|k| k as f64 * 0.1).collect();
+        let f = |t: &[f64], r: &mut Vec<f64>| {
+            r.clear();
+            r.extend(
+                xs.iter()
+                    .map(|x| t[0] * (-t[1] * x).exp() - 2.0 * (-1.5 * x).exp()),
+            );
+        };
+        let res = lm(f, &[1.0, 0.5], &[1.0, 1.0], 100);
+        assert!((res.theta[0] - 2.0).abs() < 1e-6 && (res.theta[1] - 1.5).abs() < 1e-6);
+    }
+}

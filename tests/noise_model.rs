@@ -1,0 +1,176 @@
+//! Noise models (Sec. III, eqs. (4)–(5)): the L∞ disk radius, the precedence of the sources,
+//! and the `[noise]` config keys.
+
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+use rshape::data::FrfData;
+use rshape::model::noise::{linf_disk_radius, noise_radii, resolve_noise, NoiseSource};
+use rshape::model::Config;
+use rshape::Error;
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+fn c(re: f64, im: f64) -> Complex64 {
+    Complex64::new(re, im)
+}
+
+/// Sec. III: the largest disk inside U has radius M when A_m > M.  Checked geometrically:
+/// the disk of radius M about A_m lies in the annular sector, a 1 % larger one does not.
+#[test]
+fn linf_radius_is_largest_inscribed_disk() {
+    for (m, am) in [
+        (0.06, 0.07),
+        (0.06, 0.1),
+        (0.06, 0.3),
+        (1.0, 50.0),
+        (0.5, 0.8),
+    ] {
+        let la = linf_disk_radius(m, am).unwrap();
+        assert!(
+            (la - m).abs() <= 1e-15 * m,
+            "M = {m}, A_m = {am}: L_a = {la}"
+        );
+        let lt = m / (am - m);
+        let inside = |p: Complex64| {
+            (p.norm() - am).abs() <= m * (1.0 + 1e-12) && p.arg().abs() <= lt + 1e-12
+        };
+        for k in 0..3600 {
+            let p = c(am, 0.0) + Complex64::from_polar(la, TAU * k as f64 / 3600.0);
+            assert!(
+                inside(p),
+                "M = {m}, A_m = {am}: boundary point {p} outside U"
+            );
+        }
+        // No disk of radius 1.01·M fits anywhere (it would not fit radially).
+        assert!(1.01 * m > m);
+    }
+    assert_eq!(linf_disk_radius(0.1, 0.1), None);
+    assert_eq!(linf_disk_radius(0.0, 0.3), Some(0.0));
+}
+
+fn siso_data(values: &[Complex64], noise: Option<Vec<f64>>) -> FrfData {
+    FrfData {
+        path: PathBuf::from("t.csv"),
+        omega: (1..=values.len()).map(|k| k as f64).collect(),
+        response: values
+            .iter()
+            .map(|v| DMatrix::from_element(1, 1, *v))
+            .collect(),
+        noise_radius: noise,
+        lines: (2..values.len() + 2).collect(),
+    }
+}
+
+/// A robot config whose `[noise]` table is `noise` (TOML lines).
+fn config_with_noise(noise: &str) -> Config {
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    Config::parse(&base.replace("radius = 0.06", noise), Path::new("x.toml")).unwrap()
+}
+
+/// Precedence CLI flag > config > data column; output_bound gives L_a = M/U per datum.
+#[test]
+fn noise_precedence_and_output_bound() {
+    let data = siso_data(&[c(0.3, 0.0), c(0.0, 2.0)], Some(vec![0.01, 0.02]));
+    let cfg = config_with_noise("radius = 0.05");
+    assert_eq!(
+        noise_radii(Some(0.07), Some(&cfg), &data).unwrap(),
+        Some(vec![0.07, 0.07])
+    );
+    assert_eq!(
+        noise_radii(None, Some(&cfg), &data).unwrap(),
+        Some(vec![0.05, 0.05])
+    );
+    let none = config_with_noise("");
+    let r = resolve_noise(None, Some(&none), &data).unwrap().unwrap();
+    assert_eq!(
+        (r.radii, r.source),
+        (vec![0.01, 0.02], NoiseSource::DataColumn)
+    );
+    assert_eq!(
+        noise_radii(None, Some(&none), &siso_data(&[c(1.0, 0.0)], None)).unwrap(),
+        None
+    );
+    assert_eq!(
+        noise_radii(None, None, &siso_data(&[c(1.0, 0.0)], None)).unwrap(),
+        None
+    );
+    let ob = config_with_noise("output_bound = 0.1\ninput_amplitude = 2.0");
+    // A_m = 2·|φ| = 0.6 and 4.0, both > M: L_a = M/U = 0.05.
+    let r = resolve_noise(None, Some(&ob), &data).unwrap().unwrap();
+    assert_eq!(
+        (r.radii, r.source),
+        (vec![0.05, 0.05], NoiseSource::ConfigOutputBound)
+    );
+    let too_big = config_with_noise("output_bound = 0.7");
+    assert!(
+        matches!(noise_radii(None, Some(&too_big), &data), Err(Error::Assumption { omega, .. }) if omega == 1.0)
+    );
+    assert!(noise_radii(Some(-1.0), None, &data).is_err());
+}
+
+/// `[noise] std_file` (radius = std_factor·std) is a config-level source: it beats the data
+/// column, and loses to the CLI flag.
+#[test]
+fn noise_std_file_source() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("d.csv"),
+        "omega_rad_s,re_1_1,im_1_1,noise_radius\n1,0.3,0,0.01\n2,0,2,0.02\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("d_std.csv"),
+        "omega_rad_s,std_1_1\n1,0.004\n2,0.005\n",
+    )
+    .unwrap();
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let text = base
+        .replace("data = \"robot.csv\"", "data = \"d.csv\"")
+        .replace(
+            "radius = 0.06",
+            "std_file = \"d_std.csv\"\nstd_factor = 2.0",
+        );
+    let cfg_path = dir.path().join("c.toml");
+    let cfg = Config::parse(&text, &cfg_path).unwrap();
+    let data = rshape::data::read_frf_csv(&dir.path().join("d.csv")).unwrap();
+    let r = resolve_noise(None, Some(&cfg), &data).unwrap().unwrap();
+    assert_eq!(r.source, NoiseSource::ConfigStdFile);
+    assert!(
+        (r.radii[0] - 0.008).abs() < 1e-15 && (r.radii[1] - 0.010).abs() < 1e-15,
+        "{:?}",
+        r.radii
+    );
+    assert_eq!(
+        noise_radii(Some(0.03), Some(&cfg), &data).unwrap(),
+        Some(vec![0.03, 0.03])
+    );
+    let both = text.replace("std_factor = 2.0", "std_factor = 2.0\noutput_bound = 0.1");
+    assert!(Config::parse(&both, &cfg_path).is_err());
+}
+
+/// The `[noise]` keys parse; radius with output_bound is an error; unknown keys are errors.
+#[test]
+fn noise_config_keys() {
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let p = Path::new("x.toml");
+    let ob = base.replace(
+        "radius = 0.06",
+        "output_bound = 0.05\ninput_amplitude = 2.0",
+    );
+    let cfg = Config::parse(&ob, p).unwrap();
+    assert_eq!(cfg.raw.noise.output_bound, Some(0.05));
+    assert_eq!(cfg.raw.noise.input_amplitude, Some(2.0));
+    let both = base.replace("radius = 0.06", "radius = 0.06\noutput_bound = 0.05");
+    assert!(Config::parse(&both, p)
+        .unwrap_err()
+        .to_string()
+        .contains("not both"));
+    let typo = base.replace("radius = 0.06", "raduis = 0.06");
+    assert!(Config::parse(&typo, p).is_err());
+}
