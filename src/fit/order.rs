@@ -92,7 +92,7 @@ pub fn fit_auto(
 /// The order table as aligned text, with the chosen order marked.
 pub fn format_table(rows: &[OrderRow], chosen: usize, tol: f64) -> String {
     let mut s = format!(
-        "{:>5}  {:>14}  {:>14}  {}\n",
+        "{:>5}  {:>18}  {:>14}  {}\n",
         "order", "mean log10 r/r_min", "max log10", "status"
     );
     for r in rows {
