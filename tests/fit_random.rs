@@ -11,14 +11,14 @@ use rshape::system::{logspace, TransferFunction};
 
 fn random_envelope(rng: &mut ChaCha8Rng, k: usize) -> Envelope {
     let decades = rng.gen_range(1.0..=6.0);
-    let n = if k % 10 == 0 {
+    let n = if k.is_multiple_of(10) {
         2000
     } else {
         rng.gen_range(20..=600)
     };
     let lo = 10f64.powf(rng.gen_range(-3.0..2.0));
     let omega = logspace(lo, lo * 10f64.powf(decades), n);
-    let jagged = k % 2 == 1;
+    let jagged = !k.is_multiple_of(2);
     // Smooth trend: a random rational-like shape in log-log (slopes up to ±1.5).
     let c1 = rng.gen_range(-1.0..1.0);
     let c2 = rng.gen_range(-0.3..0.3);
@@ -82,7 +82,7 @@ fn random_envelopes_give_certified_units() {
         let order = 1 + k % 6;
         let set = FitSettings {
             order,
-            objective: if k % 3 == 0 {
+            objective: if k.is_multiple_of(3) {
                 Objective::Area
             } else {
                 Objective::Minimax
@@ -134,7 +134,7 @@ fn random_envelopes_give_certified_units() {
                 println!("  {e:?}");
             }
         }
-        if k % 10 == 0 {
+        if k.is_multiple_of(10) {
             println!(
                 "{tag}: mean {:.4} max {:.4}, {:?}, {} LPs, {} events",
                 fit.certificate.mean_log10_ratio,
