@@ -140,7 +140,7 @@ pub struct GridSpec<'a> {
 
 /// Builds the constraint points: every datum, a dense grid over the data band (no-dip lower
 /// bound, local upper envelope), the two extensions (floor only, upper envelope from the
-/// nearest decade of data), and `ω = ∞`.
+/// nearest decade of data), `ω = 0` and `ω = ∞`.
 pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
     let n = spec.w.len();
     let (w_lo, w_hi) = (spec.w[0], spec.w[n - 1]);
@@ -216,6 +216,19 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             datum: None,
         });
     }
+    // ω = 0: the floor holds at DC too (a root of A at x = 0 is a zero at s = 0).
+    pts.push(GridPoint {
+        w: 0.0,
+        x: 0.0,
+        lower: spec.floor,
+        upper: Some(up_lo),
+        a1: match (spec.a1, spec.a1_data) {
+            (Some(f), _) => Some(f(w_lo / ext / 10.0)),
+            _ => None,
+        },
+        kind: PointKind::Outside,
+        datum: None,
+    });
     // ω = ∞: A1 from a frequency far above the band (the factors are proper, so the limit
     // settles), when a function is known.
     pts.push(GridPoint {
@@ -277,8 +290,13 @@ mod tests {
         });
         assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
         assert!(g.iter().any(|p| p.kind == PointKind::Infinity));
-        assert!(g.iter().filter(|p| p.kind == PointKind::Band).count() >= 99);
-        let lo = g.iter().map(|p| p.w).fold(f64::INFINITY, f64::min);
+        assert!(g.iter().filter(|p| p.kind == PointKind::Band).count() >= 95);
+        let lo = g
+            .iter()
+            .map(|p| p.w)
+            .filter(|w| *w > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        assert!(g.iter().any(|p| p.w == 0.0));
         assert!((lo - 1e-3).abs() < 1e-12);
     }
 }

@@ -432,6 +432,32 @@ pub fn fit_unit(
     settings: &FitSettings,
 ) -> Result<FitResult, FitError> {
     let ctx = prepare(env, a1, settings)?;
+    match fit_with(&ctx, settings) {
+        Err(e) if !settings.chain && settings.order > 0 => {
+            // Every candidate of the order alone failed: fit the lower orders and carry
+            // them forward (the lower-order r is always a candidate), keeping the events.
+            let chained = FitSettings {
+                chain: true,
+                ..settings.clone()
+            };
+            fit_with(&ctx, &chained).map(|mut r| {
+                r.solver_events.insert(
+                    0,
+                    SolverEvent {
+                        order: settings.order,
+                        stage: "order alone".into(),
+                        status: SolverStatus::NoCandidate,
+                        action: format!("{e}; refitted with the lower orders carried forward"),
+                    },
+                );
+                r
+            })
+        }
+        other => other,
+    }
+}
+
+fn fit_with(ctx: &Context<'_>, settings: &FitSettings) -> Result<FitResult, FitError> {
     let start = if settings.chain { 0 } else { settings.order };
     let mut prev: Option<Scored> = None;
     let mut masks = (Vec::new(), Vec::new());

@@ -44,6 +44,8 @@ pub enum SolverStatus {
     InsufficientProgress,
     /// The solver could not be set up, or returned another status.
     SetupError,
+    /// Not a solver status: every candidate of an order failed (see the action).
+    NoCandidate,
 }
 
 impl SolverStatus {
