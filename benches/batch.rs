@@ -70,6 +70,7 @@ fn batch_1000(bencher: divan::Bencher) {
                     shard: Shard::ALL,
                     merged_from: vec![],
                     timings_ms: Default::default(),
+                    order: rshape::fit::OrderChoice::Auto { max: 8 },
                     factorization: Some(&config.factorization),
                 },
             )

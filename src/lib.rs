@@ -18,6 +18,7 @@ pub mod consistency;
 pub mod data;
 pub mod diagnose;
 pub mod error;
+pub mod fit;
 pub mod model;
 pub mod mu;
 pub mod pipeline;

@@ -136,9 +136,11 @@ fn paper_mimo_r1_is_consistent() {
     let cfg = dir.path().join("r1.toml");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.path().join("out");
-    run(&cfg, &out, &[]);
+    run(&cfg, &out, &["--order", "1"]);
     let rep = json(&out.join("report.json"));
     assert_eq!(rep["consistent"], true);
+    assert_eq!(rep["r_fitted"]["order"], 1);
+    assert_eq!(rep["certificate"]["passed"], true);
     assert_eq!(rep["failing_omegas"], serde_json::json!([]));
     let t = svg_text(&out.join("r_vs_delta.svg"));
     assert!(!t.contains("FAILING"));

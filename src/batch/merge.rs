@@ -31,7 +31,11 @@ pub struct MergeOutcome {
 
 /// Merges shard directories into `out`.  Two shards holding the same dataset index, or
 /// shards of different batches (different totals), are errors.
-pub fn merge(shards: &[PathBuf], out: &Path) -> Result<MergeOutcome> {
+pub fn merge(
+    shards: &[PathBuf],
+    out: &Path,
+    order: crate::fit::OrderChoice,
+) -> Result<MergeOutcome> {
     let t = std::time::Instant::now();
     if shards.is_empty() {
         return Err(Error::Invalid("give at least one shard directory".into()));
@@ -93,6 +97,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<MergeOutcome> {
             shard: Shard::ALL,
             merged_from: shards.to_vec(),
             timings_ms: timings,
+            order,
             factorization: config.as_ref().map(|c| &c.factorization),
         },
     )?;

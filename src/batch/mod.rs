@@ -112,6 +112,8 @@ pub struct FinishInput<'a> {
     pub merged_from: Vec<PathBuf>,
     /// Timings so far.
     pub timings_ms: BTreeMap<String, f64>,
+    /// Order of the fitted `r` (or automatic).
+    pub order: crate::fit::OrderChoice,
     /// The model, for the A1 limit `σ_min(M̃(jω))` the fitted `r` must stay below.
     pub factorization: Option<&'a crate::model::Factorization>,
 }
@@ -129,7 +131,7 @@ pub fn finish(
     let t = std::time::Instant::now();
     let a1 = inp.factorization.map(|f| move |w: f64| f.a1_limit(w));
     let a1_dyn: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
-    let fit = combined.map(|env| integration::fit_r(env, a1_dyn));
+    let fit = combined.map(|env| integration::fit_r(env, a1_dyn, inp.order));
     timings.insert("fit".into(), t.elapsed().as_secs_f64() * 1e3);
     let t = std::time::Instant::now();
     if let Some(env) = combined {

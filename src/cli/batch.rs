@@ -39,6 +39,9 @@ pub struct BatchArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// Order of the r fitted above the combined envelope, or `auto` (sweep 0..8).
+    #[arg(long, default_value = "auto")]
+    pub order: crate::fit::OrderChoice,
     /// Do not write OUT/datasets/NAME/ (only summary.csv, the combined envelope and r).
     #[arg(long)]
     pub no_dataset_files: bool,
@@ -120,6 +123,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             shard,
             merged_from: Vec::new(),
             timings_ms: timings,
+            order: a.order,
             factorization: Some(&config.factorization),
         },
     )?;

@@ -16,12 +16,15 @@ pub struct MergeArgs {
     /// Output directory of the merged batch.
     #[arg(long)]
     pub out: PathBuf,
+    /// Order of the r fitted above the merged envelope, or `auto` (sweep 0..8).
+    #[arg(long, default_value = "auto")]
+    pub order: crate::fit::OrderChoice,
 }
 
 /// Runs `rshape merge`.
 pub fn run(a: &MergeArgs) -> Result<i32> {
     let t = std::time::Instant::now();
-    let m = merge(&a.shards, &a.out)?;
+    let m = merge(&a.shards, &a.out, a.order)?;
     super::batch::print_summary(&m.report, &m.rows, &a.out, t.elapsed().as_secs_f64());
     if !m.missing.is_empty() {
         outln!(

@@ -18,6 +18,7 @@ pub mod common;
 pub mod compare;
 pub mod diagnose;
 pub mod envelope;
+pub mod fit;
 pub mod history;
 pub mod merge;
 pub mod run;
@@ -53,6 +54,8 @@ pub enum Command {
     Diagnose(diagnose::DiagnoseArgs),
     /// Error measures across model revisions (table and error-vs-revision SVG).
     History(history::HistoryArgs),
+    /// Fit the smallest certified unit r(s) above the envelope (or an envelope file).
+    Fit(fit::FitArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -74,6 +77,7 @@ pub fn main() -> i32 {
         Command::Compare(a) => compare::run(&a),
         Command::Diagnose(a) => diagnose::run(&a),
         Command::History(a) => history::run(&a),
+        Command::Fit(a) => fit::run(&a),
     };
     match result {
         Ok(code) => code,

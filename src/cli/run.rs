@@ -18,6 +18,9 @@ pub struct RunArgs {
     /// Output directory (created if needed).
     #[arg(long)]
     pub out: PathBuf,
+    /// Order of the fitted r, or `auto` (sweep 0..8 and pick the smallest good order).
+    #[arg(long, default_value = "auto")]
+    pub order: crate::fit::OrderChoice,
 }
 
 /// `order N, certificate passed` for a fit, or its `method` (the placeholder).
@@ -58,7 +61,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     let inputs = a.input.load()?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let (config, data) = (&inputs.config, &inputs.data);
-    let mut out = pipeline::run(config, data, a.input.noise_radius)?;
+    let mut out = pipeline::run(config, data, a.input.noise_radius, a.order)?;
     out.timings.0.insert("load".into(), load_ms);
     let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;
 

@@ -1,7 +1,9 @@
-//! Measured frequency-response data: the FRF set and its CSV reader.
+//! Measured frequency-response data: the FRF set and its CSV reader; envelope CSV files.
+pub mod envelope_csv;
 pub mod frf;
 pub mod reader;
 pub mod std_file;
 
+pub use envelope_csv::read_envelope_csv;
 pub use frf::FrfData;
 pub use reader::read_frf_csv;

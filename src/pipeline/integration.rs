@@ -1,20 +1,17 @@
 //! The points where the pipeline meets the noise model and the μ test (Theorem 4,
 //! [`crate::model::noise`], [`crate::consistency::noisy`], [`crate::mu`]) and the fit of `r`
-//! (branch `fit`).  Everything that depends on those modules goes through the functions here.
-//!
-//! Status: noise and μ are integrated.  Until the fit lands (`INTEGRATION(fit)` markers),
-//! the "fit" is a constant unit `r = 1.05·max r_min` (a valid unit of RH∞ that covers every
-//! finite datum), clearly labelled as a placeholder in every output.
+//! ([`crate::fit`], [`crate::report::export`]).  Everything that depends on those modules
+//! goes through the functions here.
 
 use crate::consistency::noisy::{gamma_lft, noisy_envelope, BisectionSettings};
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
+use crate::fit::{fit_auto, fit_unit, FitResult, FitSettings, OrderChoice, OrderRow};
 use crate::model::{Config, Factorization};
 use crate::mu::{mu_full_scalar, FullPlusScalar, MuSettings};
 use crate::system::TransferFunction;
-use serde::Serialize;
-use serde_json::{json, Value};
+use serde_json::Value;
 
 /// Per-datum noise radii with the precedence of [`crate::model::noise::resolve_noise`]:
 /// `--noise-radius` (or a manifest's per-dataset radius) > the config's `[noise]` > the data
@@ -82,76 +79,55 @@ pub fn mu_per_datum(
 pub struct FittedR {
     /// The fitted unit.
     pub r: TransferFunction,
-    /// The `r.json` document (coefficients, poles, zeros, gain, certificate).
+    /// The `r.json` document (coefficients, poles, zeros, gain, certificate, order table).
     pub json: Value,
-    /// The certificate part of `json`.
+    /// The certificate (as in `r.json`).
     pub certificate: Value,
+    /// The fit.
+    pub result: FitResult,
+    /// The order table of the automatic order choice.
+    pub table: Option<Vec<OrderRow>>,
 }
 
-/// A complex number as `[re, im]` in JSON.
-#[derive(Serialize)]
-struct C2([f64; 2]);
-
-/// Fits the smallest unit `r` above the envelope.
-// INTEGRATION(fit): call `fit::...` and take `r.json` from `report::export`.
-pub fn fit_r(env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) -> Result<FittedR> {
-    let top = env
-        .r_min
-        .iter()
-        .copied()
-        .filter(|r| r.is_finite())
-        .fold(0.0f64, f64::max);
-    if top <= 0.0 {
-        return Err(Error::Invalid(
-            "no datum with a finite, positive r_min: nothing to fit".into(),
-        ));
-    }
-    let k = 1.05 * top;
-    let r = TransferFunction::gain(k);
-    let ratios: Vec<f64> = env
-        .r_min
-        .iter()
-        .filter(|x| x.is_finite() && **x > 0.0)
-        .map(|x| k / x)
-        .collect();
-    let min_ratio = ratios.iter().copied().fold(f64::INFINITY, f64::min);
-    let a1_ok = match a1 {
-        Some(f) => env.omega.iter().all(|w| k < f(*w)),
-        None => env
-            .a1_limit
-            .as_ref()
-            .is_none_or(|a| a.iter().all(|l| k < *l)),
+/// Fits the smallest unit `r` above the envelope with the defaults of `rshape fit`
+/// (minimax objective; `order` fixed or chosen automatically), keeping `|r| < σ_min(M̃)`
+/// (A1) when `a1` is given.
+pub fn fit_r(
+    env: &Envelope,
+    a1: Option<&dyn Fn(f64) -> f64>,
+    order: OrderChoice,
+) -> Result<FittedR> {
+    let err = |e: crate::fit::FitError| Error::Invalid(format!("fit: {e}"));
+    let (result, table) = match order {
+        OrderChoice::Auto { max } => {
+            let (r, t) = fit_auto(env, a1, &FitSettings::default(), max).map_err(err)?;
+            (r, Some(t))
+        }
+        OrderChoice::Fixed(n) => {
+            let s = FitSettings {
+                order: n,
+                ..FitSettings::default()
+            };
+            (fit_unit(env, a1, &s).map_err(err)?, None)
+        }
     };
-    let certificate = json!({
-        "covers_all_finite_data": env.r_min.iter().filter(|x| x.is_finite()).all(|x| k > *x),
-        "min_ratio_at_data": min_ratio,
-        "a1_holds_at_data": a1_ok,
-        "infinite_data": env.r_min.iter().filter(|x| x.is_infinite()).count(),
-        "dense_grid_checked": false,
-    });
-    let json = json!({
-        "method": "constant_cover_placeholder",
-        "note": "placeholder until the fit module lands: r = 1.05 * max finite r_min",
-        "num": [k],
-        "den": [1.0],
-        "gain": k,
-        "poles": Vec::<C2>::new(),
-        "zeros": Vec::<C2>::new(),
-        "certificate": certificate,
-    });
+    let text = crate::report::export::r_json(&result, table.as_deref());
+    let json: Value =
+        serde_json::from_str(&text).map_err(|e| Error::Invalid(format!("r.json: {e}")))?;
+    let certificate = json
+        .get("certificate")
+        .cloned()
+        .unwrap_or_else(|| serde_json::to_value(&result.certificate).unwrap_or(Value::Null));
     Ok(FittedR {
-        r,
+        r: result.r.clone(),
         json,
         certificate,
+        result,
+        table,
     })
 }
 
-/// Writes the exports of a fitted `r` into `dir` and returns the files written.
-// INTEGRATION(fit): `report::export` writes r.json, r.m, r.py, r.jl.
+/// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` and returns the files written.
 pub fn export_r(fit: &FittedR, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
-    let path = dir.join("r.json");
-    let text = serde_json::to_string_pretty(&fit.json)
-        .map_err(|e| Error::Invalid(format!("r.json: {e}")))?;
-    crate::util::write_atomic(&path, text.as_bytes())?;
-    Ok(vec![path])
+    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir)
 }

@@ -49,7 +49,12 @@ pub struct RunOutcome {
 /// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
 /// sizes, a failed assumption at a datum) is an error; the fit and μ failures are kept in
 /// the outcome.
-pub fn run(config: &Config, data: &FrfData, noise_radius: Option<f64>) -> Result<RunOutcome> {
+pub fn run(
+    config: &Config,
+    data: &FrfData,
+    noise_radius: Option<f64>,
+    order: crate::fit::OrderChoice,
+) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
     let radii = integration::noise_radii(config, data, noise_radius)?;
@@ -59,7 +64,8 @@ pub fn run(config: &Config, data: &FrfData, noise_radius: Option<f64>) -> Result
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
         let a1 = |w: f64| f.a1_limit(w);
-        integration::fit_r(&envelope, Some(&a1)).map_err(|e| crate::cli::one_line(&e.to_string()))
+        integration::fit_r(&envelope, Some(&a1), order)
+            .map_err(|e| crate::cli::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {
         warnings.push(format!("fit failed: {e}"));

@@ -1,0 +1,86 @@
+//! `rshape fit` timing: a 1000-point envelope (smooth and jagged, 4 decades) at orders 2, 4
+//! and 6, minimax objective, certificate included; order N alone (the default) and orders
+//! 0..N chained.
+//! Target: ≤ 200 ms per fit at order ≤ 6.  Run: `cargo bench --bench fit`.
+
+use rshape::consistency::{Envelope, EnvelopeMethod};
+use rshape::fit::{fit_unit, FitSettings};
+use rshape::system::logspace;
+
+fn main() {
+    divan::main();
+}
+
+fn envelope(jagged: bool) -> Envelope {
+    let omega = logspace(0.1, 1000.0, 1000);
+    let mut seed = 7u64;
+    let r_min = omega
+        .iter()
+        .map(|w| {
+            let mut v = 0.05 * (1.0 + (w / 3.0).powi(2)).sqrt()
+                / (1.0 + (w / 200.0).powi(2)).sqrt()
+                * (1.0 + 2.0 / (1.0 + (4.0 * (w / 30.0).ln()).powi(2)));
+            if jagged {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                v *= 0.5 + 0.5 * ((seed >> 11) as f64 / (1u64 << 53) as f64);
+            }
+            v
+        })
+        .collect();
+    Envelope {
+        omega,
+        r_min,
+        a1_limit: None,
+        method: EnvelopeMethod::File,
+    }
+}
+
+/// Orders 0..N chained (`chain = true`, what `--order auto` does up to N).
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn smooth_1000_chained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(false);
+    let set = FitSettings {
+        order,
+        chain: true,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Orders 0..N chained (`chain = true`).
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn jagged_1000_chained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(true);
+    let set = FitSettings {
+        order,
+        chain: true,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Order N alone (`chain = false`, the default of `fit_unit` and `--order N`).
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn jagged_1000_unchained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(true);
+    let set = FitSettings {
+        order,
+        chain: false,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Order N alone (`chain = false`), smooth envelope.
+#[divan::bench(args = [2, 4, 6], sample_count = 10)]
+fn smooth_1000_unchained(bencher: divan::Bencher, order: usize) {
+    let env = envelope(false);
+    let set = FitSettings {
+        order,
+        chain: false,
+        ..Default::default()
+    };
+    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}

@@ -1,0 +1,86 @@
+//! `rshape fit CONFIG [--data FILE] [--noise-radius X] [--order N|auto] [--objective
+//! area|minimax] [--margin X] --out DIR`, or `rshape fit --envelope ENVELOPE.csv …`: the
+//! smallest certified unit r(s) above the envelope (GitHub issue 4).  A thin wrapper over
+//! [`crate::fit::run_fit`].
+
+use super::common::InputArgs;
+use crate::data::read_envelope_csv;
+use crate::fit::{run_fit, FitSettings, Objective, OrderChoice};
+use anyhow::{anyhow, Result};
+use clap::{Args, ValueEnum};
+use std::path::PathBuf;
+
+/// `--objective`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum ObjectiveArg {
+    /// Smallest max |r|/r_min over the data (log-Chebyshev), then smallest area.
+    Minimax,
+    /// Smallest log-frequency-weighted Σ|r|²/r_min².
+    Area,
+}
+
+/// Arguments of `rshape fit`.
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// The TOML config (model and data); omit it with --envelope.
+    pub config: Option<PathBuf>,
+    /// Data file overriding the one named in the config.
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Global noise-disk radius L_a overriding the config.
+    #[arg(long)]
+    pub noise_radius: Option<f64>,
+    /// Fit this envelope file (omega_rad_s,r_min[,a1_limit]) instead of a config.
+    #[arg(long, conflicts_with_all = ["config", "data", "noise_radius"])]
+    pub envelope: Option<PathBuf>,
+    /// Order of r, or `auto` (sweep 0..8, print the table, pick the smallest good order).
+    #[arg(long, default_value = "auto")]
+    pub order: OrderChoice,
+    /// What to minimize.
+    #[arg(long, value_enum, default_value = "minimax")]
+    pub objective: ObjectiveArg,
+    /// Relative margin: |r| ≥ (1 + margin)·r_min at every datum.
+    #[arg(long, default_value_t = 0.0)]
+    pub margin: f64,
+    /// Output directory for r.json, r.m, r.py, r.jl.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs `rshape fit`.
+pub fn run(a: &FitArgs) -> Result<i32> {
+    if !(a.margin.is_finite() && a.margin >= 0.0) {
+        return Err(anyhow!(
+            "--margin {}: must be a finite number ≥ 0",
+            a.margin
+        ));
+    }
+    let settings = FitSettings {
+        objective: match a.objective {
+            ObjectiveArg::Minimax => Objective::Minimax,
+            ObjectiveArg::Area => Objective::Area,
+        },
+        margin: a.margin,
+        ..Default::default()
+    };
+    let outcome = match (&a.envelope, &a.config) {
+        (Some(path), _) => {
+            let env = read_envelope_csv(path)?;
+            run_fit(&env, None, &settings, a.order, &a.out)?
+        }
+        (None, Some(config)) => {
+            let input = InputArgs {
+                config: config.clone(),
+                data: a.data.clone(),
+                noise_radius: a.noise_radius,
+            };
+            let (inputs, env) = input.envelope()?;
+            let f = &inputs.config.factorization;
+            let a1 = |w: f64| f.a1_limit(w);
+            run_fit(&env, Some(&a1), &settings, a.order, &a.out)?
+        }
+        (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),
+    };
+    print!("{}", outcome.text);
+    Ok(0)
+}

@@ -1,0 +1,302 @@
+//! Prescaling, the rational basis for `|r(jω)|²`, and the constraint grid.
+//!
+//! **Prescaling** (as MATLAB's `fitmagfrd` does): frequencies are divided by
+//! `ω₀ = √(ω_min·ω_max)` and magnitudes by `ρ`, the geometric mean of the positive finite
+//! `r_min`, so the solver sees numbers of order one.  Everything in this module works on the
+//! scaled variable `x = (ω/ω₀)²`.
+//!
+//! **Basis.**  `|r(jω)|² = A(x)/B(x)` with `A`, `B` real polynomials of degree `N` in `x`.
+//! Both are written over a fixed *reference* polynomial `D(x) = Π_k (x + q_k²)`, with the
+//! reference poles `q_k` log-spaced over the (scaled) data band:
+//!
+//! `A(x)/D(x) = a₀ + Σ_k a_k·q_k²/(x + q_k²)`, and likewise for `B`.
+//!
+//! Every basis function lies in `[0, 1]` for `x ≥ 0`, unlike raw monomials in `x`, whose
+//! values span `2N` times the number of decades.  Partial fractions over distinct `q_k` span
+//! all polynomials of degree ≤ `N` divided by `D`, so the choice of `q_k` affects only the
+//! conditioning, never which `r` can be represented: the poles of `r` stay free.
+
+/// Frequency and magnitude scales of a fit.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Scaling {
+    /// Frequency scale `ω₀` in rad/s: `ω̂ = ω/ω₀`.
+    pub omega0: f64,
+    /// Magnitude scale `ρ`: `|r̂| = |r|/ρ`.
+    pub rho: f64,
+}
+
+impl Scaling {
+    /// `ω₀ = √(ω_min·ω_max)` and `ρ` the geometric mean of the positive finite `r_min`
+    /// (1 when there is none).
+    pub fn from_data(omega: &[f64], r_min: &[f64]) -> Self {
+        let lo = omega.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = omega.iter().copied().fold(0.0, f64::max);
+        let omega0 = if lo.is_finite() && hi > 0.0 {
+            (lo * hi).sqrt()
+        } else {
+            1.0
+        };
+        let logs: Vec<f64> = r_min
+            .iter()
+            .filter(|r| r.is_finite() && **r > 0.0)
+            .map(|r| r.ln())
+            .collect();
+        let rho = if logs.is_empty() {
+            1.0
+        } else {
+            (logs.iter().sum::<f64>() / logs.len() as f64).exp()
+        };
+        Self { omega0, rho }
+    }
+}
+
+/// Reference poles `q_k` (scaled frequency units): `n` points log-spaced over the data band
+/// widened by a factor 3 on each side (one point at the geometric centre when `n = 1`).
+pub fn reference_poles(n: usize, w_lo: f64, w_hi: f64) -> Vec<f64> {
+    let (lo, hi) = ((w_lo / 3.0).ln(), (w_hi * 3.0).ln());
+    match n {
+        0 => Vec::new(),
+        1 => vec![(0.5 * (lo + hi)).exp()],
+        _ => (0..n)
+            .map(|k| (lo + (hi - lo) * k as f64 / (n - 1) as f64).exp())
+            .collect(),
+    }
+}
+
+/// The basis row `[1, q_1²/(x+q_1²), …, q_N²/(x+q_N²)]` at `x = ω̂²`; `x = ∞` gives `[1, 0, …]`.
+pub fn basis_row(q: &[f64], x: f64) -> Vec<f64> {
+    let mut row = Vec::with_capacity(q.len() + 1);
+    row.push(1.0);
+    for qk in q {
+        let q2 = qk * qk;
+        row.push(if x.is_infinite() { 0.0 } else { q2 / (x + q2) });
+    }
+    row
+}
+
+/// Value of `c₀ + Σ c_k q_k²/(x+q_k²)` at `x`.
+pub fn basis_eval(q: &[f64], c: &[f64], x: f64) -> f64 {
+    basis_row(q, x).iter().zip(c).map(|(a, b)| a * b).sum()
+}
+
+/// What a grid point stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointKind {
+    /// A datum of the envelope.
+    Datum,
+    /// A dense-grid point inside the data band.
+    Band,
+    /// A dense-grid point outside the data band (two decades on each side).
+    Outside,
+    /// `ω = ∞`.
+    Infinity,
+}
+
+/// One constraint point in scaled units; all bounds are on `|r̂|²`.
+#[derive(Debug, Clone, Copy)]
+pub struct GridPoint {
+    /// Scaled frequency `ω̂` (`inf` for the point at infinity).
+    pub w: f64,
+    /// `x = ω̂²`.
+    pub x: f64,
+    /// Lower bound on `|r̂|²` (the data bound, the no-dip bound between data, or the floor).
+    pub lower: f64,
+    /// Envelope for the upper bound: `|r̂|² ≤ t·upper` (`None`: no such bound).
+    pub upper: Option<f64>,
+    /// A1 limit on `|r̂|²` (`None`: unknown).
+    pub a1: Option<f64>,
+    /// What the point stands for.
+    pub kind: PointKind,
+    /// Index of the datum for `Datum` points.
+    pub datum: Option<usize>,
+}
+
+/// Log-spaced grid with at least `per_decade` points per decade from `lo` to `hi`.
+pub fn dense_grid(lo: f64, hi: f64, per_decade: usize) -> Vec<f64> {
+    let decades = (hi / lo).log10().max(0.0);
+    let n = ((decades * per_decade as f64).ceil() as usize).max(1) + 1;
+    crate::system::logspace(lo, hi, n)
+}
+
+/// Inputs of the grid construction, in scaled units.
+pub struct GridSpec<'a> {
+    /// Scaled data frequencies, increasing.
+    pub w: &'a [f64],
+    /// Scaled lower bounds `((1+margin)·r_min/ρ)²` per datum (0: no bound).
+    pub lower: &'a [f64],
+    /// A1 limit `(σ_min(M̃)/ρ)²` as a function of the scaled frequency, if known.
+    pub a1: Option<&'a dyn Fn(f64) -> f64>,
+    /// A1 limit per datum (scaled, squared), used when no function is given.
+    pub a1_data: Option<&'a [f64]>,
+    /// Floor on `|r̂|²` everywhere.
+    pub floor: f64,
+    /// Points per decade of the dense grid.
+    pub per_decade: usize,
+    /// Decades added on each side of the data band.
+    pub extend_decades: f64,
+    /// Enforce `|r| ≥ min(neighbouring data bounds)` between data (no dips).
+    pub no_dip: bool,
+}
+
+/// Builds the constraint points: every datum, a dense grid over the data band (no-dip lower
+/// bound, local upper envelope), the two extensions (floor only, upper envelope from the
+/// nearest decade of data), `ω = 0` and `ω = ∞`.
+pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
+    let n = spec.w.len();
+    let (w_lo, w_hi) = (spec.w[0], spec.w[n - 1]);
+    let ext = 10f64.powf(spec.extend_decades);
+    let a1_at = |w: f64| -> Option<f64> {
+        match (spec.a1, spec.a1_data) {
+            (Some(f), _) => Some(f(w)),
+            (None, Some(d)) => Some(interp_loglog(spec.w, d, w)?),
+            _ => None,
+        }
+    };
+    let edge_upper = |at_low: bool| -> f64 {
+        let mut m: f64 = 0.0;
+        for (wi, li) in spec.w.iter().zip(spec.lower) {
+            let near = if at_low {
+                *wi <= w_lo * 10.0
+            } else {
+                *wi >= w_hi / 10.0
+            };
+            if near {
+                m = m.max(*li);
+            }
+        }
+        m.max(spec.floor)
+    };
+    let (up_lo, up_hi) = (edge_upper(true), edge_upper(false));
+    let mut pts = Vec::with_capacity(n + 8 * spec.per_decade);
+    for i in 0..n {
+        pts.push(GridPoint {
+            w: spec.w[i],
+            x: spec.w[i] * spec.w[i],
+            lower: spec.lower[i].max(spec.floor),
+            upper: Some(spec.lower[i].max(spec.floor)),
+            a1: match (spec.a1, spec.a1_data) {
+                (Some(f), _) => Some(f(spec.w[i])),
+                (None, Some(d)) => Some(d[i]),
+                _ => None,
+            },
+            kind: PointKind::Datum,
+            datum: Some(i),
+        });
+    }
+    let mut j = 0; // index of the datum at or below w
+    for w in dense_grid(w_lo / ext, w_hi * ext, spec.per_decade) {
+        let (lower, upper, kind) = if w < w_lo {
+            (spec.floor, up_lo, PointKind::Outside)
+        } else if w > w_hi {
+            (spec.floor, up_hi, PointKind::Outside)
+        } else {
+            while j + 1 < n && spec.w[j + 1] <= w {
+                j += 1;
+            }
+            let k = (j + 1).min(n - 1);
+            // Skip grid points that coincide with a datum (relative 1e-9).
+            if (w / spec.w[j] - 1.0).abs() < 1e-9 || (w / spec.w[k] - 1.0).abs() < 1e-9 {
+                continue;
+            }
+            let (a, b) = (spec.lower[j], spec.lower[k]);
+            let lower = if spec.no_dip { a.min(b) } else { 0.0 };
+            (
+                lower.max(spec.floor),
+                a.max(b).max(spec.floor),
+                PointKind::Band,
+            )
+        };
+        pts.push(GridPoint {
+            w,
+            x: w * w,
+            lower,
+            upper: Some(upper),
+            a1: a1_at(w),
+            kind,
+            datum: None,
+        });
+    }
+    // ω = 0: the floor holds at DC too (a root of A at x = 0 is a zero at s = 0).
+    pts.push(GridPoint {
+        w: 0.0,
+        x: 0.0,
+        lower: spec.floor,
+        upper: Some(up_lo),
+        a1: match (spec.a1, spec.a1_data) {
+            (Some(f), _) => Some(f(w_lo / ext / 10.0)),
+            _ => None,
+        },
+        kind: PointKind::Outside,
+        datum: None,
+    });
+    // ω = ∞: A1 from a frequency far above the band (the factors are proper, so the limit
+    // settles), when a function is known.
+    pts.push(GridPoint {
+        w: f64::INFINITY,
+        x: f64::INFINITY,
+        lower: spec.floor,
+        upper: Some(up_hi),
+        a1: spec.a1.map(|f| f(w_hi * 1e6)),
+        kind: PointKind::Infinity,
+        datum: None,
+    });
+    pts
+}
+
+/// Log-log linear interpolation of `y(w)` inside `[w_0, w_n]`; `None` outside.
+pub fn interp_loglog(w: &[f64], y: &[f64], at: f64) -> Option<f64> {
+    let n = w.len();
+    if n == 0 || at < w[0] || at > w[n - 1] {
+        return None;
+    }
+    if n == 1 {
+        return Some(y[0]);
+    }
+    let k = w.partition_point(|v| *v <= at).clamp(1, n - 1);
+    let (w0, w1, y0, y1) = (w[k - 1], w[k], y[k - 1], y[k]);
+    if y0 <= 0.0 || y1 <= 0.0 || w1 == w0 {
+        return Some(y0.min(y1));
+    }
+    let t = (at / w0).ln() / (w1 / w0).ln();
+    Some((y0.ln() + t * (y1 / y0).ln()).exp())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_spans_polynomials() {
+        // (x + 2)/(x + 1) with q = 1: a0 = 1, a1·1/(x+1) = 1/(x+1) → a1 = 1.
+        let q = [1.0];
+        for x in [0.0, 0.5, 3.0, 100.0] {
+            assert!((basis_eval(&q, &[1.0, 1.0], x) - (x + 2.0) / (x + 1.0)).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn grid_has_data_band_outside_and_infinity() {
+        let w = [0.1, 1.0, 10.0];
+        let lower = [4.0, 1.0, 0.25];
+        let g = build_grid(&GridSpec {
+            w: &w,
+            lower: &lower,
+            a1: None,
+            a1_data: None,
+            floor: 1e-6,
+            per_decade: 50,
+            extend_decades: 2.0,
+            no_dip: true,
+        });
+        assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
+        assert!(g.iter().any(|p| p.kind == PointKind::Infinity));
+        assert!(g.iter().filter(|p| p.kind == PointKind::Band).count() >= 95);
+        let lo = g
+            .iter()
+            .map(|p| p.w)
+            .filter(|w| *w > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        assert!(g.iter().any(|p| p.w == 0.0));
+        assert!((lo - 1e-3).abs() < 1e-12);
+    }
+}

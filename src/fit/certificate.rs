@@ -1,0 +1,317 @@
+//! The certificate: the final `r(s)` re-evaluated, in rad/s and unscaled units, from its
+//! poles and zeros (not from the LP variables), at every datum and on a dense grid
+//! (`≥ 50` points per decade over the band widened by two decades each side), refined by
+//! golden-section search inside every grid cell where a margin is small — between data for
+//! the no-dip bound, and near the A1 limit.
+//!
+//! If coverage fails (LP tolerance, or a dip between data), the gain is rescaled by the
+//! worst under-coverage, as MATLAB's `ucover` does, and everything is checked again; a
+//! failure that remains (for example A1 broken by the rescaling) is reported, never hidden.
+
+use super::spectral::Zpk;
+use serde::Serialize;
+
+/// What the certificate checked and found.  Frequencies in rad/s.
+#[derive(Debug, Clone, Serialize)]
+pub struct Certificate {
+    /// True when every check passed.
+    pub passed: bool,
+    /// One line per failed check.
+    pub failures: Vec<String>,
+    /// `min |r(jω_i)|/r_min,i` over the data with `r_min > 0` (must be ≥ 1 + margin).
+    pub worst_ratio: f64,
+    /// Where the worst ratio is.
+    pub worst_ratio_omega: f64,
+    /// Mean of `log10(|r|/r_min)` over the data (conservatism).
+    pub mean_log10_ratio: f64,
+    /// Max of `log10(|r|/r_min)` over the data.
+    pub max_log10_ratio: f64,
+    /// `min |r|/min(r_min,i, r_min,i+1)` between consecutive data (no dip), refined.
+    pub worst_between_ratio: f64,
+    /// Where it is.
+    pub worst_between_omega: f64,
+    /// `min σ_min(M̃(jω))/|r(jω)|` on the dense grid (refined), when the A1 limit is known
+    /// (must be > 1).
+    pub worst_a1_margin: Option<f64>,
+    /// Where it is.
+    pub worst_a1_omega: Option<f64>,
+    /// How A1 was checked: `function` (dense grid), `data` (only at the data), `none`.
+    pub a1_checked_on: String,
+    /// `min |r(jω)|` over the dense grid and `ω = ∞` (strict positivity).
+    pub min_abs_r: f64,
+    /// `|r(∞)|` (biproper: nonzero).
+    pub r_at_infinity: f64,
+    /// `min |Re p|` over the poles (rad/s); `inf` for order 0.
+    pub min_axis_distance_pole: f64,
+    /// `min |Re z|` over the zeros (rad/s); `inf` for order 0.
+    pub min_axis_distance_zero: f64,
+    /// `min |Re|/|root|` over poles and zeros (damping; 1 for real roots).
+    pub min_damping: f64,
+    /// Number of frequencies evaluated (grid, data and refinement).
+    pub grid_points: usize,
+    /// Gain factor applied by the repair (1: none).
+    pub repair_factor: f64,
+}
+
+/// Inputs of the certificate, unscaled.
+pub struct CertInput<'a> {
+    /// Data frequencies (rad/s), increasing.
+    pub omega: &'a [f64],
+    /// `r_min` per datum (0: no bound; never `inf` here).
+    pub r_min: &'a [f64],
+    /// A1 limit function, if known.
+    pub a1: Option<&'a dyn Fn(f64) -> f64>,
+    /// A1 limit per datum, if known.
+    pub a1_data: Option<&'a [f64]>,
+    /// Required relative margin over `r_min`.
+    pub margin: f64,
+    /// Floor on `|r|` everywhere.
+    pub floor: f64,
+    /// Grid density.
+    pub per_decade: usize,
+    /// Decades beyond the data band.
+    pub extend_decades: f64,
+    /// Check the no-dip bound between data.
+    pub no_dip: bool,
+    /// Smallest accepted `|Re|/|root|`.
+    pub axis_tol: f64,
+}
+
+fn golden_min(f: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, iters: usize) -> (f64, f64) {
+    // On ln ω.
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut fd) = (f(c.exp()), f(d.exp()));
+    for _ in 0..iters {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c.exp());
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d.exp());
+        }
+    }
+    if fc < fd {
+        (c.exp(), fc)
+    } else {
+        (d.exp(), fd)
+    }
+}
+
+/// Minimum of `f` over the sorted grid `w`, refined by golden section around every grid
+/// cell whose value is below `refine_below` (at most `max_refine` cells, lowest first).
+fn refined_min(
+    f: &dyn Fn(f64) -> f64,
+    w: &[f64],
+    refine_below: f64,
+    max_refine: usize,
+    count: &mut usize,
+) -> (f64, f64) {
+    let vals: Vec<f64> = w.iter().map(|x| f(*x)).collect();
+    *count += w.len();
+    let mut best = (f64::NAN, f64::INFINITY);
+    let mut cells: Vec<usize> = Vec::new();
+    for (i, v) in vals.iter().enumerate() {
+        if *v < best.1 || best.0.is_nan() {
+            best = (w[i], *v);
+        }
+        let left = i == 0 || vals[i - 1] >= *v;
+        let right = i + 1 == vals.len() || vals[i + 1] >= *v;
+        if *v < refine_below && left && right {
+            cells.push(i);
+        }
+    }
+    cells.sort_by(|a, b| vals[*a].total_cmp(&vals[*b]));
+    for &i in cells.iter().take(max_refine) {
+        let a = w[i.saturating_sub(1)].ln();
+        let b = w[(i + 1).min(w.len() - 1)].ln();
+        if b > a {
+            let (x, v) = golden_min(f, a, b, 40);
+            *count += 42;
+            if v < best.1 {
+                best = (x, v);
+            }
+        }
+    }
+    best
+}
+
+/// Computes the certificate of `r` without any repair.
+pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
+    let n = inp.omega.len();
+    let mut count = 0usize;
+    let mut failures = Vec::new();
+    let need = 1.0 + inp.margin;
+    // Data.
+    let (mut worst, mut worst_w, mut sum, mut cnt, mut max) =
+        (f64::INFINITY, f64::NAN, 0.0, 0usize, f64::NEG_INFINITY);
+    for i in 0..n {
+        if inp.r_min[i] > 0.0 {
+            let ratio = r.mag(inp.omega[i]) / inp.r_min[i];
+            if ratio < worst {
+                worst = ratio;
+                worst_w = inp.omega[i];
+            }
+            sum += ratio.log10();
+            cnt += 1;
+            max = max.max(ratio.log10());
+        }
+    }
+    count += n;
+    if worst < need {
+        failures.push(format!(
+            "datum at ω = {worst_w:.6e} rad/s not covered: |r|/r_min = {worst:.9} < {need}"
+        ));
+    }
+    // Dense grid.
+    let (lo, hi) = (inp.omega[0], inp.omega[n - 1]);
+    let ext = 10f64.powf(inp.extend_decades);
+    let grid = super::basis::dense_grid(lo / ext, hi * ext, inp.per_decade);
+    // Between data: ratio to the smaller neighbouring bound.
+    let (mut between, mut between_w) = (f64::INFINITY, f64::NAN);
+    if inp.no_dip && n > 1 {
+        let bound = |w: f64| -> f64 {
+            let k = inp.omega.partition_point(|v| *v <= w).clamp(1, n - 1);
+            inp.r_min[k - 1].min(inp.r_min[k])
+        };
+        let f = |w: f64| {
+            let b = bound(w);
+            if b > 0.0 {
+                r.mag(w) / b
+            } else {
+                f64::INFINITY
+            }
+        };
+        let mut band: Vec<f64> = grid
+            .iter()
+            .copied()
+            .filter(|w| *w > lo && *w < hi)
+            .collect();
+        band.extend_from_slice(inp.omega);
+        band.sort_by(f64::total_cmp);
+        // Refine per data interval: the minimum of |r| inside an interval.
+        let (bw, bv) = refined_min(&f, &band, need * 1.02, 200, &mut count);
+        between = bv;
+        between_w = bw;
+        if between < need * (1.0 - 1e-9) {
+            failures.push(format!(
+                "|r| dips between data: at ω = {between_w:.6e} rad/s, |r|/min(neighbouring r_min) = {between:.9}"
+            ));
+        }
+    }
+    // A1.
+    let (mut a1m, mut a1w, a1_on) = (None, None, String::from("none"));
+    let a1_on = if let Some(a1) = inp.a1 {
+        let f = |w: f64| a1(w) / r.mag(w);
+        let mut all = grid.clone();
+        all.extend_from_slice(inp.omega);
+        all.sort_by(f64::total_cmp);
+        let (w, v) = refined_min(&f, &all, 1.05, 200, &mut count);
+        let far = a1(hi * 1e6) / r.gain.abs();
+        let (w, v) = if far < v {
+            (f64::INFINITY, far)
+        } else {
+            (w, v)
+        };
+        a1m = Some(v);
+        a1w = Some(w);
+        "function".to_string()
+    } else if let Some(d) = inp.a1_data {
+        let mut m = (f64::NAN, f64::INFINITY);
+        for (w, a) in inp.omega.iter().zip(d) {
+            let v = a / r.mag(*w);
+            if v < m.1 {
+                m = (*w, v);
+            }
+        }
+        a1m = Some(m.1);
+        a1w = Some(m.0);
+        "data".to_string()
+    } else {
+        a1_on
+    };
+    if let (Some(m), Some(w)) = (a1m, a1w) {
+        if !(m > 1.0) {
+            failures.push(format!(
+                "A1 fails: |r| ≥ σ_min(M̃) at ω = {w:.6e} rad/s (σ_min/|r| = {m:.9})"
+            ));
+        }
+    }
+    // Positivity and units.
+    let min_abs = grid.iter().map(|w| r.mag(*w)).fold(r.gain.abs(), f64::min);
+    count += grid.len();
+    if !(min_abs >= inp.floor * (1.0 - 1e-6)) {
+        failures.push(format!(
+            "|r| falls to {min_abs:.3e}, below the floor {:.3e}",
+            inp.floor
+        ));
+    }
+    if !(r.gain > 0.0 && r.gain.is_finite()) || r.zeros.len() != r.poles.len() {
+        failures.push("r is not biproper with a positive finite gain".into());
+    }
+    let dist = |v: &[num_complex::Complex64]| v.iter().map(|z| -z.re).fold(f64::INFINITY, f64::min);
+    let (dp, dz) = (dist(&r.poles), dist(&r.zeros));
+    let damping = r
+        .poles
+        .iter()
+        .chain(&r.zeros)
+        .map(|z| -z.re / z.norm())
+        .fold(1.0, f64::min);
+    if !(dp > 0.0) || !(dz > 0.0) || !(damping > inp.axis_tol) {
+        failures.push(format!(
+            "a pole or zero is on or near the jω-axis (min |Re p| = {dp:.3e}, min |Re z| = {dz:.3e}, damping {damping:.3e})"
+        ));
+    }
+    Certificate {
+        passed: failures.is_empty(),
+        failures,
+        worst_ratio: worst,
+        worst_ratio_omega: worst_w,
+        mean_log10_ratio: if cnt > 0 { sum / cnt as f64 } else { 0.0 },
+        max_log10_ratio: max,
+        worst_between_ratio: between,
+        worst_between_omega: between_w,
+        worst_a1_margin: a1m,
+        worst_a1_omega: a1w,
+        a1_checked_on: a1_on,
+        min_abs_r: min_abs,
+        r_at_infinity: r.gain.abs(),
+        min_axis_distance_pole: dp,
+        min_axis_distance_zero: dz,
+        min_damping: damping,
+        grid_points: count,
+        repair_factor: 1.0,
+    }
+}
+
+/// Certifies `r`; if coverage fails, rescales the gain by the worst under-coverage
+/// (`ucover` style) and certifies again.  Returns the (possibly rescaled) `r` and its
+/// certificate, which says whether it passed.
+pub fn certify_and_repair(r: &Zpk, inp: &CertInput) -> (Zpk, Certificate) {
+    let c = certify(r, inp);
+    if c.passed {
+        return (r.clone(), c);
+    }
+    let need = 1.0 + inp.margin;
+    let under = c.worst_ratio.min(if inp.no_dip {
+        c.worst_between_ratio
+    } else {
+        f64::INFINITY
+    });
+    if !(under < need) || !under.is_finite() || under <= 0.0 {
+        return (r.clone(), c);
+    }
+    let factor = need / under * (1.0 + 1e-9);
+    let mut fixed = r.clone();
+    fixed.gain *= factor;
+    let mut c2 = certify(&fixed, inp);
+    c2.repair_factor = factor;
+    (fixed, c2)
+}

@@ -1,0 +1,112 @@
+//! Order selection: fit orders `0..=n_max` in one chained sweep (each order starts from the
+//! previous one, so conservatism never increases), tabulate order against conservatism
+//! (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest order whose
+//! mean and max are both within `auto_tolerance` of the best in the table.
+
+use super::engine::{fit_order, Scored};
+use super::{prepare, A1Fn, FitError, FitResult, FitSettings};
+use crate::consistency::Envelope;
+use serde::Serialize;
+
+/// One row of the order table.
+#[derive(Debug, Clone, Serialize)]
+pub struct OrderRow {
+    /// Order.
+    pub order: usize,
+    /// Mean `log10(|r|/r_min)` over the data (certified `r`); `NaN` when the order failed.
+    pub mean_log10: f64,
+    /// Max `log10(|r|/r_min)` over the data.
+    pub max_log10: f64,
+    /// `ok`, or why the order failed.
+    pub status: String,
+    /// Solver calls of this order that did not end in `Solved`.
+    pub solver_events: usize,
+}
+
+/// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table.
+pub fn fit_auto(
+    env: &Envelope,
+    a1: Option<A1Fn<'_>>,
+    settings: &FitSettings,
+    n_max: usize,
+) -> Result<(FitResult, Vec<OrderRow>), FitError> {
+    let ctx = prepare(env, a1, settings)?;
+    let mut prev: Option<Scored> = None;
+    let mut masks = (Vec::new(), Vec::new());
+    let mut rows = Vec::new();
+    let mut fits: Vec<Option<FitResult>> = Vec::new();
+    let mut events = Vec::new();
+    let mut solves = 0;
+    let mut last_err = None;
+    for n in 0..=n_max {
+        let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
+        let ne = of.events.len();
+        events.extend(of.events);
+        solves += of.lp_solves;
+        match ctx.certify_ranked(n, &of.ranked, events.clone(), solves, settings) {
+            Ok((res, sc)) => {
+                rows.push(OrderRow {
+                    order: n,
+                    mean_log10: res.certificate.mean_log10_ratio,
+                    max_log10: res.certificate.max_log10_ratio,
+                    status: "ok".into(),
+                    solver_events: ne,
+                });
+                prev = Some(sc);
+                fits.push(Some(res));
+            }
+            Err(e) => {
+                rows.push(OrderRow {
+                    order: n,
+                    mean_log10: f64::NAN,
+                    max_log10: f64::NAN,
+                    status: e.to_string(),
+                    solver_events: ne,
+                });
+                fits.push(None);
+                last_err = Some(e);
+            }
+        }
+    }
+    let ok = rows.iter().filter(|r| r.status == "ok");
+    let best_mean = ok
+        .clone()
+        .map(|r| r.mean_log10)
+        .fold(f64::INFINITY, f64::min);
+    let best_max = ok.map(|r| r.max_log10).fold(f64::INFINITY, f64::min);
+    let tol = settings.auto_tolerance;
+    let chosen = rows.iter().position(|r| {
+        r.status == "ok" && r.mean_log10 <= best_mean + tol && r.max_log10 <= best_max + tol
+    });
+    match chosen {
+        Some(i) => {
+            let mut res = fits[i].take().expect("row ok has a fit");
+            res.solver_events = events;
+            res.lp_solves = solves;
+            Ok((res, rows))
+        }
+        None => Err(last_err.unwrap_or_else(|| FitError::Invalid("no order fitted".into()))),
+    }
+}
+
+/// The order table as aligned text, with the chosen order marked.
+pub fn format_table(rows: &[OrderRow], chosen: usize, tol: f64) -> String {
+    let mut s = format!(
+        "{:>5}  {:>18}  {:>14}  {}\n",
+        "order", "mean log10 r/r_min", "max log10", "status"
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "{:>5}  {:>18.5}  {:>14.5}  {}{}\n",
+            r.order,
+            r.mean_log10,
+            r.max_log10,
+            r.status,
+            if r.order == chosen { "  <- chosen" } else { "" }
+        ));
+    }
+    s.push_str(&format!(
+        "chosen: the smallest order whose mean and max are within {tol} (log10) of the best\n"
+    ));
+    s
+}
