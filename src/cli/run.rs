@@ -23,7 +23,7 @@ pub struct RunArgs {
     pub order: crate::fit::OrderChoice,
 }
 
-/// `order N, certificate passed` for a fit, or its `method` (the placeholder).
+/// `order N, certificate passed` for an `r.json` document (or its `method`, if it names one).
 pub fn fit_tag(j: &serde_json::Value) -> String {
     if let Some(m) = j.get("method").and_then(|m| m.as_str()) {
         return m.to_string();
