@@ -101,8 +101,8 @@ fn paper_mimo_report_and_figures() {
         "configured r = (1.0000e-8 s + 0.3)/(s + 1)",
         "fitted r",
         "A1 limit σ_min(M̃(jω))",
-        "‖Δᵢ‖, min-norm perturbation (Thm 2, eq. 8) (explained)",
-        "FAILING, |r(jω)| ≤ r_min",
+        "‖Δᵢ‖, min-norm perturbation (Thm 2, eq. 8): explained by the configured r",
+        "FAILING, configured |r(jω)| ≤ r_min",
     ] {
         assert!(t.contains(label), "r_vs_delta.svg lacks `{label}`");
     }

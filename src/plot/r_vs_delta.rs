@@ -129,7 +129,11 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
             chart
                 .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
                 .map_err(plot_err)?
-                .label(format!("{} (explained)", inp.r_min_label))
+                .label(if inp.r_configured.is_some() {
+                    format!("{}: explained by the configured r", inp.r_min_label)
+                } else {
+                    inp.r_min_label.to_string()
+                })
                 .legend(|(x, y)| Circle::new((x + 12, y), 5, C_GREEN.filled()));
         }
         let bad = pts(true);
@@ -141,7 +145,10 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                         + Cross::new((0, 0), 5, C_RED.stroke_width(2))
                 }))
                 .map_err(plot_err)?
-                .label(format!("{}: FAILING, |r(jω)| ≤ r_min", inp.r_min_label))
+                .label(format!(
+                    "{}: FAILING, configured |r(jω)| ≤ r_min",
+                    inp.r_min_label
+                ))
                 .legend(|(x, y)| {
                     EmptyElement::at((x + 12, y))
                         + Circle::new((0, 0), 7, C_RED.stroke_width(3))
