@@ -8,6 +8,7 @@
 //! comments.  This reads the `envelope.csv` that `rshape envelope` writes.  Rows are sorted by
 //! frequency; duplicate frequencies are errors.  Every error names the file and the line.
 
+use super::table::Table;
 use crate::consistency::{Envelope, EnvelopeMethod};
 use crate::error::{Error, Result};
 use std::path::Path;
@@ -30,24 +31,11 @@ fn parse_num(s: &str) -> Option<f64> {
 
 /// Parses envelope CSV text; `path` is used in messages.
 pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
-    let err = |line: usize, msg: String| Error::Data {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(k, l)| (k + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = rows.next().ok_or_else(|| {
-        err(
-            1,
-            "empty file: expected the header `omega_rad_s,r_min[,a1_limit]`".into(),
-        )
-    })?;
+    let table = Table::parse(text, path, "omega_rad_s,r_min[,a1_limit]")?;
+    let err = |line: usize, msg: String| table.err(line, msg);
+    let hline = table.header_line;
     let (mut cw, mut cr, mut ca) = (None, None, None);
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let names = &table.names;
     for (k, name) in names.iter().enumerate() {
         let slot = match *name {
             "omega_rad_s" => &mut cw,
@@ -73,14 +61,8 @@ pub fn parse_envelope_csv(text: &str, path: &Path) -> Result<Envelope> {
         ));
     };
     let mut data: Vec<(f64, f64, Option<f64>, usize)> = Vec::new();
-    for (line, row) in rows {
-        let cells: Vec<&str> = row.split(',').map(str::trim).collect();
-        if cells.len() != names.len() {
-            return Err(err(
-                line,
-                format!("{} cells, the header has {}", cells.len(), names.len()),
-            ));
-        }
+    for (line, cells) in &table.rows {
+        let line = *line;
         let w = parse_num(cells[cw])
             .filter(|w| w.is_finite() && *w > 0.0)
             .ok_or_else(|| {

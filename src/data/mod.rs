@@ -3,6 +3,7 @@ pub mod envelope_csv;
 pub mod frf;
 pub mod reader;
 pub mod std_file;
+pub mod table;
 
 pub use envelope_csv::read_envelope_csv;
 pub use frf::FrfData;

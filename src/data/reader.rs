@@ -6,6 +6,7 @@
 //! per-frequency noise radius.  Lines starting with `#` are comments.
 
 use super::frf::FrfData;
+use super::table::Table;
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -31,33 +32,10 @@ pub fn read_frf_csv(path: &Path) -> Result<FrfData> {
 
 /// Parses FRF CSV text; `path` is used in messages.
 pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
-    let err = |line: usize, msg: String| Error::Data {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(k, l)| (k + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = rows.next().ok_or_else(|| {
-        err(
-            1,
-            "empty file: expected a header such as `freq_hz,re_1_1,im_1_1`".into(),
-        )
-    })?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let hz = match names[0] {
-        "omega_rad_s" => false,
-        "freq_hz" => true,
-        other => {
-            return Err(err(
-                hline,
-                format!("first column is `{other}`: it must be `omega_rad_s` or `freq_hz`"),
-            ))
-        }
-    };
+    let table = Table::parse(text, path, "freq_hz,re_1_1,im_1_1")?;
+    let err = |line: usize, msg: String| table.err(line, msg);
+    let (hline, names) = (table.header_line, &table.names);
+    let hz = table.first_column_is_hz()?;
     let mut cells: HashMap<(usize, usize, Part), usize> = HashMap::new();
     let mut noise_col = None;
     let (mut p, mut m) = (0, 0);
@@ -126,14 +104,8 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
         }
     }
     let mut data: Vec<(f64, DMatrix<Complex64>, Option<f64>, usize)> = Vec::new();
-    for (line, row) in rows {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
-        if fields.len() != names.len() {
-            return Err(err(
-                line,
-                format!("{} fields, the header has {}", fields.len(), names.len()),
-            ));
-        }
+    for (line, fields) in &table.rows {
+        let line = *line;
         let num = |col: usize| -> Result<f64> {
             let v: f64 = fields[col].parse().map_err(|_| {
                 err(

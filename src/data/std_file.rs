@@ -1,6 +1,7 @@
 //! Reader of FRF standard-deviation files (`freq_hz` or `omega_rad_s`, then `std_i_j`
 //! columns), converted to per-frequency noise radii with a stated factor (e.g. 3σ).
 
+use super::table::Table;
 use crate::error::{Error, Result};
 use std::collections::HashMap;
 use std::path::Path;
@@ -22,30 +23,10 @@ pub fn read_std_csv(path: &Path) -> Result<StdData> {
         path: path.to_path_buf(),
         source,
     })?;
-    let err = |line: usize, msg: String| Error::Data {
-        path: path.to_path_buf(),
-        line,
-        msg,
-    };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(k, l)| (k + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hline, header) = rows
-        .next()
-        .ok_or_else(|| err(1, "empty file: expected a header `freq_hz,std_1_1`".into()))?;
-    let names: Vec<&str> = header.split(',').map(str::trim).collect();
-    let hz = match names[0] {
-        "freq_hz" => true,
-        "omega_rad_s" => false,
-        other => {
-            return Err(err(
-                hline,
-                format!("first column is `{other}`: it must be `omega_rad_s` or `freq_hz`"),
-            ))
-        }
-    };
+    let table = Table::parse(&text, path, "freq_hz,std_1_1")?;
+    let err = |line: usize, msg: String| table.err(line, msg);
+    let (hline, names) = (table.header_line, &table.names);
+    let hz = table.first_column_is_hz()?;
     let mut cols = Vec::new();
     for name in &names[1..] {
         let key = name
@@ -61,14 +42,8 @@ pub fn read_std_csv(path: &Path) -> Result<StdData> {
         std: cols.iter().map(|k| (*k, Vec::new())).collect(),
         lines: Vec::new(),
     };
-    for (line, row) in rows {
-        let fields: Vec<&str> = row.split(',').map(str::trim).collect();
-        if fields.len() != names.len() {
-            return Err(err(
-                line,
-                format!("{} fields, the header has {}", fields.len(), names.len()),
-            ));
-        }
+    for (line, fields) in &table.rows {
+        let line = *line;
         let mut vals = Vec::with_capacity(fields.len());
         for (c, f) in fields.iter().enumerate() {
             let v: f64 = f.parse().map_err(|_| {
