@@ -169,9 +169,7 @@ pub fn print_summary(
     );
     match (&rep.r_fitted, &rep.fit_error) {
         (Some(j), _) => outln!(
-            "  fitted r covering all datasets: num = {}, den = {} [{}]",
-            j.get("num").map_or("?".into(), |v| v.to_string()),
-            j.get("den").map_or("?".into(), |v| v.to_string()),
+            "  fitted r covering all datasets: {} (coefficients in r.json)",
             super::run::fit_tag(j)
         ),
         (None, Some(e)) => outln!("  fit failed: {e}"),

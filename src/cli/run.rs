@@ -102,23 +102,16 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         ),
         None => outln!("  check     no [r] in the config: nothing to check"),
     }
+    let coeffs = |c: &[f64]| c.iter().map(|x| fmt_g(*x)).collect::<Vec<_>>().join(", ");
     match (&out.fit, &rep.r_fitted) {
-        (Ok(f), Some(j)) => outln!(
+        // Up to order 3 the coefficients fit on a line; beyond, r.json has them.
+        (Ok(f), Some(j)) if f.r.den.degree() <= 3 => outln!(
             "  fit       r = ({})/({}) [{}]",
-            f.r.num
-                .coeffs()
-                .iter()
-                .map(|c| fmt_g(*c))
-                .collect::<Vec<_>>()
-                .join(", "),
-            f.r.den
-                .coeffs()
-                .iter()
-                .map(|c| fmt_g(*c))
-                .collect::<Vec<_>>()
-                .join(", "),
+            coeffs(f.r.num.coeffs()),
+            coeffs(f.r.den.coeffs()),
             fit_tag(j)
         ),
+        (Ok(_), Some(j)) => outln!("  fit       r: {} (coefficients in r.json)", fit_tag(j)),
         _ => outln!(
             "  fit       failed: {}",
             rep.fit_error.clone().unwrap_or_default()

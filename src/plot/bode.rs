@@ -27,6 +27,33 @@ fn phase_deg(z: Complex64) -> f64 {
     z.arg().to_degrees()
 }
 
+/// An angle in degrees wrapped into `(-180, 180]`.
+fn wrap180(a: f64) -> f64 {
+    let r = a.rem_euclid(360.0);
+    if r > 180.0 {
+        r - 360.0
+    } else {
+        r
+    }
+}
+
+/// The model's (wrapped) phase of channel `ch` at the grid point nearest to `w`.
+fn model_phase_near(inp: &BodeInput, w: f64, ch: (usize, usize)) -> Option<f64> {
+    let k = inp.grid.partition_point(|g| *g < w);
+    let cand = [k.saturating_sub(1), k.min(inp.grid.len().saturating_sub(1))];
+    let best = cand
+        .into_iter()
+        .filter(|&c| c < inp.grid.len())
+        .min_by(|&a, &b| {
+            (inp.grid[a] / w)
+                .ln()
+                .abs()
+                .total_cmp(&(inp.grid[b] / w).ln().abs())
+        })?;
+    let g = inp.model.get(best)?.as_ref()?[ch];
+    (g.norm() > 0.0).then(|| phase_deg(g))
+}
+
 /// Splits a wrapped phase curve where it jumps by more than 180°, so no vertical line is
 /// drawn across the ±180° wrap.
 fn wrap_segments(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
@@ -99,6 +126,8 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             .x_label_formatter(&log_tick)
             .y_label_formatter(&log_tick)
             .light_line_style(RGBColor(235, 235, 235))
+            .max_light_lines(4)
+            .x_labels(12)
             .draw()
             .map_err(plot_err)?;
         for (c, &(i, j)) in channels.iter().enumerate() {
@@ -179,6 +208,8 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             .y_labels(9)
             .y_label_formatter(&|v| format!("{v:.0}°"))
             .light_line_style(RGBColor(235, 235, 235))
+            .max_light_lines(4)
+            .x_labels(12)
             .draw()
             .map_err(plot_err)?;
         for (c, &(i, j)) in channels.iter().enumerate() {
@@ -197,7 +228,12 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             }
             for (k, (w, d)) in inp.omega.iter().zip(inp.data).enumerate() {
                 let z = d[(i, j)];
-                let ang = phase_deg(z);
+                // Put the datum on the branch of the model's phase nearby, so that data and
+                // model do not sit on opposite sides of the ±180° wrap.
+                let ang = match model_phase_near(inp, *w, (i, j)) {
+                    Some(pm) => pm + wrap180(phase_deg(z) - pm),
+                    None => phase_deg(z),
+                };
                 let r = radius(k);
                 if r > 0.0 {
                     // The disk of radius r around z subtends ±asin(r/|z|) (all angles if it holds 0).
@@ -238,5 +274,12 @@ mod tests {
             (4.0, -170.0),
         ]);
         assert_eq!(s.len(), 2);
+    }
+
+    #[test]
+    fn wrap() {
+        assert_eq!(super::wrap180(190.0), -170.0);
+        assert_eq!(super::wrap180(-190.0), 170.0);
+        assert_eq!(super::wrap180(180.0), 180.0);
     }
 }

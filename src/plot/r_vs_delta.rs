@@ -74,6 +74,8 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
             .x_label_formatter(&log_tick)
             .y_label_formatter(&log_tick)
             .light_line_style(RGBColor(235, 235, 235))
+            .max_light_lines(4)
+            .x_labels(12)
             .draw()
             .map_err(plot_err)?;
 

@@ -95,25 +95,38 @@ pub fn legend<'a, 'b, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTransla
         .map_err(plot_err)
 }
 
-/// Formats a tick label of a log axis as `1e-3`, `0.01`, `100`, `1e5`.
+/// Formats a tick label of a log axis: plain numbers from 0.01 to 9999 (`0.05`, `200`),
+/// else `1e-3`, `2e5`.  Only ticks with mantissa 1, 2 or 5 are labelled (the others stay as
+/// grid lines), so labels never crowd.
 pub fn log_tick(v: &f64) -> String {
-    let e = v.log10();
-    if (e - e.round()).abs() < 1e-9 {
-        let k = e.round() as i32;
-        if (-2..=3).contains(&k) {
-            format!("{}", 10f64.powi(k))
+    // Round off the last bits of the axis arithmetic (0.009999999999 → 0.01).
+    let v: f64 = format!("{:.10e}", *v).parse().unwrap_or(*v);
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let mantissa = v.abs() / 10f64.powf(v.abs().log10().floor());
+    if ![1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .any(|m| (mantissa - m).abs() < 1e-6 * m)
+    {
+        return String::new();
+    }
+    if (0.01..1e4).contains(&v.abs()) {
+        let s = format!(
+            "{:.*}",
+            (2 - v.abs().log10().floor() as i32).max(0) as usize,
+            v
+        );
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
-            format!("1e{k}")
+            s
         }
     } else {
-        let s = format!("{v:.3e}");
+        let s = format!("{v:.2e}");
         let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
         let m = m.trim_end_matches('0').trim_end_matches('.');
-        if x == "0" {
-            m.to_string()
-        } else {
-            format!("{m}e{x}")
-        }
+        format!("{m}e{x}")
     }
 }
 
@@ -172,4 +185,22 @@ pub fn reserve_bottom(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
 /// Fraction of a plot of `height` pixels taken by a legend of `rows` entries.
 pub fn legend_fraction(rows: usize, height: u32) -> f64 {
     (rows as f64 * 19.0 + 24.0) / height as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::log_tick;
+
+    #[test]
+    fn ticks() {
+        assert_eq!(log_tick(&300.0), "");
+        assert_eq!(log_tick(&200.0), "200");
+        assert_eq!(log_tick(&0.05), "0.05");
+        assert_eq!(log_tick(&1.0), "1");
+        assert_eq!(log_tick(&1e-3), "1e-3");
+        assert_eq!(log_tick(&2e5), "2e5");
+        assert_eq!(log_tick(&1000.0), "1000");
+        assert_eq!(log_tick(&0.5), "0.5");
+        assert_eq!(log_tick(&0.009999999999999), "0.01");
+    }
 }
