@@ -54,6 +54,16 @@ fn model_phase_near(inp: &BodeInput, w: f64, ch: (usize, usize)) -> Option<f64> 
     (g.norm() > 0.0).then(|| phase_deg(g))
 }
 
+/// Phase (degrees) of datum `k`, channel `ch`, on the branch of the model's phase nearby, so
+/// that data and model do not sit on opposite sides of the ±180° wrap.
+fn data_phase(inp: &BodeInput, k: usize, ch: (usize, usize)) -> f64 {
+    let z = inp.data[k][ch];
+    match model_phase_near(inp, inp.omega[k], ch) {
+        Some(pm) => pm + wrap180(phase_deg(z) - pm),
+        None => phase_deg(z),
+    }
+}
+
 /// Splits a wrapped phase curve where it jumps by more than 180°, so no vertical line is
 /// drawn across the ±180° wrap.
 fn wrap_segments(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
@@ -192,12 +202,21 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
         }
         legend(&mut mag, SeriesLabelPosition::LowerLeft)?;
 
-        // Phase.
+        // Phase: ±180° plus whatever the data on the model's branch need (at most ±360°).
+        let (mut plo, mut phi) = (-180.0f64, 180.0f64);
+        for k in 0..inp.omega.len() {
+            for &ch in &channels {
+                let a = data_phase(inp, k, ch);
+                plo = plo.min(a);
+                phi = phi.max(a);
+            }
+        }
+        let (plo, phi) = (plo.max(-360.0) - 22.5, phi.min(360.0) + 22.5);
         let mut ph = ChartBuilder::on(&bottom)
             .margin(14)
             .x_label_area_size(52)
             .y_label_area_size(78)
-            .build_cartesian_2d((xlo..xhi).log_scale(), -202.5..202.5)
+            .build_cartesian_2d((xlo..xhi).log_scale(), plo..phi)
             .map_err(plot_err)?;
         ph.configure_mesh()
             .x_desc("frequency ω (rad/s)")
@@ -228,12 +247,7 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             }
             for (k, (w, d)) in inp.omega.iter().zip(inp.data).enumerate() {
                 let z = d[(i, j)];
-                // Put the datum on the branch of the model's phase nearby, so that data and
-                // model do not sit on opposite sides of the ±180° wrap.
-                let ang = match model_phase_near(inp, *w, (i, j)) {
-                    Some(pm) => pm + wrap180(phase_deg(z) - pm),
-                    None => phase_deg(z),
-                };
+                let ang = data_phase(inp, k, (i, j));
                 let r = radius(k);
                 if r > 0.0 {
                     // The disk of radius r around z subtends ±asin(r/|z|) (all angles if it holds 0).
@@ -243,8 +257,8 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
                         (r / z.norm()).asin().to_degrees()
                     };
                     let (lo, hi) = (
-                        clamp(ang - half, -200.0, 200.0),
-                        clamp(ang + half, -200.0, 200.0),
+                        clamp(ang - half, plo, phi),
+                        clamp(ang + half, plo, phi),
                     );
                     ph.draw_series(std::iter::once(PathElement::new(
                         vec![(*w, lo), (*w, hi)],
