@@ -256,10 +256,7 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
                     } else {
                         (r / z.norm()).asin().to_degrees()
                     };
-                    let (lo, hi) = (
-                        clamp(ang - half, plo, phi),
-                        clamp(ang + half, plo, phi),
-                    );
+                    let (lo, hi) = (clamp(ang - half, plo, phi), clamp(ang + half, plo, phi));
                     ph.draw_series(std::iter::once(PathElement::new(
                         vec![(*w, lo), (*w, hi)],
                         col.mix(0.6).stroke_width(1),
