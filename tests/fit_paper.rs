@@ -196,3 +196,26 @@ fn beyond_a1_is_reported_with_frequencies() {
     let e = fit_unit(&env, None, &FitSettings::default()).unwrap_err();
     assert!(e.to_string().contains("r_min = inf"), "{e}");
 }
+
+/// The shipped robot example (configs/robot.toml: eqs. (18)–(21), L_a = 0.06, 211 noisy
+/// data): the Theorem 4 envelope, fitted at orders 1 to 6.
+#[test]
+fn conservatism_does_not_increase_with_order_shipped_robot() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cfg = rshape::model::Config::load(&root.join("configs/robot.toml")).unwrap();
+    let data = rshape::data::read_frf_csv(&root.join("configs/robot.csv")).unwrap();
+    let radii = rshape::model::noise::noise_radii(None, Some(&cfg), &data)
+        .unwrap()
+        .expect("robot.toml has a noise radius");
+    let env = rshape::consistency::noisy_envelope(
+        &cfg.factorization,
+        &data,
+        &radii,
+        &rshape::consistency::BisectionSettings::default(),
+    )
+    .unwrap();
+    assert!(env.r_min.iter().any(|r| *r > 0.0) && env.r_min.iter().all(|r| r.is_finite()));
+    let f = &cfg.factorization;
+    let a1 = |w: f64| f.a1_limit(w);
+    assert_monotone("shipped robot", &env, Some(&a1));
+}
