@@ -146,8 +146,9 @@ impl Lp {
             .verbose(false)
             .max_iter(max_iter)
             .presolve_enable(false)
-            .tol_gap_abs(1e-7)
-            .tol_gap_rel(1e-7)
+            .tol_gap_abs(1e-6)
+            .tol_gap_rel(1e-6)
+            .iterative_refinement_max_iter(3)
             .build()
         else {
             return fail;
