@@ -105,12 +105,22 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         rep.r_env_max.map_or("-".into(), fmt_g)
     );
     println!("r_env:  {}", rep.r_env_method);
+    if let Some(n) = rep.n_unexplainable.filter(|n| *n > 0) {
+        println!(
+            "r_env:  {n} data have r_min = inf (no admissible |r| explains them; not in r_env_max)"
+        );
+    }
     println!("fails (noise only):      {}", fmt_bands(&rep.bands));
     match &rep.bands_with_r {
         Some(b) => println!(
-            "fails (with the config's r): {} (invalid_fraction {:.1} %)",
+            "fails (with the config's r): {} (invalid_fraction {:.1} %; {})",
             fmt_bands(b),
-            100.0 * rep.invalid_fraction_with_r.unwrap_or(0.0)
+            100.0 * rep.invalid_fraction_with_r.unwrap_or(0.0),
+            if rep.with_r_exact {
+                "exact: |r| ≤ r_min of Theorem 4"
+            } else {
+                "conservative noise-free test"
+            }
         ),
         None => println!("fails (with the config's r): - (no [r] in the config, or no envelope)"),
     }

@@ -5,15 +5,23 @@
 //! * `misfit_rms = sqrt(mean c_k²)`, `invalid_fraction` = share of invalid data;
 //! * without a noise radius the misfit is relative, `|G_d − G_m|/|G_d|`, and
 //!   `invalid_fraction` is not defined;
-//! * `r_env_max` = max over the data of the **noise-free** envelope (Theorem 2 or 3 on the
-//!   model's rational factorization, a physical model's Padé export): the largest smallest
-//!   `|r(jω)|` that explains the data with no noise. Noise is not subtracted (the noisy
-//!   envelope of Theorem 4 lives on branch `mu`);
-//! * "fails with r": a datum neither the noise disk alone (`c_k > 1`) nor the configured `r`
-//!   alone (`r_min > |r(jω)|`, noise-free) explains. The exact joint test is Theorem 4 (μ);
-//!   this one is conservative (it may flag a datum that noise and `r` together explain).
+//! * envelope `r_min` per datum, on the model's rational factorization (a physical model's
+//!   Padé export), SISO models only:
+//!   - **with a noise radius**: the noisy envelope of Theorem 4 (`noisy_envelope`, μ test):
+//!     the smallest `|r(jω)|` that explains the datum together with the noise disk; 0 inside
+//!     the noise of the nominal model, `inf` when no `|r|` below the A1 limit `σ_min(M̃)`
+//!     explains it;
+//!   - **without** (or when the noisy test cannot be computed, e.g. A7 at a datum; the reason
+//!     is in `r_env_method`): the noise-free envelope (Theorem 2 or 3);
+//! * `r_env_max` = the largest **finite** `r_min`; `n_unexplainable` = the number of data
+//!   with `r_min = inf` (not counted in `r_env_max`);
+//! * "fails with r" (`invalid_with_r`, `bands_with_r`): with the Theorem 4 envelope a datum
+//!   fails iff `|r(jω)| ≤ r_min` (exact joint test of noise and the configured `r`; a datum
+//!   with `r_min = 0` never fails). With the noise-free fallback the test is conservative:
+//!   a datum fails when neither the noise disk alone (`c_k > 1`) nor `r` alone
+//!   (`r_min > |r(jω)|`) explains it. `with_r_exact` says which test was used.
 
-use crate::consistency::noise_free_envelope;
+use crate::consistency::{noise_free_envelope, noisy_envelope, BisectionSettings};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::noise::resolve_noise_for_channel;
@@ -245,7 +253,8 @@ pub struct CompareRow {
     pub misfit: f64,
     /// Noise radius.
     pub noise_radius: Option<f64>,
-    /// Noise-free smallest consistent `|r|`.
+    /// Smallest consistent `|r|`: Theorem 4 (with the noise) when a radius is known,
+    /// else noise-free (Theorem 2 or 3); see `r_env_method`.
     pub r_min: Option<f64>,
     /// Not explained by the noise.
     pub invalid: bool,
@@ -274,8 +283,14 @@ pub struct CompareReport {
     pub invalid_fraction: Option<f64>,
     /// Share of data explained neither by the noise nor by the configured r.
     pub invalid_fraction_with_r: Option<f64>,
-    /// Max of the noise-free envelope (smallest consistent |r|) over the data.
+    /// Largest finite envelope value (smallest consistent |r|) over the data: Theorem 4 with
+    /// the noise radius when one is known, else noise-free.
     pub r_env_max: Option<f64>,
+    /// Data no admissible `|r|` explains (`r_min = inf`), not counted in `r_env_max`.
+    pub n_unexplainable: Option<usize>,
+    /// True when "fails with r" is the exact Theorem 4 test (`|r| ≤ r_min`), false for the
+    /// conservative noise-free approximation.
+    pub with_r_exact: bool,
     /// How `r_env_max` was computed (or why not).
     pub r_env_method: String,
     /// Bands where the nominal model fails (noise only).
@@ -328,29 +343,56 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
         .iter()
         .map(|x| siso.radius.is_some() && *x > 1.0)
         .collect();
-    // Noise-free envelope on the rational factorization of the model.
+    // Envelope on the rational factorization of the model: Theorem 4 (noisy) when the
+    // noise radius is known, else (or when the μ test cannot run) noise-free.
+    let mut exact = false;
     let (r_min, r_env_method) = if model.size() == (1, 1) {
         let f = match model {
             PlantModel::Physical(p) => p.to_factorization().map_err(Error::Invalid),
             PlantModel::Factored(f) => Ok(f.clone()),
         };
-        match f.and_then(|f| noise_free_envelope(&f, &siso.as_frf()).map(|e| (e, f))) {
-            Ok((e, f)) => (
-                Some(e.r_min),
-                format!(
-                    "noise-free envelope, {} ({}), noise not subtracted",
-                    match f.kind {
-                        crate::model::FactorizationKind::Standard => "Theorem 2",
-                        crate::model::FactorizationKind::Special => "Theorem 3",
-                    },
-                    if matches!(model, PlantModel::Physical(_)) {
-                        "Padé export of the physical model"
-                    } else {
-                        "configured factors"
-                    }
-                ),
-            ),
+        let source = if matches!(model, PlantModel::Physical(_)) {
+            "Padé export of the physical model"
+        } else {
+            "configured factors"
+        };
+        match f {
             Err(e) => (None, format!("not computed: {e}")),
+            Ok(f) => {
+                let frf = siso.as_frf();
+                let noisy = siso
+                    .radius
+                    .as_ref()
+                    .map(|rad| noisy_envelope(&f, &frf, rad, &BisectionSettings::default()));
+                match noisy {
+                    Some(Ok(e)) => {
+                        exact = true;
+                        (
+                            Some(e.r_min),
+                            format!("noisy envelope, Theorem 4 (μ test with the noise radius; {source})"),
+                        )
+                    }
+                    other => {
+                        let why = match other {
+                            Some(Err(e)) => format!("; the noisy test (Theorem 4) failed: {e}"),
+                            _ => String::new(),
+                        };
+                        match noise_free_envelope(&f, &frf) {
+                            Ok(e) => (
+                                Some(e.r_min),
+                                format!(
+                                    "noise-free envelope, {} ({source}), noise not subtracted{why}",
+                                    match f.kind {
+                                        crate::model::FactorizationKind::Standard => "Theorem 2",
+                                        crate::model::FactorizationKind::Special => "Theorem 3",
+                                    },
+                                ),
+                            ),
+                            Err(e) => (None, format!("not computed: {e}{why}")),
+                        }
+                    }
+                }
+            }
         }
     } else {
         (
@@ -366,7 +408,15 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
     let with_r: Option<Vec<bool>> = match (&r_min, &r_abs) {
         (Some(rm), Some(ra)) => Some(
             (0..c.len())
-                .map(|k| (siso.radius.is_none() || invalid[k]) && rm[k] > ra[k])
+                .map(|k| {
+                    if exact {
+                        // Theorem 4: consistent iff μ(|r|) > 1, i.e. |r| > r_min (and
+                        // always when r_min = 0: the noise alone explains the datum).
+                        rm[k] > 0.0 && ra[k] <= rm[k]
+                    } else {
+                        (siso.radius.is_none() || invalid[k]) && rm[k] > ra[k]
+                    }
+                })
                 .collect(),
         ),
         _ => None,
@@ -397,9 +447,16 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
         invalid_fraction_with_r: with_r
             .as_ref()
             .map(|w| w.iter().filter(|x| **x).count() as f64 / n),
-        r_env_max: r_min
+        r_env_max: r_min.as_ref().map(|r| {
+            r.iter()
+                .cloned()
+                .filter(|x| x.is_finite())
+                .fold(0.0, f64::max)
+        }),
+        n_unexplainable: r_min
             .as_ref()
-            .map(|r| r.iter().cloned().fold(0.0, f64::max)),
+            .map(|r| r.iter().filter(|x| x.is_infinite()).count()),
+        with_r_exact: exact && with_r.is_some(),
         r_env_method,
         bands: bands(&siso.omega, &c, &invalid),
         bands_with_r: with_r.as_ref().map(|w| bands(&siso.omega, &c, w)),
