@@ -4,7 +4,7 @@
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::candidates::sig;
-use crate::diagnose::{apply_candidate, diagnose, prepare};
+use crate::diagnose::{apply_candidate, diagnose, prepare, refit_nominal};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -67,7 +67,12 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     )?;
     let d = diagnose(&base, &siso, a.max_effects.max(1))?;
     if let (Some(k), Some(out)) = (a.apply, &a.write) {
-        let revised = apply_candidate(&base, &d, k)?;
+        // The candidate, then a joint refit of every parameter (the configured ones too).
+        let applied = apply_candidate(&base, &d, k)?;
+        let radius = siso.radius.clone().unwrap_or_default();
+        let revised = refit_nominal(&applied, &siso.omega, &siso.g, &radius).model;
+        let gm: Vec<_> = siso.omega.iter().map(|w| revised.eval_siso(*w)).collect();
+        let (_, rms_refit, _, inv_refit) = crate::diagnose::compare::misfit(&siso, &gm);
         let mut raw = config.raw.clone();
         let c = &d.candidates[k - 1];
         raw.physical = Some(revised);
@@ -92,7 +97,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         }
         let text = toml::to_string_pretty(&raw)?;
         let header = format!(
-            "# Revised by `rshape diagnose {} --apply {k}`: added {} ({}).\n# {}\n# Error on {}: misfit_rms {} -> {}, invalid_fraction {:.1} % -> {:.1} %.\n",
+            "# Revised by `rshape diagnose {} --apply {k}`: added {} ({}), then every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {} (effect alone) -> {} (joint refit), invalid_fraction {:.1} % -> {:.1} % -> {:.1} %.\n",
             config.path.display(),
             c.effect,
             c.params
@@ -104,8 +109,10 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             siso.path.display(),
             sig(c.misfit_rms_before),
             sig(c.misfit_rms_after),
+            sig(rms_refit),
             100.0 * c.invalid_fraction_before,
-            100.0 * c.invalid_fraction_after
+            100.0 * c.invalid_fraction_after,
+            100.0 * inv_refit.unwrap_or(f64::NAN)
         );
         let full = format!("{header}{text}");
         // The written file must load back.
@@ -179,7 +186,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         println!("\ngreedy path (joint refit after each step):");
         for s in &d.steps {
             println!(
-                "  step {}: + {} ({}) → misfit_rms {}, invalid {:.1} %",
+                "  step {}: + {} ({}) → misfit_rms {}, invalid {:.1} % (joint refit of {} parameters; effect alone: {}, {:.1} %)",
                 s.step,
                 s.effect,
                 s.params
@@ -188,7 +195,10 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
                     .collect::<Vec<_>>()
                     .join(", "),
                 sig(s.misfit_rms),
-                100.0 * s.invalid_fraction
+                100.0 * s.invalid_fraction,
+                s.n_refit,
+                sig(s.misfit_rms_before_refit),
+                100.0 * s.invalid_fraction_before_refit
             );
         }
     }

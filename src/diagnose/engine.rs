@@ -16,6 +16,7 @@
 use super::candidates::{explain, fmt_w, Cand};
 use super::compare::{bands, Band, Siso, MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
 use super::fit::lm;
+use super::nominal::refit_nominal;
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
@@ -457,12 +458,18 @@ pub struct Step {
     pub params: BTreeMap<String, f64>,
     /// Explanation.
     pub explanation: String,
-    /// Measures after the step.
+    /// Measures after the step (effect added and every parameter refit jointly).
     pub misfit_rms: f64,
     /// After the step.
     pub invalid_fraction: f64,
-    /// ΔBIC of the step.
+    /// ΔBIC of the step (the effect alone, before the joint refit).
     pub delta_bic: f64,
+    /// `misfit_rms` with the effect added, before the joint refit of the nominal parameters.
+    pub misfit_rms_before_refit: f64,
+    /// `invalid_fraction` before the joint refit.
+    pub invalid_fraction_before_refit: f64,
+    /// Number of parameters refit jointly (the model's own and every accepted effect's).
+    pub n_refit: usize,
     /// Ties reported at this step.
     pub ties: Vec<Tie>,
 }
@@ -489,6 +496,9 @@ pub struct Diagnosis {
     pub steps: Vec<Step>,
     /// Expected `V` of a right model (`F − n_θ/2`), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
+    /// The model after the greedy steps (effects added, everything refit jointly).
+    #[serde(skip)]
+    pub final_model: PhysicalModel,
 }
 
 fn si_map(c: &Cand, th: &[f64]) -> BTreeMap<String, f64> {
@@ -721,9 +731,19 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
             ties: vec![],
             steps,
             cost_test: Some([p.f() as f64, before.v]),
+            final_model: base.clone(),
         });
     }
+    let before_f = p.f() as f64;
+    drop(p);
+    // After each accepted effect the model is rebuilt with the effect written into it, and
+    // every parameter (the configured ones and the accepted effects') is refit jointly
+    // (bounded LM, `nominal::refit_nominal`); the next step ranks candidates on that model.
+    let radius = siso.radius.clone().expect("checked by Problem::new");
+    let mut model = base.clone();
+    let mut n_fitted = 0usize;
     for step in 0..max_effects {
+        let p = Problem::new(&model, siso)?;
         let ranked = p.rank(&cur, cur_m);
         let ties = p.ties(&ranked);
         let accept = ranked.iter().find(|c| c.passes).cloned();
@@ -731,18 +751,32 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
             first = Some((ranked, ties.clone()));
         }
         let Some(acc) = accept else { break };
-        cur = acc.mods.clone();
-        cur_m = p.measures(&cur);
+        let with_effect = p.measures(&acc.mods);
         let n = acc.cand.n_params();
-        let th = &cur.theta[cur.theta.len() - n..];
+        let th = &acc.mods.theta[acc.mods.theta.len() - n..];
+        let params = si_map(&acc.cand, th);
+        let mut next = model.clone();
+        acc.cand.apply_to(
+            th,
+            &mut next,
+            &format!("added by rshape diagnose: {}", acc.effect),
+        );
+        let refit = refit_nominal(&next, &siso.omega, &siso.g, &radius);
+        n_fitted = refit.n_params;
+        model = refit.model;
+        cur = Mods::default();
+        cur_m = Problem::new(&model, siso)?.measures(&cur);
         steps.push(Step {
             step: step + 1,
             effect: acc.effect.clone(),
-            params: si_map(&acc.cand, th),
+            params,
             explanation: acc.explanation.clone(),
             misfit_rms: cur_m.misfit_rms,
             invalid_fraction: cur_m.invalid_fraction,
             delta_bic: acc.delta_bic,
+            misfit_rms_before_refit: with_effect.misfit_rms,
+            invalid_fraction_before_refit: with_effect.invalid_fraction,
+            n_refit: refit.n_params,
             ties,
         });
         if cur_m.consistent() {
@@ -773,17 +807,18 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
             }
         )
     };
-    let n_theta = cur.theta.len() as f64;
+    let n_theta = n_fitted as f64;
     Ok(Diagnosis {
         verdict: verdict.into(),
         message,
-        n_data: p.f(),
+        n_data: siso.omega.len(),
         before,
         after: cur_m,
         candidates,
         ties,
         steps,
-        cost_test: Some([p.f() as f64 - n_theta / 2.0, cur_m.v]),
+        cost_test: Some([before_f - n_theta / 2.0, cur_m.v]),
+        final_model: model,
     })
 }
 

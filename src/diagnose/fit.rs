@@ -21,7 +21,32 @@ where
     F: Fn(&[f64], &mut Vec<f64>),
 {
     let n = theta0.len();
-    let mut theta = theta0.to_vec();
+    lm_box(
+        f,
+        theta0,
+        typ,
+        &vec![f64::NEG_INFINITY; n],
+        &vec![f64::INFINITY; n],
+        max_iter,
+    )
+}
+
+/// [`lm`] with box bounds `lo ≤ θ ≤ hi`: the start is clamped into the box and every
+/// trial step is projected onto it (a step that the projection makes worse is rejected
+/// like any other, so `V` never rises).
+pub fn lm_box<F>(
+    f: F,
+    theta0: &[f64],
+    typ: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    max_iter: usize,
+) -> LmResult
+where
+    F: Fn(&[f64], &mut Vec<f64>),
+{
+    let n = theta0.len();
+    let mut theta: Vec<f64> = (0..n).map(|i| theta0[i].clamp(lo[i], hi[i])).collect();
     let mut r = Vec::new();
     f(&theta, &mut r);
     let ss = |r: &[f64]| {
@@ -75,7 +100,9 @@ where
                     continue;
                 }
             };
-            let cand: Vec<f64> = theta.iter().zip(step.iter()).map(|(t, s)| t + s).collect();
+            let cand: Vec<f64> = (0..n)
+                .map(|i| (theta[i] + step[i]).clamp(lo[i], hi[i]))
+                .collect();
             f(&cand, &mut trial);
             let vt = ss(&trial);
             if vt < v {
@@ -117,5 +144,17 @@ mod tests {
         };
         let res = lm(f, &[1.0, 0.5], &[1.0, 1.0], 100);
         assert!((res.theta[0] - 2.0).abs() < 1e-6 && (res.theta[1] - 1.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn respects_the_box() {
+        // Minimum of (t − 3)² at 3, box [0, 2]: the fit stops on the bound.
+        let f = |t: &[f64], r: &mut Vec<f64>| {
+            r.clear();
+            r.push(t[0] - 3.0);
+        };
+        let res = lm_box(f, &[0.5], &[1.0], &[0.0], &[2.0], 100);
+        assert_eq!(res.theta[0], 2.0);
+        assert!((res.v - 1.0).abs() < 1e-12);
     }
 }

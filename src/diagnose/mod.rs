@@ -11,5 +11,7 @@ pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
 pub mod candidates;
 pub mod engine;
 pub mod fit;
+pub mod nominal;
 
 pub use engine::{apply_candidate, diagnose, Diagnosis};
+pub use nominal::{refit_nominal, NominalRefit};
