@@ -197,3 +197,38 @@ fn cli_compare_json_and_apply_write() {
         .unwrap()
         .contains("<svg"));
 }
+
+/// The extrapolation holdout (global candidates: fit below 70 % of the band, predict the top
+/// 30 %) rejects what the interleaved holdout lets through: on the rigid-body model a gain
+/// lowers V a lot but fails to predict the top of the band; on rev 1 a delay and an NMP zero
+/// tie in BIC, and only the delay extrapolates.
+#[test]
+fn extrapolation_holdout_rejects_global_candidates_that_do_not_predict() {
+    let cand = |config: &str| {
+        let c = Config::load(Path::new(config)).unwrap();
+        let a = read_frf_csv(c.data.as_ref().unwrap()).unwrap();
+        let siso = prepare(&c, &a, None, None).unwrap();
+        diagnose(c.physical.as_ref().unwrap(), &siso, 1)
+            .unwrap()
+            .candidates
+    };
+    let rigid = cand("configs/twomass_rigid.toml");
+    let gain = rigid.iter().find(|c| c.effect == "gain").unwrap();
+    assert!(gain.delta_bic > 1e4, "{}", gain.delta_bic);
+    assert!(gain.holdout_interleaved_ok);
+    assert_eq!(gain.holdout_extrapolation_ok, Some(false));
+    assert!(!gain.holdout_ok && !gain.passes);
+    // Local candidates are not extrapolated.
+    let mode = rigid.iter().find(|c| c.effect == "mode").unwrap();
+    assert_eq!(mode.holdout_extrapolation_ok, None);
+    assert!(mode.passes);
+
+    let rev1 = cand("configs/twomass_rev1.toml");
+    let delay = rev1.iter().find(|c| c.effect == "delay").unwrap();
+    let nmp = rev1.iter().find(|c| c.effect == "nmp_zero").unwrap();
+    assert!((delay.delta_bic - nmp.delta_bic).abs() < 6.0);
+    assert_eq!(delay.holdout_extrapolation_ok, Some(true));
+    assert!(delay.passes);
+    assert_eq!(nmp.holdout_extrapolation_ok, Some(false));
+    assert!(nmp.holdout_interleaved_ok && !nmp.passes);
+}

@@ -6,8 +6,9 @@
 //! * Each candidate is fitted by Levenberg–Marquardt from the best points of a grid or a
 //!   closed-form estimate (effects.md), jointly with every effect accepted before.
 //! * Score: `ΔBIC = 2(V₀ − V) − n_θ·ln(2F)`. A candidate **passes** when ΔBIC > 10, the
-//!   invalid fraction does not rise, and a holdout check passes (fit on 3 of every 4 data, the held-out
-//!   quarter's `V` must fall too).
+//!   invalid fraction does not rise, and the holdout checks pass: fit on 3 of every 4 data,
+//!   the held-out quarter's `V` must fall too; for a global (multiplicative) candidate, also
+//!   fit below 70 % of the band (log frequency) and the top 30 %'s `V` must fall.
 //! * Stop when the model is consistent (`invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`), when no
 //!   candidate passes, or after `max_effects` effects. Candidates within 6 of the best BIC are
 //!   reported as ties, with the frequency range where the two fitted models differ by more
@@ -28,6 +29,10 @@ use std::collections::BTreeMap;
 pub const MIN_DELTA_BIC: f64 = 10.0;
 /// BIC gap under which two candidates are a tie.
 pub const TIE_BIC: f64 = 6.0;
+/// Extrapolation holdout: fit below this share of the band (log frequency), predict above.
+pub const EXTRAPOLATION_SPLIT: f64 = 0.7;
+/// Fewest data on either side of the split for the extrapolation holdout to run.
+pub const MIN_SPLIT_DATA: usize = 8;
 
 /// The fitting problem: data, noise and the base model split as `core · path`.
 pub struct Problem<'a> {
@@ -120,6 +125,13 @@ impl<'a> Problem<'a> {
 
     fn f(&self) -> usize {
         self.omega.len()
+    }
+
+    /// Indices of the data below and above `ω_min·(ω_max/ω_min)^share`.
+    fn split_band(&self, share: f64) -> (Vec<usize>, Vec<usize>) {
+        let (lo, hi) = (self.omega[0].max(1e-300), self.omega_max().max(1e-300));
+        let w = (lo.ln() + share * (hi.ln() - lo.ln())).exp();
+        (0..self.f()).partition(|&k| self.omega[k] < w)
     }
 
     fn omega_max(&self) -> f64 {
@@ -418,8 +430,15 @@ pub struct CandidateReport {
     pub delta_bic: f64,
     /// Number of new parameters.
     pub n_params: usize,
-    /// The held-out quarter of the data is predicted better.
+    /// Both holdout checks pass (`holdout_interleaved_ok` and, for a global candidate,
+    /// `holdout_extrapolation_ok`).
     pub holdout_ok: bool,
+    /// Fitted on 3 of every 4 data, the held-out quarter's `V` falls.
+    pub holdout_interleaved_ok: bool,
+    /// Global (multiplicative) candidates only: fitted below 70 % of the band (log
+    /// frequency), the top 30 % is predicted better than by the model without it. `None`
+    /// for local candidates, or when either part holds fewer than 8 data.
+    pub holdout_extrapolation_ok: Option<bool>,
     /// Passes all acceptance tests.
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
@@ -588,6 +607,16 @@ impl Problem<'_> {
         let ho_mask: Vec<usize> = (0..self.f()).filter(|k| k % 4 == 3).collect();
         let cur_fit = self.refit(cur, &fit_mask).0;
         let v_ho_cur = self.v(&cur_fit, &ho_mask);
+        // Extrapolation holdout for global (multiplicative) candidates: fit below 70 % of the
+        // band (in log frequency), predict the top 30 %.
+        let (lo_mask, hi_mask) = self.split_band(EXTRAPOLATION_SPLIT);
+        let extrap = lo_mask.len() >= MIN_SPLIT_DATA && hi_mask.len() >= MIN_SPLIT_DATA;
+        let v_hi_cur = if extrap {
+            let f = self.refit(cur, &lo_mask).0;
+            self.v(&f, &hi_mask)
+        } else {
+            f64::INFINITY
+        };
         let (_, flags0) = self.invalid_flags(cur);
         let ln2f = (2.0 * self.f() as f64).ln();
         let used: Vec<Cand> = cur.cands.clone();
@@ -614,7 +643,12 @@ impl Problem<'_> {
             let n_new = c.n_params();
             let delta_bic = 2.0 * (cur_m.v - v) - n_new as f64 * ln2f;
             let ho = self.refit(&mods, &fit_mask).0;
-            let holdout_ok = self.v(&ho, &ho_mask) < v_ho_cur;
+            let interleaved_ok = self.v(&ho, &ho_mask) < v_ho_cur;
+            let extrapolation_ok = (extrap && c.multiplicative()).then(|| {
+                let f = self.refit(&mods, &lo_mask).0;
+                self.v(&f, &hi_mask) < v_hi_cur
+            });
+            let holdout_ok = interleaved_ok && extrapolation_ok.unwrap_or(true);
             let th_new = &mods.theta[mods.theta.len() - n_new..];
             // 2σ of the new parameters.
             let ntot = mods.theta.len();
@@ -658,6 +692,8 @@ impl Problem<'_> {
                 delta_bic,
                 n_params: n_new,
                 holdout_ok,
+                holdout_interleaved_ok: interleaved_ok,
+                holdout_extrapolation_ok: extrapolation_ok,
                 passes,
                 tie_with_best: false,
                 explanation: explain(&c, th_new, self.base, &self.omega),
