@@ -8,23 +8,7 @@ use std::path::Path;
 /// flushed and renamed over `path`, so a reader never sees a half-written file and a failed
 /// run leaves no output behind.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let io = |source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    tmp.write_all(contents).map_err(io)?;
-    tmp.as_file().sync_all().map_err(io)?;
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    write_via_temp(path, contents, true)
 }
 
 /// As [`write_atomic`] (temporary file + rename, so a reader never sees a half-written
@@ -32,6 +16,10 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
 /// flush to disk per file costs more than the computation.  After a crash such a file may
 /// be missing or empty, never partial-but-plausible; rerun the batch.
 pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
+    write_via_temp(path, contents, false)
+}
+
+fn write_via_temp(path: &Path, contents: &[u8], sync: bool) -> Result<()> {
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -46,6 +34,9 @@ pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
     };
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
     tmp.write_all(contents).map_err(io)?;
+    if sync {
+        tmp.as_file().sync_all().map_err(io)?;
+    }
     tmp.persist(path).map_err(|e| io(e.error))?;
     Ok(())
 }

@@ -128,18 +128,7 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
             .y_label_area_size(78)
             .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
             .map_err(plot_err)?;
-        mag.configure_mesh()
-            .x_desc("frequency ω (rad/s)")
-            .y_desc("magnitude |G(jω)| (absolute)")
-            .axis_desc_style((FONT, AXIS))
-            .label_style((FONT, TICKS))
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .light_line_style(RGBColor(235, 235, 235))
-            .max_light_lines(4)
-            .x_labels(12)
-            .draw()
-            .map_err(plot_err)?;
+        loglog_mesh(&mut mag, "magnitude |G(jω)| (absolute)")?;
         for (c, &(i, j)) in channels.iter().enumerate() {
             let col = PALETTE[c % PALETTE.len()];
             let line: Vec<(f64, f64)> = inp

@@ -32,19 +32,7 @@ pub fn mu_svg(inp: &MuInput) -> Result<String> {
             .y_label_area_size(78)
             .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
             .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("frequency ω (rad/s)")
-            .y_desc("μ_Γ (dimensionless)")
-            .axis_desc_style((FONT, AXIS))
-            .label_style((FONT, TICKS))
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .light_line_style(RGBColor(235, 235, 235))
-            .max_light_lines(4)
-            .x_labels(12)
-            .draw()
-            .map_err(plot_err)?;
+        loglog_mesh(&mut chart, "μ_Γ (dimensionless)")?;
         let s = C_GREY.stroke_width(2);
         chart
             .draw_series(DashedLineSeries::new(

@@ -65,19 +65,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
             .y_label_area_size(78)
             .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
             .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("frequency ω (rad/s)")
-            .y_desc("magnitude (absolute, unitless)")
-            .axis_desc_style((FONT, AXIS))
-            .label_style((FONT, TICKS))
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .light_line_style(RGBColor(235, 235, 235))
-            .max_light_lines(4)
-            .x_labels(12)
-            .draw()
-            .map_err(plot_err)?;
+        loglog_mesh(&mut chart, "magnitude (absolute, unitless)")?;
 
         let grid = inp.grid;
         let curve = |v: &[f64]| -> Vec<(f64, f64)> {

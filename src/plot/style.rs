@@ -1,6 +1,7 @@
 //! Shared look of the figures: size, fonts, palette, legend placement, axis ranges.
 
 use crate::error::{Error, Result};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 use plotters::style::RGBColor;
 
@@ -185,6 +186,32 @@ pub fn reserve_bottom(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
 /// Fraction of a plot of `height` pixels taken by a legend of `rows` entries.
 pub fn legend_fraction(rows: usize, height: u32) -> f64 {
     (rows as f64 * 19.0 + 24.0) / height as f64
+}
+
+/// The mesh shared by the log-log figures: frequency in rad/s on x, `y_desc` on y, ticks at
+/// 1-2-5, light grid lines.
+pub fn loglog_mesh<X, Y>(
+    chart: &mut ChartContext<'_, SVGBackend<'_>, Cartesian2d<X, Y>>,
+    y_desc: &str,
+) -> Result<()>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    chart
+        .configure_mesh()
+        .x_desc("frequency ω (rad/s)")
+        .y_desc(y_desc)
+        .axis_desc_style((FONT, AXIS))
+        .label_style((FONT, TICKS))
+        .x_label_formatter(&log_tick)
+        .y_label_formatter(&log_tick)
+        .light_line_style(RGBColor(235, 235, 235))
+        .max_light_lines(4)
+        .x_labels(12)
+        .draw()
+        .map_err(plot_err)?;
+    Ok(())
 }
 
 #[cfg(test)]
