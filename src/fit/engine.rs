@@ -114,6 +114,27 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
+/// The level `max A/(U·B)` over the grid points with an upper bound reached by `(A, B)`
+/// (`+∞` when `B ≤ 0` somewhere, which a feasible max-slack solution never has).
+fn achieved_level(phi: &[Vec<f64>], grid: &[GridPoint], a: &[f64], b: &[f64]) -> f64 {
+    let dot = |r: &[f64], c: &[f64]| r.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
+    let mut t = 0.0f64;
+    for (ph, g) in phi.iter().zip(grid) {
+        if let Some(u) = g.upper {
+            let bv = dot(ph, b);
+            if !(bv > 0.0) {
+                return f64::INFINITY;
+            }
+            t = t.max(dot(ph, a) / (u * bv));
+        }
+    }
+    if t.is_nan() {
+        f64::INFINITY
+    } else {
+        t
+    }
+}
+
 /// Result of one order: the candidates (best first) and the solver events.
 pub(crate) struct OrderFit {
     pub ranked: Vec<Scored>,
@@ -177,8 +198,7 @@ pub(crate) fn fit_order(
         (s, a, b)
     };
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let (mut lo, mut s_lo) = (0.0f64, None::<f64>); // ln t ≥ 0: upper = lower at the data
-    let mut s_hi = 0.0;
+    let mut lo = 0.0f64; // ln t ≥ 0: upper = lower at the data
     let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
     let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
     for _ in 0..12 {
@@ -191,44 +211,26 @@ pub(crate) fn fit_order(
         );
         if s >= 0.0 {
             best = Some((t_hi, a, b));
-            s_hi = s;
             break;
         }
         lo = t_hi.ln();
-        s_lo = s.is_finite().then_some(s);
         t_hi *= 100.0;
     }
-    if let Some((t0, _, _)) = &best {
-        // Safeguarded false position (Illinois) on the max-slack s(ln t).
-        let mut hi = t0.ln();
-        let mut side = 0i8;
+    if let Some((t0, a0, b0)) = &best {
+        // Bisection on ln t.  The max-slack s(ln t) is close to a step (the slack of a
+        // feasible level is limited only by the cap s ≤ 1), so false position gains nothing
+        // over bisection.  A feasible (A, B) at level t also meets every bound at its own
+        // level max A/(U·B) ≤ t: that level is feasible and tightens the bracket.
+        let mut hi = t0.ln().min(achieved_level(&phi, &prep.grid, a0, b0).ln());
         while hi - lo > tol {
-            let w = hi - lo;
-            let mid = match s_lo {
-                Some(sl) if s_hi > sl => {
-                    (hi - s_hi * w / (s_hi - sl)).clamp(lo + 0.02 * w, hi - 0.02 * w)
-                }
-                _ => 0.5 * (lo + hi),
-            };
-            // Aim a little above the estimate so that a good estimate closes the bracket.
-            let mid = (mid + 0.3 * tol).min(hi - 0.3 * tol).max(lo + 0.3 * tol);
+            let mid = 0.5 * (lo + hi);
             let t = mid.exp();
             let (s, a, b) = solve(t, "minimax", &mut events, &mut lp_solves, &mut mask);
             if s >= 0.0 {
-                hi = mid;
-                s_hi = s;
+                hi = mid.min(achieved_level(&phi, &prep.grid, &a, &b).ln());
                 best = Some((t, a, b));
-                if side == 1 {
-                    s_lo = s_lo.map(|v| 0.5 * v);
-                }
-                side = 1;
             } else {
                 lo = mid;
-                s_lo = s.is_finite().then_some(s);
-                if side == -1 {
-                    s_hi *= 0.5;
-                }
-                side = -1;
             }
         }
     } else {
