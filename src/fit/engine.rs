@@ -199,6 +199,8 @@ pub(crate) fn fit_order(
     };
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
     let mut lo = 0.0f64; // ln t ≥ 0: upper = lower at the data
+    let mut s_lo = None::<f64>;
+    let mut s_hi = 0.0;
     let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
     let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
     for _ in 0..12 {
@@ -211,26 +213,73 @@ pub(crate) fn fit_order(
         );
         if s >= 0.0 {
             best = Some((t_hi, a, b));
+            s_hi = s;
             break;
         }
         lo = t_hi.ln();
+        s_lo = s.is_finite().then_some(s);
         t_hi *= 100.0;
     }
     if let Some((t0, a0, b0)) = &best {
-        // Bisection on ln t.  The max-slack s(ln t) is close to a step (the slack of a
-        // feasible level is limited only by the cap s ≤ 1), so false position gains nothing
-        // over bisection.  A feasible (A, B) at level t also meets every bound at its own
-        // level max A/(U·B) ≤ t: that level is feasible and tightens the bracket.
+        // ITP search (interpolate, truncate, project; Oliveira & Takahashi 2020) on the
+        // max-slack s(ln t), never more than one step beyond bisection.  The interpolation
+        // is Illinois false position, used only while the slack at the feasible end is
+        // well below its cap s ≤ 1: at higher orders s(ln t) is close to a step (a feasible
+        // level's slack is limited only by the cap) and false position crawled from the
+        // infeasible end, so those steps are bisections.  A feasible (A, B) at level t
+        // also meets every bound at its own level max A/(U·B) ≤ t: that level is feasible
+        // too and tightens the bracket.
         let mut hi = t0.ln().min(achieved_level(&phi, &prep.grid, a0, b0).ln());
+        let eps = 0.5 * tol;
+        let w0 = hi - lo;
+        let n_max = (w0 / tol).log2().ceil().max(0.0) + 1.0;
+        let k1 = 0.2 / w0.max(tol);
+        let mut j = 0.0;
+        let mut side = 0i8; // Illinois: halve the value kept at a repeated end
+        let mut hi_raw = s_hi;
         while hi - lo > tol {
-            let mid = 0.5 * (lo + hi);
+            let w = hi - lo;
+            let half = 0.5 * (lo + hi);
+            let r = (eps * (n_max - j).exp2() - 0.5 * w).max(0.0);
+            j += 1.0;
+            let mid = match s_lo {
+                Some(sl) if s_hi > sl && hi_raw < 0.9 => {
+                    // Aim a little above the estimate so that a good one closes the bracket.
+                    let xf = (lo - sl * w / (s_hi - sl) + 0.3 * tol).min(hi);
+                    let sigma = (half - xf).signum();
+                    let delta = k1 * w * w;
+                    let xt = if delta <= (half - xf).abs() {
+                        xf + sigma * delta
+                    } else {
+                        half
+                    };
+                    let x = if (xt - half).abs() <= r {
+                        xt
+                    } else {
+                        half - sigma * r
+                    };
+                    x.clamp(lo + 1e-3 * w, hi - 1e-3 * w)
+                }
+                _ => half,
+            };
             let t = mid.exp();
             let (s, a, b) = solve(t, "minimax", &mut events, &mut lp_solves, &mut mask);
             if s >= 0.0 {
                 hi = mid.min(achieved_level(&phi, &prep.grid, &a, &b).ln());
+                s_hi = s;
+                hi_raw = s;
                 best = Some((t, a, b));
+                if side == 1 {
+                    s_lo = s_lo.map(|v| 0.5 * v);
+                }
+                side = 1;
             } else {
                 lo = mid;
+                s_lo = s.is_finite().then_some(s);
+                if side == -1 {
+                    s_hi *= 0.5;
+                }
+                side = -1;
             }
         }
     } else {
