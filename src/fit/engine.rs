@@ -162,7 +162,7 @@ pub(crate) fn fit_order(
     };
 
     // 1. Minimax: bracket the level t (from the previous order when known), then a
-    //    safeguarded false-position (Illinois) search on the max-slack s(ln t).  The
+    //    safeguarded (ITP) search on the max-slack s(ln t), see below.  The
     //    max-slack solutions are centred: they keep away from the floor, so the poles and
     //    zeros keep away from the axis (a Dinkelbach iteration, tried, converged to boundary
     //    solutions with poles on the axis).
