@@ -114,6 +114,27 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
+/// The level `max A/(U·B)` over the grid points with an upper bound reached by `(A, B)`
+/// (`+∞` when `B ≤ 0` somewhere, which a feasible max-slack solution never has).
+fn achieved_level(phi: &[Vec<f64>], grid: &[GridPoint], a: &[f64], b: &[f64]) -> f64 {
+    let dot = |r: &[f64], c: &[f64]| r.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
+    let mut t = 0.0f64;
+    for (ph, g) in phi.iter().zip(grid) {
+        if let Some(u) = g.upper {
+            let bv = dot(ph, b);
+            if !(bv > 0.0) {
+                return f64::INFINITY;
+            }
+            t = t.max(dot(ph, a) / (u * bv));
+        }
+    }
+    if t.is_nan() {
+        f64::INFINITY
+    } else {
+        t
+    }
+}
+
 /// Result of one order: the candidates (best first) and the solver events.
 pub(crate) struct OrderFit {
     pub ranked: Vec<Scored>,
@@ -141,7 +162,7 @@ pub(crate) fn fit_order(
     };
 
     // 1. Minimax: bracket the level t (from the previous order when known), then a
-    //    safeguarded false-position (Illinois) search on the max-slack s(ln t).  The
+    //    safeguarded (ITP) search on the max-slack s(ln t), see below.  The
     //    max-slack solutions are centred: they keep away from the floor, so the poles and
     //    zeros keep away from the axis (a Dinkelbach iteration, tried, converged to boundary
     //    solutions with poles on the axis).
@@ -177,7 +198,8 @@ pub(crate) fn fit_order(
         (s, a, b)
     };
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let (mut lo, mut s_lo) = (0.0f64, None::<f64>); // ln t ≥ 0: upper = lower at the data
+    let mut lo = 0.0f64; // ln t ≥ 0: upper = lower at the data
+    let mut s_lo = None::<f64>;
     let mut s_hi = 0.0;
     let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
     let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
@@ -198,25 +220,54 @@ pub(crate) fn fit_order(
         s_lo = s.is_finite().then_some(s);
         t_hi *= 100.0;
     }
-    if let Some((t0, _, _)) = &best {
-        // Safeguarded false position (Illinois) on the max-slack s(ln t).
-        let mut hi = t0.ln();
-        let mut side = 0i8;
+    if let Some((t0, a0, b0)) = &best {
+        // ITP search (interpolate, truncate, project; Oliveira & Takahashi 2020) on the
+        // max-slack s(ln t), never more than one step beyond bisection.  The interpolation
+        // is Illinois false position, used only while the slack at the feasible end is
+        // well below its cap s ≤ 1: at higher orders s(ln t) is close to a step (a feasible
+        // level's slack is limited only by the cap) and false position crawled from the
+        // infeasible end, so those steps are bisections.  A feasible (A, B) at level t
+        // also meets every bound at its own level max A/(U·B) ≤ t: that level is feasible
+        // too and tightens the bracket.
+        let mut hi = t0.ln().min(achieved_level(&phi, &prep.grid, a0, b0).ln());
+        let eps = 0.5 * tol;
+        let w0 = hi - lo;
+        let n_max = (w0 / tol).log2().ceil().max(0.0) + 1.0;
+        let k1 = 0.2 / w0.max(tol);
+        let mut j = 0.0;
+        let mut side = 0i8; // Illinois: halve the value kept at a repeated end
+        let mut hi_raw = s_hi;
         while hi - lo > tol {
             let w = hi - lo;
+            let half = 0.5 * (lo + hi);
+            let r = (eps * (n_max - j).exp2() - 0.5 * w).max(0.0);
+            j += 1.0;
             let mid = match s_lo {
-                Some(sl) if s_hi > sl => {
-                    (hi - s_hi * w / (s_hi - sl)).clamp(lo + 0.02 * w, hi - 0.02 * w)
+                Some(sl) if s_hi > sl && hi_raw < 0.9 => {
+                    // Aim a little above the estimate so that a good one closes the bracket.
+                    let xf = (lo - sl * w / (s_hi - sl) + 0.3 * tol).min(hi);
+                    let sigma = (half - xf).signum();
+                    let delta = k1 * w * w;
+                    let xt = if delta <= (half - xf).abs() {
+                        xf + sigma * delta
+                    } else {
+                        half
+                    };
+                    let x = if (xt - half).abs() <= r {
+                        xt
+                    } else {
+                        half - sigma * r
+                    };
+                    x.clamp(lo + 1e-3 * w, hi - 1e-3 * w)
                 }
-                _ => 0.5 * (lo + hi),
+                _ => half,
             };
-            // Aim a little above the estimate so that a good estimate closes the bracket.
-            let mid = (mid + 0.3 * tol).min(hi - 0.3 * tol).max(lo + 0.3 * tol);
             let t = mid.exp();
             let (s, a, b) = solve(t, "minimax", &mut events, &mut lp_solves, &mut mask);
             if s >= 0.0 {
-                hi = mid;
+                hi = mid.min(achieved_level(&phi, &prep.grid, &a, &b).ln());
                 s_hi = s;
+                hi_raw = s;
                 best = Some((t, a, b));
                 if side == 1 {
                     s_lo = s_lo.map(|v| 0.5 * v);

@@ -148,7 +148,7 @@ impl Lp {
             .presolve_enable(false)
             .tol_gap_abs(1e-6)
             .tol_gap_rel(1e-6)
-            .iterative_refinement_max_iter(3)
+            .iterative_refinement_max_iter(1)
             .build()
         else {
             return fail;
