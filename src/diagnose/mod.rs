@@ -12,6 +12,7 @@ pub mod candidates;
 pub mod engine;
 pub mod fit;
 pub mod nominal;
+pub mod report;
 
 pub use engine::{apply_candidate, diagnose, Diagnosis};
 pub use nominal::{refit_nominal, NominalRefit};
