@@ -626,16 +626,7 @@ impl PhysicalModel {
                 num: d,
                 den: qk.clone(),
             });
-            n_rows.push(
-                md.input_gain
-                    .to_vec(m)
-                    .iter()
-                    .map(|b| TransferFunction {
-                        num: Polynomial::constant(*b),
-                        den: qk.clone(),
-                    })
-                    .collect(),
-            );
+            n_rows.push(over(&md.input_gain.to_vec(m), &qk));
             c_cols.push(md.output_gain.to_vec(p));
         }
         for (list, order) in [(&self.rigid_body, 2usize), (&self.integrator, 1)] {
@@ -654,16 +645,7 @@ impl PhysicalModel {
                     num: Polynomial::new(num),
                     den: qk.clone(),
                 });
-                n_rows.push(
-                    md.input_gain
-                        .to_vec(m)
-                        .iter()
-                        .map(|b| TransferFunction {
-                            num: Polynomial::constant(*b),
-                            den: qk.clone(),
-                        })
-                        .collect(),
-                );
+                n_rows.push(over(&md.input_gain.to_vec(m), &qk));
                 c_cols.push(md.output_gain.to_vec(p));
             }
         }
@@ -705,6 +687,18 @@ impl PhysicalModel {
         let nn = TfMatrix::from_rows(n_rows).ok_or("[physical]: inconsistent input gains")?;
         Factorization::special(c, mm, nn, j).map_err(|e| format!("[physical]: {e}"))
     }
+}
+
+/// The row of `Ñ` for one modal coordinate: constant input gains over the common
+/// denominator `q(s)` of its row of `M̃`.
+fn over(gains: &[f64], q: &Polynomial) -> Vec<TransferFunction> {
+    gains
+        .iter()
+        .map(|b| TransferFunction {
+            num: Polynomial::constant(*b),
+            den: q.clone(),
+        })
+        .collect()
 }
 
 #[cfg(test)]
