@@ -25,14 +25,13 @@ pub fn mu_svg(inp: &MuInput) -> Result<String> {
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(inp.title, (FONT, CAPTION))
-            .margin(14)
-            .x_label_area_size(52)
-            .y_label_area_size(78)
-            .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
-            .map_err(plot_err)?;
-        loglog_mesh(&mut chart, "μ_Γ (dimensionless)")?;
+        let mut chart = loglog_chart(
+            &root,
+            inp.title,
+            (xlo, xhi),
+            (ylo, yhi),
+            "μ_Γ (dimensionless)",
+        )?;
         let s = C_GREY.stroke_width(2);
         chart
             .draw_series(DashedLineSeries::new(

@@ -188,6 +188,30 @@ pub fn legend_fraction(rows: usize, height: u32) -> f64 {
     (rows as f64 * 19.0 + 24.0) / height as f64
 }
 
+/// A chart with logarithmic axes on both sides.
+pub type LogLogChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// A log-frequency × log-magnitude chart on `root` with the caption, margins and mesh that
+/// `r_vs_delta.svg` and `mu.svg` share.
+pub fn loglog_chart<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    (xlo, xhi): (f64, f64),
+    (ylo, yhi): (f64, f64),
+    y_desc: &str,
+) -> Result<LogLogChart<'a, 'b>> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FONT, CAPTION))
+        .margin(14)
+        .x_label_area_size(52)
+        .y_label_area_size(78)
+        .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
+        .map_err(plot_err)?;
+    loglog_mesh(&mut chart, y_desc)?;
+    Ok(chart)
+}
+
 /// The mesh shared by the log-log figures: frequency in rad/s on x, `y_desc` on y, ticks at
 /// 1-2-5, light grid lines.
 pub fn loglog_mesh<X, Y>(
