@@ -177,7 +177,7 @@ pub fn finish(
             .and_then(|f| f.as_ref().ok())
             .map(|f| f.certificate.clone()),
         fit_error: match &fit {
-            Some(Err(e)) => Some(crate::cli::one_line(&e.to_string())),
+            Some(Err(e)) => Some(crate::report::fmt::one_line(&e.to_string())),
             None => Some("no dataset succeeded: nothing to fit".into()),
             _ => None,
         },

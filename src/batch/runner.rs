@@ -72,7 +72,7 @@ pub fn run_one(config: &Config, d: &Dataset, opts: &RunOptions, out: &Path) -> D
         envelope: None,
     };
     if let Err(e) = fill(config, d, opts, out, &mut res) {
-        res.error = Some(crate::cli::one_line(&e.to_string()));
+        res.error = Some(crate::report::fmt::one_line(&e.to_string()));
         res.envelope = None;
     }
     res

@@ -88,7 +88,4 @@ pub fn main() -> i32 {
     }
 }
 
-/// Folds a message onto one line.
-pub fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
-}
+pub use crate::report::fmt::one_line;

@@ -65,7 +65,7 @@ pub fn run(
     let fit = timings.time("fit", || {
         let a1 = |w: f64| f.a1_limit(w);
         integration::fit_r(&envelope, Some(&a1), order)
-            .map_err(|e| crate::cli::one_line(&e.to_string()))
+            .map_err(|e| crate::report::fmt::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {
         warnings.push(format!("fit failed: {e}"));

@@ -145,10 +145,10 @@ pub fn tf_label(tf: &crate::system::TransferFunction) -> String {
                 let coef = if p > 0 && *x == 1.0 {
                     String::new()
                 } else {
-                    crate::cli::common::fmt_g(*x)
+                    crate::report::fmt::fmt_g(*x)
                 };
                 match p {
-                    0 => crate::cli::common::fmt_g(*x),
+                    0 => crate::report::fmt::fmt_g(*x),
                     1 => format!("{coef} s"),
                     _ => format!("{coef} s^{p}"),
                 }

@@ -2,6 +2,7 @@
 //! `report.json` of a run.
 pub mod csv;
 pub mod export;
+pub mod fmt;
 pub mod run_report;
 
 pub use self::csv::envelope_csv;
