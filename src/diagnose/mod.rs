@@ -12,7 +12,10 @@ pub mod candidates;
 pub mod engine;
 pub mod fit;
 pub mod nominal;
+pub mod problem;
+pub mod rank;
 pub mod report;
+mod starts;
 
 pub use engine::{apply_candidate, diagnose, Diagnosis};
 pub use nominal::{refit_nominal, NominalRefit};

@@ -3,7 +3,7 @@
 
 use super::candidates::Cand;
 use super::compare::Band;
-use super::engine::{Measures, Mods};
+use super::problem::{Measures, Mods};
 use crate::model::physical::PhysicalModel;
 use serde::Serialize;
 use std::collections::BTreeMap;
