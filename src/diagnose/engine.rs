@@ -1,145 +1,475 @@
-//! `diagnose`: rank candidate missing effects by how much each lowers the error once fitted,
-//! and add them greedily.
+//! `diagnose`: retune the configured model, then search effect sets (several effects at
+//! once), check the final set on held-out data, and report.
 //!
-//! * Noise: `σ_k = r_k/√2` (noise uniform in the disk of radius `r_k`); the cost is
-//!   `V = Σ|G_d − Ĝ(θ)|²/σ_k²` (`E V ≈ F` for a right model), the complex-Gaussian `−ln L`.
-//! * Each candidate is fitted by Levenberg–Marquardt from the best points of a grid or a
-//!   closed-form estimate (effects.md), jointly with every effect accepted before.
-//! * Score: `ΔBIC = 2(V₀ − V) − n_θ·ln(2F)`. A candidate **passes** when ΔBIC > 10, the
-//!   invalid fraction does not rise, and the holdout checks pass: fit on 3 of every 4 data,
-//!   the held-out quarter's `V` must fall too; for a global (multiplicative) candidate, also
-//!   fit below 70 % of the band (log frequency) and the top 30 %'s `V` must fall.
-//! * Stop when the model is consistent (`invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`), when no
-//!   candidate passes, or after `max_effects` effects. Candidates within 6 of the best BIC are
-//!   reported as ties, with the frequency range where the two fitted models differ by more
-//!   than the noise.
+//! * Noise: `σ = r/√2` (noise uniform in the disk of radius `r`); the cost is
+//!   `V = Σ|G_d − Ĝ(θ)|²/σ²` over every channel (`E V ≈ F` for a right model), the
+//!   complex-Gaussian `−ln L`.
+//! * [`super::retune`]: the configured parameters, refit with wide bounds (residues by
+//!   least squares, modes placed by a grid from a rough start): the `retune` candidate.
+//! * [`super::search`]: beam search over effect sequences with a joint refit at every node.
+//! * Final holdout, per effect of the chosen set: fitted on 3 of every 4 data, the held-out
+//!   quarter's `V` must be lower with the effect than without it; for a multiplicative
+//!   effect, also fitted below 70 % of the band (log frequency), the top 30 % must be
+//!   predicted better. Both models are fitted on all data first and refit on the part from
+//!   there (so an effect the part does not see keeps its value). An effect that fails is
+//!   dropped and the rest refit. The extrapolation test decides only for a set of
+//!   multiplicative effects (a fit below the split cannot place a mode or a feedthrough that
+//!   acts above it); otherwise it is reported.
+//! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
 
-use super::compare::Siso;
-use super::nominal::refit_nominal;
-pub use super::problem::Measures;
-use super::problem::{Mods, Problem};
-use super::rank::si_map;
-pub use super::rank::{candidate_list, MIN_DELTA_BIC, TIE_BIC};
-pub use super::report::{CandidateReport, Diagnosis, Step, Tie};
+use super::candidates::{explain, sig};
+use crate::report::fmt::fmt_pct;
+use super::channels::Channels;
+use super::compare::{bands, Siso};
+use super::problem::{Measures, Problem};
+pub use super::problem::Measures as ErrorMeasures;
+use super::rank::{disambiguate, prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC};
+pub use super::rank::candidate_list;
+pub use super::report::{
+    CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
+};
+use super::retune::{cost, retune, ADDED_NOTE};
+use super::search::{add_effect, roots, search, Node, Settings};
 use crate::error::{Error, Result};
-use crate::model::physical::PhysicalModel;
+use crate::model::physical::{EffectKind, PhysicalModel};
+use std::collections::BTreeMap;
+use std::time::Instant;
 
-/// Runs the greedy diagnosis.
+/// Diagnoses one SISO channel (see [`diagnose_channels`]).
 pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result<Diagnosis> {
-    let p = Problem::new(base, siso)?;
-    let mut cur = Mods::default();
-    let before = p.measures(&cur);
-    let mut cur_m = before;
-    let mut steps = Vec::new();
-    let mut first: Option<(Vec<CandidateReport>, Vec<Tie>)> = None;
+    let data = Channels::from_siso(siso)?;
+    diagnose_channels(
+        base,
+        &data,
+        &Settings {
+            max_effects,
+            ..Default::default()
+        },
+    )
+}
+
+fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
+    Ok(Problem::new(m, data)?.measures(&Default::default()))
+}
+
+/// The model made of `root` (the configured model) and the effects `effects` (parameters as
+/// fitted when added), jointly refit on `mask` from a rough start.
+fn assemble(
+    root: &PhysicalModel,
+    effects: &[(super::candidates::Cand, Vec<f64>)],
+    data: &Channels,
+    mask: Option<&[usize]>,
+) -> PhysicalModel {
+    let mut m = root.clone();
+    for (c, th) in effects {
+        m = add_effect(&m, c, th, data);
+    }
+    retune(&m, data, mask, true).model
+}
+
+/// Final-set holdout of every effect of `node` (see the module docs).
+fn holdouts(root: &PhysicalModel, node: &Node, data: &Channels) -> Vec<Holdout> {
+    let f = data.len();
+    let fit: Vec<usize> = (0..f).filter(|k| k % 4 != 3).collect();
+    let ho: Vec<usize> = (0..f).filter(|k| k % 4 == 3).collect();
+    let cut = {
+        let (lo, hi) = (data.omega[0].ln(), data.omega[f - 1].ln());
+        (lo + EXTRAPOLATION_SPLIT * (hi - lo)).exp()
+    };
+    let (low, high): (Vec<usize>, Vec<usize>) = (0..f).partition(|k| data.omega[*k] < cut);
+    let extrap = low.len() >= MIN_SPLIT_DATA && high.len() >= MIN_SPLIT_DATA;
+    // Each model is fitted on all data first, then refit (LM from there) on the part: an
+    // effect the part does not see keeps its all-data value instead of drifting.
+    let part = |m: &PhysicalModel, mask: &[usize], test: &[usize]| {
+        cost(&retune(m, data, Some(mask), false).model, data, test)
+    };
+    let full = assemble(root, &node.effects, data, None);
+    let full_ho = part(&full, &fit, &ho);
+    let full_hi = extrap.then(|| part(&full, &low, &high));
+    (0..node.effects.len())
+        .map(|j| {
+            let others: Vec<_> = node
+                .effects
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != j)
+                .map(|(_, e)| e.clone())
+                .collect();
+            let c = node.effects[j].0;
+            let wo = assemble(root, &others, data, None);
+            let wo_ho = part(&wo, &fit, &ho);
+            let extrapolation_ok = (extrap && c.multiplicative())
+                .then(|| full_hi.unwrap_or(f64::INFINITY) < part(&wo, &low, &high));
+            Holdout {
+                effect: c.label(),
+                interleaved_ok: full_ho < wo_ho,
+                extrapolation_ok,
+            }
+        })
+        .collect()
+}
+
+/// The effects `diagnose` added to `m`, with their current parameters.
+pub fn final_effects(m: &PhysicalModel) -> Vec<FinalEffect> {
+    let added = |s: &Option<String>| s.as_deref().is_some_and(|n| n.starts_with(ADDED_NOTE));
+    let label = |s: &Option<String>| {
+        s.as_deref()
+            .and_then(|n| n.strip_prefix(ADDED_NOTE))
+            .map(|n| n.trim_start_matches(": ").to_string())
+            .unwrap_or_default()
+    };
+    let mut out = Vec::new();
+    for md in m.mode.iter().filter(|x| added(&x.name)) {
+        let mut p = BTreeMap::new();
+        p.insert("omega_n".to_string(), md.omega_n);
+        p.insert("zeta".to_string(), md.zeta);
+        for (i, c) in md.output_gain.to_vec(m.n_outputs()).iter().enumerate() {
+            let b = md.input_gain.to_vec(m.n_inputs());
+            for (j, bj) in b.iter().enumerate() {
+                let name = if m.n_outputs() * m.n_inputs() == 1 {
+                    "rho".to_string()
+                } else {
+                    format!("rho_{}_{}", i + 1, j + 1)
+                };
+                p.insert(name, c * bj / md.mass);
+            }
+        }
+        out.push(FinalEffect {
+            effect: label(&md.name),
+            params: p,
+        });
+    }
+    for (list, order) in [(&m.rigid_body, 2.0), (&m.integrator, 1.0)] {
+        for r in list.iter().filter(|x| added(&x.name)) {
+            let mut p = BTreeMap::new();
+            p.insert("order".to_string(), order);
+            let c = r.output_gain.to_vec(m.n_outputs());
+            p.insert("c".to_string(), c[0] * r.input_gain.to_vec(m.n_inputs())[0] / r.mass);
+            out.push(FinalEffect {
+                effect: label(&r.name),
+                params: p,
+            });
+        }
+    }
+    for e in m.effect.iter().filter(|e| added(&e.note)) {
+        let mut p = BTreeMap::new();
+        let (k, v) = match e.kind {
+            EffectKind::Delay => ("tau_s", e.tau_s),
+            EffectKind::Lag => ("omega_c", e.omega_c),
+            EffectKind::NmpZero => ("z", e.z),
+            EffectKind::Zoh => ("t_s", e.t_s),
+            EffectKind::Gain => ("k", e.k),
+            EffectKind::Sign => ("k", Some(-1.0)),
+        };
+        p.insert(k.to_string(), v.unwrap_or(f64::NAN));
+        out.push(FinalEffect {
+            effect: label(&e.note),
+            params: p,
+        });
+    }
+    out
+}
+
+/// Diagnoses the channels `data` jointly: retune, search, final holdout, report.
+pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) -> Result<Diagnosis> {
+    let t0 = Instant::now();
+    if data.is_empty() {
+        return Err(Error::Invalid(format!("{}: no data", data.path.display())));
+    }
+    let before = measures(base, data)?;
+    let n = data.n_data();
+    let ln2f = (2.0 * n as f64).ln();
+    let mk_stats = |expanded, joint_refits| SearchStats {
+        beam: s.beam,
+        nodes_expanded: expanded,
+        joint_refits,
+        seconds: t0.elapsed().as_secs_f64(),
+    };
     if before.consistent() {
         return Ok(Diagnosis {
             verdict: "consistent".into(),
             message: format!(
-                "the model explains the data within the noise (misfit_rms = {:.3}, invalid_fraction = {:.1} %): nothing needs to be added",
-                before.misfit_rms,
-                100.0 * before.invalid_fraction
+                "the model explains the data within the noise (misfit_rms = {}, invalid_fraction = {}): nothing needs to be added",
+                sig(before.misfit_rms),
+                fmt_pct(before.invalid_fraction)
             ),
-            n_data: p.f(),
+            n_data: n,
+            n_channels: data.n_ch(),
             before,
+            retuned: before,
             after: before,
             candidates: vec![],
             ties: vec![],
-            steps,
-            cost_test: Some([p.f() as f64, before.v]),
+            steps: vec![],
+            chosen: vec![],
+            runner_up: vec![],
+            holdout: vec![],
+            dropped: vec![],
+            final_effects: vec![],
+            cost_test: Some([n as f64, before.v]),
+            search: mk_stats(0, 0),
             final_model: base.clone(),
         });
     }
-    let before_f = p.f() as f64;
-    drop(p);
-    // After each accepted effect the model is rebuilt with the effect written into it, and
-    // every parameter (the configured ones and the accepted effects') is refit jointly
-    // (bounded LM, `nominal::refit_nominal`); the next step ranks candidates on that model.
-    let radius = siso.radius.clone().expect("checked by Problem::new");
-    let mut model = base.clone();
-    let mut n_fitted = 0usize;
-    for step in 0..max_effects {
-        let p = Problem::new(&model, siso)?;
-        let ranked = p.rank(&cur, cur_m);
-        let ties = p.ties(&ranked);
-        let accept = ranked.iter().find(|c| c.passes).cloned();
-        if first.is_none() {
-            first = Some((ranked, ties.clone()));
+    let [configured, retuned_node] = roots(base, data)?;
+    let root_model = retuned_node.model.clone();
+    let retuned = retuned_node.measures;
+    let res = search(vec![configured, retuned_node], data, s)?;
+    // First-level candidates: the retune, and each effect on top of it.
+    let (_, flags0) = Problem::new(base, data)?.invalid_flags(&Default::default());
+    let explained = |m: &PhysicalModel| -> Vec<super::compare::Band> {
+        let Ok(p) = Problem::new(m, data) else {
+            return vec![];
+        };
+        let (c1, f1) = p.invalid_flags(&Default::default());
+        let fixed: Vec<bool> = flags0.iter().zip(&f1).map(|(a, b)| *a && !*b).collect();
+        bands(&data.omega, &c1, &fixed)
+    };
+    let mut candidates = vec![CandidateReport {
+        rank: 0,
+        effect: "retune".into(),
+        params: BTreeMap::new(),
+        uncertainty_2sigma: BTreeMap::new(),
+        v_before: before.v,
+        v_after: retuned.v,
+        misfit_rms_before: before.misfit_rms,
+        misfit_rms_after: retuned.misfit_rms,
+        invalid_fraction_before: before.invalid_fraction,
+        invalid_fraction_after: retuned.invalid_fraction,
+        delta_bic: 2.0 * (before.v - retuned.v),
+        delta_bic_vs_retune: 0.0,
+        n_params: 0,
+        joint_refit: true,
+        passes: 2.0 * (before.v - retuned.v) > MIN_DELTA_BIC,
+        tie_with_best: false,
+        flags: vec![],
+        no_fit: None,
+        explanation: format!(
+            "refit of the configured model's own parameters (residues and gains over four decades, every ω_n, ζ, pole and delay; modes placed by a grid from a rough start): misfit_rms {} → {}",
+            sig(before.misfit_rms),
+            sig(retuned.misfit_rms)
+        ),
+        explained_bands: explained(&root_model),
+        cand: None,
+        model: root_model.clone(),
+    }];
+    for (sc, child) in &res.first_level {
+        let nn = sc.cand.n_params(data.n_ch());
+        let th = &sc.mods.theta;
+        let (model, m, joint) = match child {
+            Some(c) => (c.model.clone(), c.measures, true),
+            None => (add_effect(&root_model, &sc.cand, th, data), sc.measures, false),
+        };
+        let mut unc = BTreeMap::new();
+        if sc.no_fit.is_none() {
+            if let Some(cov) = (sc.jtj.clone() * 2.0).try_inverse() {
+                for (j, (name, _, fac)) in sc.cand.si_params(th, &data.entries).iter().enumerate() {
+                    let idx = j.saturating_sub(sc.cand.si_params(th, &data.entries).len() - nn);
+                    if *fac != 0.0 && idx < nn {
+                        let sd = 2.0 * cov[(idx, idx)].max(0.0).sqrt() * fac;
+                        if sd.is_finite() {
+                            unc.insert(name.clone(), sd);
+                        }
+                    }
+                }
+            }
         }
-        let Some(acc) = accept else { break };
-        let with_effect = p.measures(&acc.mods);
-        let n = acc.cand.n_params();
-        let th = &acc.mods.theta[acc.mods.theta.len() - n..];
-        let params = si_map(&acc.cand, th);
-        let mut next = model.clone();
-        acc.cand.apply_to(
-            th,
-            &mut next,
-            &format!("added by rshape diagnose: {}", acc.effect),
-        );
-        let refit = refit_nominal(&next, &siso.omega, &siso.g, &radius);
-        n_fitted = refit.n_params;
-        model = refit.model;
-        cur = Mods::default();
-        cur_m = Problem::new(&model, siso)?.measures(&cur);
-        steps.push(Step {
-            step: step + 1,
-            effect: acc.effect.clone(),
-            params,
-            explanation: acc.explanation.clone(),
-            misfit_rms: cur_m.misfit_rms,
-            invalid_fraction: cur_m.invalid_fraction,
-            delta_bic: acc.delta_bic,
-            misfit_rms_before_refit: with_effect.misfit_rms,
-            invalid_fraction_before_refit: with_effect.invalid_fraction,
-            n_refit: refit.n_params,
-            ties,
+        let d_root = 2.0 * (retuned.v - m.v) - nn as f64 * ln2f;
+        candidates.push(CandidateReport {
+            rank: 0,
+            effect: sc.cand.label(),
+            params: if sc.no_fit.is_none() {
+                si_map(&sc.cand, th, &data.entries)
+            } else {
+                BTreeMap::new()
+            },
+            uncertainty_2sigma: unc,
+            v_before: before.v,
+            v_after: m.v,
+            misfit_rms_before: before.misfit_rms,
+            misfit_rms_after: m.misfit_rms,
+            invalid_fraction_before: before.invalid_fraction,
+            invalid_fraction_after: m.invalid_fraction,
+            delta_bic: 2.0 * (before.v - m.v) - nn as f64 * ln2f,
+            delta_bic_vs_retune: d_root,
+            n_params: nn,
+            joint_refit: joint,
+            passes: sc.no_fit.is_none()
+                && sc.flags.is_empty()
+                && d_root > MIN_DELTA_BIC
+                && m.invalid_fraction <= retuned.invalid_fraction,
+            tie_with_best: false,
+            flags: sc.flags.clone(),
+            no_fit: sc.no_fit.clone(),
+            explanation: match &sc.no_fit {
+                Some(why) => format!("no fit: {why}"),
+                None => explain(&sc.cand, th, &data.entries, &root_model, &data.omega),
+            },
+            explained_bands: if sc.no_fit.is_none() { explained(&model) } else { vec![] },
+            cand: Some(sc.cand),
+            model,
         });
-        if cur_m.consistent() {
-            break;
+    }
+    // Rank: usable fits by ΔBIC (near-ties by fewer parameters, then the catalogue's prior
+    // order), no-fits last.
+    candidates.sort_by(|a, b| {
+        (a.no_fit.is_some())
+            .cmp(&b.no_fit.is_some())
+            .then(b.delta_bic.total_cmp(&a.delta_bic))
+    });
+    if let Some(best) = candidates.first().map(|c| c.delta_bic) {
+        let n_tied = candidates
+            .iter()
+            .take_while(|c| c.no_fit.is_none() && best - c.delta_bic < TIE_BIC)
+            .count();
+        candidates[..n_tied].sort_by_key(|c| (c.n_params, c.cand.as_ref().map_or(0, |c| 1 + prior(c))));
+    }
+    for (k, c) in candidates.iter_mut().enumerate() {
+        c.rank = k + 1;
+    }
+    let mut ties = Vec::new();
+    if let Some(best) = candidates.first().cloned() {
+        for c in candidates.iter_mut().skip(1) {
+            c.tie_with_best = c.passes
+                && best.passes
+                && (best.delta_bic - c.delta_bic).abs() < TIE_BIC;
+            if c.tie_with_best {
+                ties.push(Tie {
+                    effects: [best.effect.clone(), c.effect.clone()],
+                    bic_gap: (best.delta_bic - c.delta_bic).abs(),
+                    disambiguation: disambiguate(&best.model, &c.model, data),
+                });
+            }
         }
     }
-    let (candidates, ties) = first.unwrap_or_default();
-    let verdict = if steps.is_empty() {
-        "no_effect_found"
-    } else {
+    // The chosen set, its final holdout, runner-ups and ties.
+    let mut node = res.nodes[res.chosen].clone();
+    let holdout = holdouts(base, &node, data);
+    // A fit below 70 % of the band cannot place an additive effect (a mode, a feedthrough)
+    // that acts above it, so the extrapolation test decides only for sets of multiplicative
+    // effects; otherwise it is reported.
+    let all_mult = node.effects.iter().all(|e| e.0.multiplicative());
+    let failing: Vec<usize> = holdout
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| !h.interleaved_ok || (all_mult && h.extrapolation_ok == Some(false)))
+        .map(|(i, _)| i)
+        .collect();
+    let mut dropped = Vec::new();
+    if !failing.is_empty() {
+        let keep: Vec<_> = node
+            .effects
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !failing.contains(i))
+            .map(|(_, e)| e.clone())
+            .collect();
+        dropped = failing.iter().map(|i| node.effects[*i].0.label()).collect();
+        let model = assemble(base, &keep, data, None);
+        node.measures = measures(&model, data)?;
+        node.model = model;
+        node.steps.retain(|st| !dropped.contains(&st.effect));
+        node.effects = keep;
+    }
+    // A last joint refit of the chosen model.
+    let polished = retune(&node.model, data, None, false);
+    if polished.v_after < node.measures.v {
+        node.measures = measures(&polished.model, data)?;
+        node.model = polished.model;
+    }
+    let chosen_bic = res.nodes[res.chosen].bic;
+    let mut runner_up: Vec<EffectSet> = res
+        .nodes
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != res.chosen)
+        .map(|(_, nd)| EffectSet {
+            effects: nd.labels(),
+            bic: nd.bic,
+            bic_gap: nd.bic - chosen_bic,
+            misfit_rms: nd.measures.misfit_rms,
+            invalid_fraction: nd.measures.invalid_fraction,
+            consistent: nd.measures.consistent(),
+        })
+        .collect();
+    runner_up.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+    runner_up.truncate(4);
+    let chosen_labels = node.labels();
+    for (i, nd) in res.nodes.iter().enumerate() {
+        let gap = (nd.bic - chosen_bic).abs();
+        if i != res.chosen
+            && gap < TIE_BIC
+            && nd.effects.len() == res.nodes[res.chosen].effects.len()
+            && !nd.effects.is_empty()
+        {
+            ties.push(Tie {
+                effects: [chosen_labels.join(" + "), nd.labels().join(" + ")],
+                bic_gap: gap,
+                disambiguation: disambiguate(&node.model, &nd.model, data),
+            });
+        }
+    }
+    let after = node.measures;
+    let verdict = if !node.effects.is_empty() {
         "effects_found"
-    };
-    let message = if steps.is_empty() {
-        "the model does not explain the data, but no candidate effect passes (ΔBIC > 10, fewer invalid data, holdout): the missing dynamics are not in the catalogue, or the noise radius is too small".to_string()
+    } else if retuned.consistent() {
+        "retuned"
     } else {
-        let list: Vec<String> = steps.iter().map(|s| s.effect.clone()).collect();
-        format!(
-            "added {}: misfit_rms {:.3} → {:.3}, invalid_fraction {:.1} % → {:.1} %{}",
-            list.join(" + "),
-            before.misfit_rms,
-            cur_m.misfit_rms,
-            100.0 * before.invalid_fraction,
-            100.0 * cur_m.invalid_fraction,
-            if cur_m.consistent() {
-                " (now consistent with the data within the noise)"
-            } else {
-                " (still not consistent: more is missing)"
-            }
-        )
+        "no_effect_found"
     };
-    let n_theta = n_fitted as f64;
+    let status = if after.consistent() {
+        " (now consistent with the data within the noise)"
+    } else {
+        " (still not consistent: more is missing)"
+    };
+    let message = match verdict {
+        "retuned" => format!(
+            "the configured model explains the data once its own parameters are refit (retune): misfit_rms {} → {}, invalid_fraction {} → {}; nothing added",
+            sig(before.misfit_rms),
+            sig(retuned.misfit_rms),
+            fmt_pct(before.invalid_fraction),
+            fmt_pct(retuned.invalid_fraction)
+        ),
+        "effects_found" => format!(
+            "retune + {}: misfit_rms {} → {} (retune alone {}), invalid_fraction {} → {}{status}",
+            chosen_labels.join(" + "),
+            sig(before.misfit_rms),
+            sig(after.misfit_rms),
+            sig(retuned.misfit_rms),
+            fmt_pct(before.invalid_fraction),
+            fmt_pct(after.invalid_fraction)
+        ),
+        _ => format!(
+            "the model does not explain the data even retuned (misfit_rms {} → {}), and no candidate effect passes (ΔBIC > 10, plausible, fewer invalid data, holdout): the missing dynamics are not in the catalogue, or the noise radius is too small",
+            sig(before.misfit_rms),
+            sig(retuned.misfit_rms)
+        ),
+    };
     Ok(Diagnosis {
         verdict: verdict.into(),
         message,
-        n_data: siso.omega.len(),
+        n_data: n,
+        n_channels: data.n_ch(),
         before,
-        after: cur_m,
+        retuned,
+        after,
         candidates,
         ties,
-        steps,
-        cost_test: Some([before_f - n_theta / 2.0, cur_m.v]),
-        final_model: model,
+        steps: node.steps.clone(),
+        chosen: chosen_labels,
+        runner_up,
+        holdout,
+        dropped,
+        final_effects: final_effects(&node.model),
+        cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
+        search: mk_stats(res.expanded, res.joint_refits),
+        final_model: node.model,
     })
 }
 
-/// The base model with candidate `rank` (1-based) of the first step added.
-pub fn apply_candidate(base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Result<PhysicalModel> {
+/// The revised model of first-level candidate `rank` (1-based): the retuned model with the
+/// candidate added and every parameter refit jointly.
+pub fn apply_candidate(_base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Result<PhysicalModel> {
     let c = d.candidates.get(rank.wrapping_sub(1)).ok_or_else(|| {
         Error::Invalid(format!(
             "--apply {rank}: there are {} candidates (1..={})",
@@ -147,13 +477,11 @@ pub fn apply_candidate(base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Resu
             d.candidates.len()
         ))
     })?;
-    let mut m = base.clone();
-    let n = c.cand.n_params();
-    let th = &c.mods.theta[c.mods.theta.len() - n..];
-    c.cand.apply_to(
-        th,
-        &mut m,
-        &format!("added by rshape diagnose: {}", c.effect),
-    );
-    Ok(m)
+    if let Some(why) = &c.no_fit {
+        return Err(Error::Invalid(format!(
+            "--apply {rank}: {} has no fit ({why})",
+            c.effect
+        )));
+    }
+    Ok(c.model.clone())
 }

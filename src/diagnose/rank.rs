@@ -1,80 +1,198 @@
-//! Fitting and ranking the candidates on top of a model: ΔBIC, invalid fraction, the
-//! interleaved and extrapolation holdouts, 2σ uncertainties and ties.
+//! Screening the candidates on top of a model (each fitted alone, the model fixed), their
+//! physical plausibility, and where two fitted models can be told apart.
 
-use super::candidates::{explain, fmt_w, Cand};
-use super::compare::bands;
+use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
+use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
-use super::report::{CandidateReport, Tie};
 use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
 /// ΔBIC a candidate needs to be accepted.
 pub const MIN_DELTA_BIC: f64 = 10.0;
-/// BIC gap under which two candidates are a tie.
+/// BIC gap under which two candidates (or two effect sets) are a tie.
 pub const TIE_BIC: f64 = 6.0;
 /// Extrapolation holdout: fit below this share of the band (log frequency), predict above.
 pub const EXTRAPOLATION_SPLIT: f64 = 0.7;
 /// Fewest data on either side of the split for the extrapolation holdout to run.
 pub const MIN_SPLIT_DATA: usize = 8;
-/// Prior order among near-ties (lower first).
-pub(super) fn prior(c: &Cand) -> usize {
+/// A fitted frequency beyond this factor outside the measured band is "no fit".
+pub const MAX_BAND_FACTOR: f64 = 1e6;
+
+/// Prior order among near-ties (lower first): fewer assumptions first.
+pub fn prior(c: &Cand) -> usize {
     match c {
-        Cand::Sign => 0,
-        Cand::Gain => 1,
-        Cand::Delay => 2,
-        Cand::Lag => 3,
-        Cand::Zoh => 4,
+        Cand::Sign(_) => 0,
+        Cand::Gain(_) => 1,
+        Cand::Delay(_) => 2,
+        Cand::Lag(_) => 3,
+        Cand::Zoh(_) => 4,
         Cand::Feedthrough => 5,
-        Cand::Integrator(_) => 6,
+        Cand::Integrator(_) | Cand::Friction(_) => 6,
         Cand::Damping(_) => 7,
         Cand::ModeShift(_) => 8,
-        Cand::NmpZero => 9,
+        Cand::NmpZero(_) => 9,
         Cand::Mode => 10,
-        Cand::Friction(_) => 6,
     }
 }
 
-pub(super) fn si_map(c: &Cand, th: &[f64]) -> BTreeMap<String, f64> {
-    c.si_params(th)
+/// SI parameters by name.
+pub fn si_map(c: &Cand, th: &[f64], entries: &[(usize, usize)]) -> BTreeMap<String, f64> {
+    c.si_params(th, entries)
         .into_iter()
-        .map(|(n, v, _)| (n.to_string(), v))
+        .map(|(n, v, _)| (n, v))
         .collect()
 }
 
-/// The candidate list for a base model (mode shifts and damping for every base mode).
-pub fn candidate_list(base: &PhysicalModel) -> Vec<Cand> {
-    let mut v = vec![
-        Cand::Delay,
-        Cand::Lag,
-        Cand::Gain,
-        Cand::Sign,
+/// The candidates tried on a model with `n_out × n_in` channels observed.  Gains, signs,
+/// mode shifts and damping changes are not in the list: the retune (refit of the model's own
+/// residues, frequencies and dampings) covers them.  With several channels, path effects are
+/// tried on every channel, on each output and on each input.
+pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
+    let mut sels = vec![Sel::All];
+    if data.n_ch() > 1 {
+        let mut outs: Vec<usize> = data.entries.iter().map(|e| e.0).collect();
+        outs.dedup();
+        let mut ins: Vec<usize> = data.entries.iter().map(|e| e.1).collect();
+        ins.sort();
+        ins.dedup();
+        if outs.len() > 1 {
+            sels.extend(outs.iter().map(|o| Sel::Output(*o)));
+        }
+        if ins.len() > 1 {
+            sels.extend(ins.iter().map(|i| Sel::Input(*i)));
+        }
+    }
+    let mut v = Vec::new();
+    for s in &sels {
+        v.extend([Cand::Delay(*s), Cand::Lag(*s), Cand::NmpZero(*s), Cand::Zoh(*s)]);
+    }
+    v.extend([
         Cand::Mode,
         Cand::Integrator(1),
         Cand::Integrator(2),
         Cand::Feedthrough,
-        Cand::NmpZero,
-        Cand::Zoh,
-    ];
-    for i in 0..base.mode.len() {
-        v.push(Cand::ModeShift(i));
-        v.push(Cand::Damping(i));
-    }
-    for i in 0..base.rigid_body.len() {
-        v.push(Cand::Friction(i));
+    ]);
+    for (i, r) in base.rigid_body.iter().enumerate() {
+        if r.friction_pole.is_none() {
+            v.push(Cand::Friction(i));
+        }
     }
     v
 }
 
+/// Physical plausibility of fitted parameters (effects.md step 3): `(flags, no_fit)`.
+/// `no_fit` is the reason the fit is unusable (non-finite, or a frequency more than
+/// [`MAX_BAND_FACTOR`] outside the band); a flag names a parameter at its bound (not
+/// identified) or a mode outside the band (a compliance or mass line, another effect).
+pub fn plausibility(
+    c: &Cand,
+    th: &[f64],
+    v: f64,
+    entries: &[(usize, usize)],
+    w_min: f64,
+    w_max: f64,
+) -> (Vec<String>, Option<String>) {
+    if !v.is_finite() || th.iter().any(|x| !x.is_finite()) {
+        return (
+            vec![],
+            Some("the fit did not converge (non-finite cost or parameter)".into()),
+        );
+    }
+    let si = si_map(c, th, entries);
+    let mut flags = Vec::new();
+    for (name, x) in &si {
+        let freq = match name.as_str() {
+            "omega_n" | "omega_c" | "z" | "pole" => Some(*x),
+            "t_s" => Some(std::f64::consts::TAU / x),
+            _ => None,
+        };
+        if let Some(w) = freq {
+            if !(w > w_min / MAX_BAND_FACTOR && w < w_max * MAX_BAND_FACTOR) {
+                return (
+                    vec![],
+                    Some(format!(
+                        "{name} runs away from the measured band ({} … {}): the data do not determine it",
+                        fmt_w(w_min),
+                        fmt_w(w_max)
+                    )),
+                );
+            }
+        }
+        if !x.is_finite() || x.abs() > 1e300 {
+            return (vec![], Some(format!("{name} is not finite")));
+        }
+    }
+    let bounds = c.bounds(entries.len(), w_min, w_max);
+    let at = |i: usize| {
+        let (lo, hi) = bounds[i];
+        let tol = 1e-3 * (1.0 + th[i].abs());
+        (th[i] - lo).abs() < tol || (hi - th[i]).abs() < tol
+    };
+    match c {
+        Cand::Mode => {
+            if at(0) {
+                let w = th[0].exp();
+                let edge = if w < (w_min * w_max).sqrt() {
+                    "below: a mass line, see the rigid_body candidate"
+                } else {
+                    "above: a compliance line, see the feedthrough candidate"
+                };
+                flags.push(format!(
+                    "ω_n at the band edge {}: the resonance is not inside the measured band ({edge})",
+                    fmt_w(w)
+                ));
+            }
+            if at(1) {
+                let z = th[1].exp().clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1);
+                flags.push(format!(
+                    "ζ at its {} bound {}: not identified",
+                    if z < 0.01 { "lower" } else { "upper" },
+                    sig(z)
+                ));
+            }
+        }
+        Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
+        Cand::Lag(_) | Cand::NmpZero(_) | Cand::Zoh(_) | Cand::Friction(_) | Cand::Delay(_)
+            if at(0) =>
+        {
+            flags.push(format!(
+                "{} at its bound: not identified",
+                si.keys().last().cloned().unwrap_or_default()
+            ))
+        }
+        _ => {}
+    }
+    (flags, None)
+}
+
+/// A candidate fitted alone on top of a model.
+#[derive(Debug, Clone)]
+pub struct Screened {
+    /// The candidate.
+    pub cand: Cand,
+    /// Its fitted parameters (on top of the model).
+    pub mods: Mods,
+    /// Cost with it.
+    pub v: f64,
+    /// Measures with it.
+    pub measures: Measures,
+    /// `2(V₀ − V) − n ln(2F)`.
+    pub delta_bic: f64,
+    /// Plausibility flags.
+    pub flags: Vec<String>,
+    /// Why the fit is unusable.
+    pub no_fit: Option<String>,
+    /// `JᵀJ` at the optimum.
+    pub jtj: DMatrix<f64>,
+}
+
 impl Problem<'_> {
-    pub(super) fn fit_candidate(
-        &self,
-        cur: &Mods,
-        c: Cand,
-        mask: &[usize],
-    ) -> (Mods, f64, DMatrix<f64>) {
+    /// Fits candidate `c` alone on top of the problem's model (multi-start).
+    pub(super) fn fit_candidate(&self, c: Cand, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
+        let cur = Mods::default();
         let mut best: Option<(Mods, f64, DMatrix<f64>)> = None;
-        for st in self.starts(cur, c, mask) {
+        for st in self.starts(&cur, c, mask) {
             let m = cur.with(c, &st);
             let fit = self.refit(&m, mask);
             if best.as_ref().is_none_or(|b| fit.1 < b.1) {
@@ -84,182 +202,77 @@ impl Problem<'_> {
         best.expect("at least one start")
     }
 
-    pub(super) fn disambiguate(&self, a: &Mods, b: &Mods) -> String {
-        let (wmin, wmax) = (self.omega[0], self.omega_max());
-        let rel: Vec<f64> = (0..self.f())
-            .map(|k| self.radius[k] / self.g[k].norm().max(1e-300))
-            .collect();
-        let mut sorted = rel.clone();
-        sorted.sort_by(|x, y| x.total_cmp(y));
-        let rel_noise = sorted[sorted.len() / 2];
-        let differs = |w: f64| {
-            let (ga, gb) = (self.eval_at(a, None, w), self.eval_at(b, None, w));
-            (ga - gb).norm() > rel_noise * ga.norm()
-        };
-        let above = (1..=200)
-            .map(|i| wmax * 10f64.powf(i as f64 * 2.0 / 200.0))
-            .find(|w| differs(*w));
-        let below = (1..=200)
-            .map(|i| wmin / 10f64.powf(i as f64 * 2.0 / 200.0))
-            .find(|w| differs(*w));
-        match (above, below) {
-            (Some(h), Some(l)) => format!(
-                "the two fitted models differ by more than the noise above {} and below {}: measure there to tell them apart",
-                fmt_w(h),
-                fmt_w(l)
-            ),
-            (Some(h), None) => format!(
-                "the two fitted models differ by more than the noise above {}: measure there to tell them apart",
-                fmt_w(h)
-            ),
-            (None, Some(l)) => format!(
-                "the two fitted models differ by more than the noise below {}: measure there to tell them apart",
-                fmt_w(l)
-            ),
-            (None, None) => "the two fitted models agree within the noise from a hundredth of the lowest to a hundred times the highest measured frequency: lower the noise (more periods or averages) to tell them apart".into(),
-        }
-    }
-
-    /// Fits and ranks every candidate on top of the current model `cur`.
-    pub(super) fn rank(&self, cur: &Mods, cur_m: Measures) -> Vec<CandidateReport> {
+    /// Fits every candidate alone on the model and sorts them by ΔBIC (best first).
+    pub(super) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
         let all: Vec<usize> = (0..self.f()).collect();
-        let fit_mask: Vec<usize> = (0..self.f()).filter(|k| k % 4 != 3).collect();
-        let ho_mask: Vec<usize> = (0..self.f()).filter(|k| k % 4 == 3).collect();
-        let cur_fit = self.refit(cur, &fit_mask).0;
-        let v_ho_cur = self.v(&cur_fit, &ho_mask);
-        // Extrapolation holdout for global (multiplicative) candidates: fit below 70 % of the
-        // band (in log frequency), predict the top 30 %.
-        let (lo_mask, hi_mask) = self.split_band(EXTRAPOLATION_SPLIT);
-        let extrap = lo_mask.len() >= MIN_SPLIT_DATA && hi_mask.len() >= MIN_SPLIT_DATA;
-        let v_hi_cur = if extrap {
-            let f = self.refit(cur, &lo_mask).0;
-            self.v(&f, &hi_mask)
-        } else {
-            f64::INFINITY
-        };
-        let (_, flags0) = self.invalid_flags(cur);
-        let ln2f = (2.0 * self.f() as f64).ln();
-        let used: Vec<Cand> = cur.cands.clone();
-        let mut out: Vec<CandidateReport> = Vec::new();
-        for c in candidate_list(self.base) {
-            // A base mode is shifted or re-damped once.
-            let clash = |i: usize| {
-                used.iter()
-                    .any(|u| matches!(u, Cand::ModeShift(j) | Cand::Damping(j) if *j == i))
-            };
-            if let Cand::ModeShift(i) | Cand::Damping(i) = c {
-                if clash(i) {
-                    continue;
+        let ln2f = (2.0 * self.n_data() as f64).ln();
+        let mut out: Vec<Screened> = cands
+            .iter()
+            .map(|c| {
+                let (mods, v, jtj) = self.fit_candidate(*c, &all);
+                let measures = self.measures(&mods);
+                let n = c.n_params(self.n_ch());
+                let (flags, no_fit) = plausibility(
+                    c,
+                    &mods.theta,
+                    v,
+                    &self.data.entries,
+                    self.omega_min(),
+                    self.omega_max(),
+                );
+                Screened {
+                    cand: *c,
+                    delta_bic: 2.0 * (cur.v - v) - n as f64 * ln2f,
+                    mods,
+                    v,
+                    measures,
+                    flags,
+                    no_fit,
+                    jtj,
                 }
-            }
-            if matches!(c, Cand::Friction(_)) && used.contains(&c) {
-                continue;
-            }
-            let (mods, v, jtj) = self.fit_candidate(cur, c, &all);
-            if !v.is_finite() {
-                continue;
-            }
-            let m = self.measures(&mods);
-            let n_new = c.n_params();
-            let delta_bic = 2.0 * (cur_m.v - v) - n_new as f64 * ln2f;
-            let ho = self.refit(&mods, &fit_mask).0;
-            let interleaved_ok = self.v(&ho, &ho_mask) < v_ho_cur;
-            let extrapolation_ok = (extrap && c.multiplicative()).then(|| {
-                let f = self.refit(&mods, &lo_mask).0;
-                self.v(&f, &hi_mask) < v_hi_cur
-            });
-            let holdout_ok = interleaved_ok && extrapolation_ok.unwrap_or(true);
-            let th_new = &mods.theta[mods.theta.len() - n_new..];
-            // 2σ of the new parameters.
-            let ntot = mods.theta.len();
-            let cov = (jtj * 2.0).try_inverse();
-            let si = c.si_params(th_new);
-            let mut unc = BTreeMap::new();
-            for (j, (name, _, fac)) in si.iter().enumerate() {
-                if *fac == 0.0 {
-                    continue;
-                }
-                let idx = ntot - n_new + j.min(n_new.saturating_sub(1));
-                let idx = match c {
-                    Cand::ModeShift(_)
-                    | Cand::Damping(_)
-                    | Cand::Integrator(_)
-                    | Cand::Friction(_) => ntot - 1,
-                    _ => idx,
-                };
-                let sd = cov
-                    .as_ref()
-                    .map(|cv| cv[(idx, idx)].max(0.0).sqrt())
-                    .unwrap_or(f64::NAN);
-                unc.insert(name.to_string(), 2.0 * sd * fac);
-            }
-            let (cm, flags1) = self.invalid_flags(&mods);
-            let fixed: Vec<bool> = flags0.iter().zip(&flags1).map(|(a, b)| *a && !*b).collect();
-            let passes = delta_bic > MIN_DELTA_BIC
-                && m.invalid_fraction <= cur_m.invalid_fraction
-                && holdout_ok;
-            out.push(CandidateReport {
-                rank: 0,
-                effect: c.name().into(),
-                params: si_map(&c, th_new),
-                uncertainty_2sigma: unc,
-                v_before: cur_m.v,
-                v_after: v,
-                misfit_rms_before: cur_m.misfit_rms,
-                misfit_rms_after: m.misfit_rms,
-                invalid_fraction_before: cur_m.invalid_fraction,
-                invalid_fraction_after: m.invalid_fraction,
-                delta_bic,
-                n_params: n_new,
-                holdout_ok,
-                holdout_interleaved_ok: interleaved_ok,
-                holdout_extrapolation_ok: extrapolation_ok,
-                passes,
-                tie_with_best: false,
-                explanation: explain(&c, th_new, self.base, &self.omega),
-                explained_bands: bands(&self.omega, &cm, &fixed),
-                cand: c,
-                mods,
-            });
-        }
+            })
+            .collect();
         out.sort_by(|a, b| b.delta_bic.total_cmp(&a.delta_bic));
-        // Near-ties with the best are ordered by fewer parameters, then by the prior order
-        // of the catalogue (a delay before an NMP zero far above the band, which only a
-        // measurement there can tell apart); the tie is still reported.
-        if let Some(best) = out.first().map(|c| c.delta_bic) {
-            let n_tied = out
-                .iter()
-                .take_while(|c| best - c.delta_bic < TIE_BIC)
-                .count();
-            out[..n_tied].sort_by_key(|c| (c.n_params, prior(&c.cand)));
-        }
-        // Keep the best of each effect name (mode_shift over modes, integrator over orders).
-        let mut seen = std::collections::HashSet::new();
-        out.retain(|c| seen.insert(c.effect.clone()));
-        for (k, c) in out.iter_mut().enumerate() {
-            c.rank = k + 1;
-        }
-        if let Some(best) = out.iter().map(|c| c.delta_bic).reduce(f64::max) {
-            for c in out.iter_mut().skip(1) {
-                c.tie_with_best = best - c.delta_bic < TIE_BIC && c.delta_bic > MIN_DELTA_BIC;
-            }
-        }
         out
     }
+}
 
-    pub(super) fn ties(&self, ranked: &[CandidateReport]) -> Vec<Tie> {
-        let Some(best) = ranked.first() else {
-            return vec![];
-        };
-        ranked
-            .iter()
-            .skip(1)
-            .filter(|c| c.tie_with_best)
-            .map(|c| Tie {
-                effects: [best.effect.clone(), c.effect.clone()],
-                bic_gap: (best.delta_bic - c.delta_bic).abs(),
-                disambiguation: self.disambiguate(&best.mods, &c.mods),
-            })
-            .collect()
+/// Where two fitted models differ by more than the (median relative) noise, beyond the band.
+pub fn disambiguate(a: &PhysicalModel, b: &PhysicalModel, data: &Channels) -> String {
+    let (wmin, wmax) = (data.omega[0], *data.omega.last().expect("data"));
+    let mut rel: Vec<f64> = (0..data.len())
+        .map(|k| data.radius[0][k] / data.g[0][k].norm().max(1e-300))
+        .collect();
+    rel.sort_by(|x, y| x.total_cmp(y));
+    let rel_noise = rel[rel.len() / 2];
+    let differs = |w: f64| {
+        let (ga, gb) = (a.eval(w), b.eval(w));
+        data.entries.iter().any(|e| {
+            let (x, y) = (ga[*e], gb[*e]);
+            (x - y).norm() > rel_noise * x.norm()
+        })
+    };
+    let above = (1..=200)
+        .map(|i| wmax * 10f64.powf(i as f64 * 2.0 / 200.0))
+        .find(|w| differs(*w));
+    let below = (1..=200)
+        .map(|i| wmin / 10f64.powf(i as f64 * 2.0 / 200.0))
+        .find(|w| differs(*w));
+    let tail = "measure there to tell them apart";
+    match (above, below) {
+        (Some(h), Some(l)) => format!(
+            "the two fitted models differ by more than the noise above {} and below {}: {tail}",
+            fmt_w(h),
+            fmt_w(l)
+        ),
+        (Some(h), None) => format!(
+            "the two fitted models differ by more than the noise above {}: {tail}",
+            fmt_w(h)
+        ),
+        (None, Some(l)) => format!(
+            "the two fitted models differ by more than the noise below {}: {tail}",
+            fmt_w(l)
+        ),
+        (None, None) => "the two fitted models agree within the noise from a hundredth of the lowest to a hundred times the highest measured frequency: lower the noise (more periods or averages) to tell them apart".into(),
     }
 }
