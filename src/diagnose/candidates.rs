@@ -10,8 +10,7 @@
 //! in logarithms.
 
 use crate::model::physical::{
-    EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel,
-    PoleAtZeroSpec,
+    EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
 use num_complex::Complex64;
 
@@ -427,7 +426,12 @@ pub fn explain(
     omega: &[f64],
 ) -> String {
     let si = c.si_params(th, entries);
-    let p = |n: &str| si.iter().find(|x| x.0 == n).map(|x| x.1).unwrap_or(f64::NAN);
+    let p = |n: &str| {
+        si.iter()
+            .find(|x| x.0 == n)
+            .map(|x| x.1)
+            .unwrap_or(f64::NAN)
+    };
     let list = |prefix: &str| {
         si.iter()
             .filter(|x| x.0.starts_with(prefix))

@@ -64,7 +64,20 @@ impl Channels {
                 }
             }
         }
-        out.ok_or_else(|| Error::Invalid(format!("{}: no channel", data.path.display())))
+        let out =
+            out.ok_or_else(|| Error::Invalid(format!("{}: no channel", data.path.display())))?;
+        let mut e = out.entries.clone();
+        e.sort();
+        e.dedup();
+        if e.len() != out.entries.len() {
+            return Err(Error::Invalid(format!(
+                "{}: the data have {} channels but the model {} is SISO: describe every output and input in the model, or pick one channel with --channel OUT,IN",
+                data.path.display(),
+                out.entries.len(),
+                config.path.display()
+            )));
+        }
+        Ok(out)
     }
 
     /// Number of channels.
@@ -86,4 +99,22 @@ impl Channels {
     pub fn n_data(&self) -> usize {
         self.len() * self.n_ch()
     }
+}
+
+/// `(misfit_rms, invalid_fraction)` of a physical model on the channels.
+pub fn misfit_channels(m: &crate::model::physical::PhysicalModel, data: &Channels) -> (f64, f64) {
+    let c: Vec<Vec<f64>> = data
+        .entries
+        .iter()
+        .enumerate()
+        .map(|(ch, e)| {
+            data.omega
+                .iter()
+                .enumerate()
+                .map(|(k, w)| (data.g[ch][k] - m.eval(*w)[*e]).norm() / data.radius[ch][k])
+                .collect()
+        })
+        .collect();
+    let me = super::problem::measures_of(&c);
+    (me.misfit_rms, me.invalid_fraction)
 }

@@ -18,13 +18,14 @@
 //! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
 
 use super::candidates::{explain, sig};
-use crate::report::fmt::fmt_pct;
 use super::channels::Channels;
 use super::compare::{bands, Siso};
-use super::problem::{Measures, Problem};
 pub use super::problem::Measures as ErrorMeasures;
-use super::rank::{disambiguate, prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC};
+use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
+use super::rank::{
+    disambiguate, prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC,
+};
 pub use super::report::{
     CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
 };
@@ -32,6 +33,7 @@ use super::retune::{cost, retune, ADDED_NOTE};
 use super::search::{add_effect, roots, search, Node, Settings};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::report::fmt::fmt_pct;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -144,7 +146,10 @@ pub fn final_effects(m: &PhysicalModel) -> Vec<FinalEffect> {
             let mut p = BTreeMap::new();
             p.insert("order".to_string(), order);
             let c = r.output_gain.to_vec(m.n_outputs());
-            p.insert("c".to_string(), c[0] * r.input_gain.to_vec(m.n_inputs())[0] / r.mass);
+            p.insert(
+                "c".to_string(),
+                c[0] * r.input_gain.to_vec(m.n_inputs())[0] / r.mass,
+            );
             out.push(FinalEffect {
                 effect: label(&r.name),
                 params: p,
@@ -258,7 +263,11 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         let th = &sc.mods.theta;
         let (model, m, joint) = match child {
             Some(c) => (c.model.clone(), c.measures, true),
-            None => (add_effect(&root_model, &sc.cand, th, data), sc.measures, false),
+            None => (
+                add_effect(&root_model, &sc.cand, th, data),
+                sc.measures,
+                false,
+            ),
         };
         let mut unc = BTreeMap::new();
         if sc.no_fit.is_none() {
@@ -305,7 +314,11 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
                 Some(why) => format!("no fit: {why}"),
                 None => explain(&sc.cand, th, &data.entries, &root_model, &data.omega),
             },
-            explained_bands: if sc.no_fit.is_none() { explained(&model) } else { vec![] },
+            explained_bands: if sc.no_fit.is_none() {
+                explained(&model)
+            } else {
+                vec![]
+            },
             cand: Some(sc.cand),
             model,
         });
@@ -322,7 +335,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             .iter()
             .take_while(|c| c.no_fit.is_none() && best - c.delta_bic < TIE_BIC)
             .count();
-        candidates[..n_tied].sort_by_key(|c| (c.n_params, c.cand.as_ref().map_or(0, |c| 1 + prior(c))));
+        candidates[..n_tied]
+            .sort_by_key(|c| (c.n_params, c.cand.as_ref().map_or(0, |c| 1 + prior(c))));
     }
     for (k, c) in candidates.iter_mut().enumerate() {
         c.rank = k + 1;
@@ -330,9 +344,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     let mut ties = Vec::new();
     if let Some(best) = candidates.first().cloned() {
         for c in candidates.iter_mut().skip(1) {
-            c.tie_with_best = c.passes
-                && best.passes
-                && (best.delta_bic - c.delta_bic).abs() < TIE_BIC;
+            c.tie_with_best =
+                c.passes && best.passes && (best.delta_bic - c.delta_bic).abs() < TIE_BIC;
             if c.tie_with_best {
                 ties.push(Tie {
                     effects: [best.effect.clone(), c.effect.clone()],

@@ -22,7 +22,7 @@ pub mod retune;
 pub mod search;
 mod starts;
 
-pub use channels::Channels;
+pub use channels::{misfit_channels, Channels};
 pub use engine::{apply_candidate, diagnose, diagnose_channels, Diagnosis};
 pub use retune::{refit_nominal, retune, NominalRefit};
 pub use search::Settings;

@@ -96,7 +96,8 @@ impl<'a> Problem<'a> {
         check_shapes(base, data)?;
         let mut core0 = Vec::new();
         let mut path0 = Vec::new();
-        let cores: Vec<DMatrix<Complex64>> = data.omega.iter().map(|w| base.eval_core(*w)).collect();
+        let cores: Vec<DMatrix<Complex64>> =
+            data.omega.iter().map(|w| base.eval_core(*w)).collect();
         for e in &data.entries {
             core0.push(cores.iter().map(|c| c[*e]).collect());
             path0.push(data.omega.iter().map(|w| path_at(base, *w, *e)).collect());
@@ -177,7 +178,13 @@ impl<'a> Problem<'a> {
     }
 
     /// Model response of channel `ch` at datum `k`, or at any `ω` with `k = None`.
-    pub(super) fn eval_at(&self, mods: &Mods, ch: usize, k: Option<usize>, omega: f64) -> Complex64 {
+    pub(super) fn eval_at(
+        &self,
+        mods: &Mods,
+        ch: usize,
+        k: Option<usize>,
+        omega: f64,
+    ) -> Complex64 {
         let (c, p) = self.parts(mods, ch, k, omega);
         c * p
     }

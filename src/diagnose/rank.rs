@@ -65,7 +65,12 @@ pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
     }
     let mut v = Vec::new();
     for s in &sels {
-        v.extend([Cand::Delay(*s), Cand::Lag(*s), Cand::NmpZero(*s), Cand::Zoh(*s)]);
+        v.extend([
+            Cand::Delay(*s),
+            Cand::Lag(*s),
+            Cand::NmpZero(*s),
+            Cand::Zoh(*s),
+        ]);
     }
     v.extend([
         Cand::Mode,

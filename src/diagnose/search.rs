@@ -20,8 +20,8 @@ use super::candidates::Cand;
 use super::channels::Channels;
 use super::problem::{Measures, Problem};
 use super::rank::{candidate_list, si_map, Screened, MIN_DELTA_BIC};
-use super::retune::{retune, ADDED_NOTE};
 use super::report::Step;
+use super::retune::{retune, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 
@@ -93,7 +93,12 @@ pub struct SearchResult {
 /// Writes effect `c` with parameters `th` into `m`.
 pub fn add_effect(m: &PhysicalModel, c: &Cand, th: &[f64], data: &Channels) -> PhysicalModel {
     let mut next = m.clone();
-    c.apply_to(th, &data.entries, &mut next, &format!("{ADDED_NOTE}: {}", c.label()));
+    c.apply_to(
+        th,
+        &data.entries,
+        &mut next,
+        &format!("{ADDED_NOTE}: {}", c.label()),
+    );
     next
 }
 
@@ -163,10 +168,13 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
                     let m = Problem::new(&r.model, data)?.measures(&Default::default());
                     let n_new = sc.cand.n_params(data.n_ch());
                     // Against the best of the node and (for the configured model) its retune.
-                    let ref_v = if node.configured { nodes[1].measures.v.min(node.measures.v) } else { node.measures.v };
+                    let ref_v = if node.configured {
+                        nodes[1].measures.v.min(node.measures.v)
+                    } else {
+                        node.measures.v
+                    };
                     let d_bic = 2.0 * (ref_v - m.v) - n_new as f64 * ln2f;
-                    if d_bic > MIN_DELTA_BIC
-                        && m.invalid_fraction <= node.measures.invalid_fraction
+                    if d_bic > MIN_DELTA_BIC && m.invalid_fraction <= node.measures.invalid_fraction
                     {
                         let mut effects = node.effects.clone();
                         effects.push((sc.cand, sc.mods.theta.clone()));
@@ -226,7 +234,10 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
         .map(|n| n.effects.len())
         .min();
     let chosen = (0..nodes.len())
-        .filter(|i| consistent_depth.is_none_or(|d| nodes[*i].effects.len() == d && nodes[*i].measures.consistent()))
+        .filter(|i| {
+            consistent_depth
+                .is_none_or(|d| nodes[*i].effects.len() == d && nodes[*i].measures.consistent())
+        })
         .min_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic))
         .unwrap_or(0);
     Ok(SearchResult {

@@ -77,9 +77,7 @@ impl Problem<'_> {
                     .collect();
                 grid_best(&grid, 3)
             }
-            Cand::Lag(_) | Cand::NmpZero(_) => {
-                grid_best(&log_grid(wmin / 3.0, wmax * 30.0, 40), 3)
-            }
+            Cand::Lag(_) | Cand::NmpZero(_) => grid_best(&log_grid(wmin / 3.0, wmax * 30.0, 40), 3),
             Cand::Zoh(_) => grid_best(&log_grid(0.01 / wmax, 3.0 / wmax, 40), 3),
             Cand::Integrator(o) => vec![(0..n_ch)
                 .map(|ch| ls(&[ch], &|ch, k| path_of(ch, k) / s(k).powi(o as i32)))
@@ -102,7 +100,9 @@ impl Problem<'_> {
                 let (cw, _) = self.invalid_flags(cur);
                 let f = self.f();
                 let mut peaks: Vec<(f64, f64)> = (0..f)
-                    .filter(|&k| (k == 0 || cw[k] >= cw[k - 1]) && (k + 1 == f || cw[k] >= cw[k + 1]))
+                    .filter(|&k| {
+                        (k == 0 || cw[k] >= cw[k - 1]) && (k + 1 == f || cw[k] >= cw[k + 1])
+                    })
                     .map(|k| (cw[k], om[k]))
                     .collect();
                 peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
