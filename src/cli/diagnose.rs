@@ -3,6 +3,7 @@
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
+use crate::diagnose::factor_form::physical_from_factors;
 use crate::diagnose::{
     apply_candidate, diagnose_channels, misfit_channels, prepare, retune, Channels, Diagnosis,
     Settings,
@@ -79,12 +80,25 @@ fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     let inputs = a.input.load()?;
     let config = &inputs.config;
-    let base = config.physical.clone().ok_or_else(|| {
-        anyhow!(
-            "{}: diagnose adds effects to a [physical] model (modes, rigid bodies, effects), and this config gives the model as coprime factors ([model]); `rshape compare` works on it as it is. To diagnose, write the plant as [physical] (configs/robot_physical.toml is the robot's factor form written by its physics)",
-            config.path.display()
-        )
-    })?;
+    let base = match &config.physical {
+        Some(p) => p.clone(),
+        None => {
+            let p = physical_from_factors(&config.factorization).map_err(|why| {
+                anyhow!(
+                    "{}: diagnose adds effects to a [physical] model, and this factor form cannot be converted ({why}); `rshape compare` works on it as it is. To diagnose, write the plant as [physical] (configs/robot_physical.toml is the robot's factor form written by its physics)",
+                    config.path.display()
+                )
+            })?;
+            if !a.json {
+                println!(
+                    "{}: the [model] factor form is a modal special factorization: converted to [physical] ({} modes); effects are added to that form (--write writes [physical])",
+                    config.path.display(),
+                    p.mode.len()
+                );
+            }
+            p
+        }
+    };
     let data = channels(a, &inputs)?;
     let settings = Settings {
         max_effects: a.max_effects.max(1),
@@ -119,6 +133,7 @@ fn write_revision(
     let mut raw = config.raw.clone();
     let c = &d.candidates[k - 1];
     raw.physical = Some(revised);
+    raw.model = None;
     raw.name = Some(format!(
         "{} + {}",
         raw.name

@@ -473,7 +473,24 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         runner_up,
         holdout,
         dropped,
-        final_effects: final_effects(&node.model),
+        final_effects: {
+            let mut fe = final_effects(&node.model);
+            // Friction changes a configured rigid body: report its refit pole.
+            for (c, _) in &node.effects {
+                if let super::candidates::Cand::Friction(i) = c {
+                    let mut p = BTreeMap::new();
+                    p.insert("rigid_body".to_string(), (*i + 1) as f64);
+                    if let Some(x) = node.model.rigid_body[*i].friction_pole {
+                        p.insert("pole".to_string(), x);
+                    }
+                    fe.push(FinalEffect {
+                        effect: "friction".into(),
+                        params: p,
+                    });
+                }
+            }
+            fe
+        },
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         search: mk_stats(res.expanded, res.joint_refits),
         final_model: node.model,

@@ -2,7 +2,7 @@
 //! add them, and watch the error fall.
 //!
 //! * [`compare`]: per-frequency misfit normalized by the noise radius, failing bands, error
-//!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); [`consistency`]: two data sets
+//!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); [`agreement`]: two data sets
 //!   against each other;
 //! * [`retune`], [`search`], [`engine`]: refit the configured model, search effect sets,
 //!   report;
@@ -11,9 +11,11 @@ pub mod compare;
 pub mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
+pub mod agreement;
 pub mod candidates;
 pub mod channels;
 pub mod engine;
+pub mod factor_form;
 pub mod fit;
 pub mod problem;
 pub mod rank;

@@ -47,7 +47,8 @@ pub fn si_map(c: &Cand, th: &[f64], entries: &[(usize, usize)]) -> BTreeMap<Stri
 /// The candidates tried on a model with `n_out × n_in` channels observed.  Gains, signs,
 /// mode shifts and damping changes are not in the list: the retune (refit of the model's own
 /// residues, frequencies and dampings) covers them.  With several channels, path effects are
-/// tried on every channel, on each output and on each input.
+/// tried on every channel and on each input (a dynamic effect on one output of a
+/// multi-output model cannot be exported to the special factorization, whose `C` is constant).
 pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
     let mut sels = vec![Sel::All];
     if data.n_ch() > 1 {
@@ -56,7 +57,9 @@ pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
         let mut ins: Vec<usize> = data.entries.iter().map(|e| e.1).collect();
         ins.sort();
         ins.dedup();
-        if outs.len() > 1 {
+        // A dynamic effect on one output has no place in the constant `C` of the special
+        // factorization (the export of a multi-output model), so it is not proposed there.
+        if outs.len() > 1 && base.n_outputs() == 1 {
             sels.extend(outs.iter().map(|o| Sel::Output(*o)));
         }
         if ins.len() > 1 {

@@ -98,7 +98,13 @@ pub fn fmt_change(ratio: f64) -> String {
     if pct == 0.0 {
         return "+0 %".into();
     }
-    let d = (2 - pct.abs().log10().floor() as i32).clamp(0, 3) as usize;
+    let mag = pct.abs().log10().floor() as i32;
+    let mut d = (2 - mag).clamp(0, 3) as usize;
+    // −9.9999 rounds to −10.0: one decimal fewer once rounding carries into the next decade.
+    let scale = 10f64.powi(d as i32);
+    if d > 0 && (pct.abs() * scale).round() / scale >= 10f64.powi(mag + 1) {
+        d -= 1;
+    }
     format!("{pct:+.d$} %")
 }
 
