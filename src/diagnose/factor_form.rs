@@ -59,7 +59,7 @@ pub fn physical_from_factors(f: &Factorization) -> Result<PhysicalModel, String>
             ));
         }
         let mut b = Vec::new();
-        for jj in 0..m_in {
+        for (jj, jgain) in j.iter().enumerate().take(m_in) {
             let e = f.n.entry(k, jj);
             if e.num.is_zero() {
                 b.push(0.0);
@@ -74,7 +74,7 @@ pub fn physical_from_factors(f: &Factorization) -> Result<PhysicalModel, String>
                     k + 1
                 ));
             };
-            b.push(e.num.leading() / lambda * j[jj]);
+            b.push(e.num.leading() / lambda * jgain);
         }
         let (m2, m1, m0) = (d[0], d[1], d[2]);
         if !(m2 > 0.0 && m0 > 0.0 && m1 > 0.0) {

@@ -379,7 +379,21 @@ pub fn retune(
 ) -> NominalRefit {
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
-    let (lin, nl) = slots(m, data);
+    let (lin, mut nl) = slots(m, data);
+    // On part of the band (a holdout fit), a mode resonating outside that part is not
+    // identified there: its ω_n and ζ keep their values.
+    if mask.len() < data.len() && !mask.is_empty() {
+        let lo = mask
+            .iter()
+            .map(|k| data.omega[*k])
+            .fold(f64::INFINITY, f64::min)
+            / 1.25;
+        let hi = mask.iter().map(|k| data.omega[*k]).fold(0.0, f64::max) * 1.25;
+        nl.retain(|s| match s {
+            Nl::ModeW(i) | Nl::ModeZ(i) => (lo..=hi).contains(&m.mode[*i].omega_n),
+            _ => true,
+        });
+    }
     let v_before = cost(m, data, mask);
     let w_min = data.omega[0];
     let w_max = *data.omega.last().expect("data");
