@@ -32,6 +32,8 @@ pub fn r_min_label(m: EnvelopeMethod) -> &'static str {
         EnvelopeMethod::Theorem3 => "smallest |r| per datum (Thm 3)",
         EnvelopeMethod::Theorem4Mu => "smallest |r| per datum, μ bisection (Thm 4)",
         EnvelopeMethod::File => "smallest |r| per datum",
+        EnvelopeMethod::ClosedLoopTheorem1 => "|Δ̄ᵢ| from the closed-loop datum (Thm 1, Cor. 1–2)",
+        EnvelopeMethod::ClosedLoopTheorem2 => "smallest |V| per datum, closed-loop μ (Thm 2)",
     }
 }
 
