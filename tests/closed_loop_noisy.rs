@@ -38,7 +38,12 @@ fn c0(re: f64, im: f64) -> Complex64 {
 fn delta_abs(at: &ClosedLoopAt, phi: Complex64) -> f64 {
     let cb = at.c_bar[(0, 0)];
     let p = phi / (1.0 - phi * cb);
-    let (ph, dh, dc, c) = (at.p_hat[(0, 0)], at.d_hat[(0, 0)], at.d_c[(0, 0)], at.c[(0, 0)]);
+    let (ph, dh, dc, c) = (
+        at.p_hat[(0, 0)],
+        at.d_hat[(0, 0)],
+        at.d_c[(0, 0)],
+        at.c[(0, 0)],
+    );
     ((p - ph) * dh / (dc * (1.0 + p * c))).norm()
 }
 
@@ -98,7 +103,11 @@ fn cases(text: &str) -> Vec<(ClosedLoopAt, Complex64, f64)> {
             let phi_true = p / (1.0 + p * at.c_bar[(0, 0)]);
             let m22 = at.nominal_closed_loop().unwrap()[(0, 0)];
             let dist = (phi_true - m22).norm();
-            let rho = if i % 7 == 3 { 3.0 * dist } else { dist * [0.05, 0.3, 0.6][i % 3] };
+            let rho = if i % 7 == 3 {
+                3.0 * dist
+            } else {
+                dist * [0.05, 0.3, 0.6][i % 3]
+            };
             let phi = phi_true + Complex64::from_polar(0.7 * rho, 1.3 * i as f64);
             (at, phi, rho)
         })
@@ -119,7 +128,11 @@ fn mu_bisection_equals_brute_force_for_both_experiments() {
                 continue;
             }
             let e = (got.v_min - want).abs() / want;
-            assert!(e < 1e-6, "μ route {} vs brute force {want}: {e:e}", got.v_min);
+            assert!(
+                e < 1e-6,
+                "μ route {} vs brute force {want}: {e:e}",
+                got.v_min
+            );
             // Noisy ≤ noise-free at the centre.
             assert!(got.v_min <= delta_abs(&at, phi) * (1.0 + 1e-12));
         }
@@ -156,7 +169,11 @@ fn two_scalar_mu_matches_the_general_full_plus_scalar_mu_and_is_monotone() {
             let mu = mu_at(&g1, v);
             let m = DMatrix::from_row_slice(2, 2, &[v * g1[0], v * g1[1], g1[2], g1[3]]);
             let b = mu_full_scalar(&m, s, &MuSettings::default()).unwrap();
-            assert!((mu - b.upper).abs() <= 1e-8 * b.upper, "closed form {mu} vs {}", b.upper);
+            assert!(
+                (mu - b.upper).abs() <= 1e-8 * b.upper,
+                "closed form {mu} vs {}",
+                b.upper
+            );
             assert!(mu >= last * (1.0 - 1e-14), "μ must not decrease with |V|");
             last = mu;
         }
@@ -171,7 +188,10 @@ fn envelope_and_mu_per_datum_agree_on_the_verdict() {
     let data = FrfData {
         path: PathBuf::from("noisy.csv"),
         omega: logspace(0.05, 200.0, 36),
-        response: cs.iter().map(|c| DMatrix::from_element(1, 1, c.1)).collect(),
+        response: cs
+            .iter()
+            .map(|c| DMatrix::from_element(1, 1, c.1))
+            .collect(),
         noise_radius: None,
         lines: (1..=36).collect(),
     };
@@ -188,5 +208,8 @@ fn envelope_and_mu_per_datum_agree_on_the_verdict() {
             both[(*m > 1.0) as usize] += 1;
         }
     }
-    assert!(both[0] > 0 && both[1] > 0, "V must split the data: {both:?}");
+    assert!(
+        both[0] > 0 && both[1] > 0,
+        "V must split the data: {both:?}"
+    );
 }

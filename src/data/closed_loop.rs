@@ -35,7 +35,10 @@ pub fn read_closed_loop_csv(path: &Path) -> Result<FrfData> {
 pub fn parse_closed_loop_csv(text: &str, path: &Path) -> Result<FrfData> {
     let table = Table::parse(text, path, "freq_hz,re_y,im_y,re_r,im_r")?;
     let is_spectrum = |n: &str| {
-        n.starts_with("re_y") || n.starts_with("im_y") || n.starts_with("re_r") || n.starts_with("im_r")
+        n.starts_with("re_y")
+            || n.starts_with("im_y")
+            || n.starts_with("re_r")
+            || n.starts_with("im_r")
     };
     if !table.names.iter().any(|n| is_spectrum(n)) {
         return parse_frf_csv(text, path);
@@ -64,7 +67,10 @@ pub fn parse_closed_loop_csv(text: &str, path: &Path) -> Result<FrfData> {
     if let Some(i) = col.iter().position(|c| *c == usize::MAX) {
         return Err(table.err(
             hline,
-            format!("missing column `{}`: spectra files need re_y,im_y,re_r,im_r", SPECTRA_COLUMNS[i]),
+            format!(
+                "missing column `{}`: spectra files need re_y,im_y,re_r,im_r",
+                SPECTRA_COLUMNS[i]
+            ),
         ));
     }
     let mut rows: Vec<(f64, Complex64, Complex64, Option<f64>, usize)> = Vec::new();
@@ -74,13 +80,19 @@ pub fn parse_closed_loop_csv(text: &str, path: &Path) -> Result<FrfData> {
             let v: f64 = fields[c].parse().map_err(|_| {
                 table.err(
                     line,
-                    format!("column `{}`: `{}` is not a number", table.names[c], fields[c]),
+                    format!(
+                        "column `{}`: `{}` is not a number",
+                        table.names[c], fields[c]
+                    ),
                 )
             })?;
             if !v.is_finite() {
                 return Err(table.err(
                     line,
-                    format!("column `{}`: value `{}` is not finite", table.names[c], fields[c]),
+                    format!(
+                        "column `{}`: value `{}` is not finite",
+                        table.names[c], fields[c]
+                    ),
                 ));
             }
             Ok(v)
@@ -178,10 +190,16 @@ mod tests {
         let e = parse_closed_loop_csv("freq_hz,re_y,im_y,re_r\n1,1,0,1\n", p)
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("cl.csv:1:") && e.contains("missing column `im_r`"), "{e}");
-        let e = parse_closed_loop_csv("freq_hz,re_y_1,im_y_1,re_y_2,im_y_2,re_r,im_r\n1,1,0,1,0,1,0\n", p)
-            .unwrap_err()
-            .to_string();
+        assert!(
+            e.starts_with("cl.csv:1:") && e.contains("missing column `im_r`"),
+            "{e}"
+        );
+        let e = parse_closed_loop_csv(
+            "freq_hz,re_y_1,im_y_1,re_y_2,im_y_2,re_r,im_r\n1,1,0,1,0,1,0\n",
+            p,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("unknown column `re_y_1`"), "{e}");
         let e = parse_closed_loop_csv("freq_hz,re_y,im_y,re_r,im_r\n1,1,0,1\n", p)
             .unwrap_err()

@@ -50,7 +50,12 @@ pub fn envelope(
     };
     let rep = closed_loop_envelope(cl, data, radii, &VBisection::default())?;
     let mut warnings = Vec::new();
-    let inf = rep.envelope.r_min.iter().filter(|x| x.is_infinite()).count();
+    let inf = rep
+        .envelope
+        .r_min
+        .iter()
+        .filter(|x| x.is_infinite())
+        .count();
     if inf > 0 {
         warnings.push(format!(
             "{inf} datum(s) have |V|_min = ∞: I + P₀C is singular there (no plant of the set explains them)"
