@@ -52,6 +52,8 @@ pub fn run_compare(
         inputs.data = eq.data;
         inputs.config.raw.noise = Default::default();
         inputs.config.noise_std = None;
+        // [v] weighs the closed-loop perturbation Δ̄, not the factor perturbations of r.
+        inputs.config.r = None;
         noise = None;
     }
     let siso = prepare(&inputs.config, &inputs.data, channel, noise)?;

@@ -109,13 +109,21 @@ pub struct OpenLoopEquivalent {
 }
 
 /// The open-loop equivalent of closed-loop data: `P₀ = (I − ΦC̄)⁻¹Φ` per datum, and, when
-/// `radii` (radii `ρ` on `Φ`) are given, the first-order radius on `P₀`.
+/// `radii` (radii `ρ` on `Φ`) are given, a radius on `P₀`.
 ///
-/// With `S = I − ΦC̄`, `P₀ = S⁻¹Φ` and `dP₀ = S⁻¹·dΦ·(I + C̄P₀)` (differentiate
-/// `S·P₀ = Φ`), so `‖dP₀‖ ≤ σ̄(S⁻¹)·σ̄(I + C̄P₀)·ρ` to first order in `ρ`; for SISO this is
-/// `ρ/|1 − ΦC̄|²`.  The bound is first order: it is accurate when `ρ·σ̄(C̄)·σ̄(S⁻¹) ≪ 1`
-/// (the exact image of the noise disk is again a disk, shifted and enlarged at second
-/// order).  Data with `σ_min(S) < 1e-8` are dropped and listed.
+/// **First order (MIMO).**  With `S = I − ΦC̄`, `P₀ = S⁻¹Φ` and
+/// `dP₀ = S⁻¹·dΦ·(I + C̄P₀)` (differentiate `S·P₀ = Φ`), so
+/// `‖dP₀‖ ≤ σ̄(S⁻¹)·σ̄(I + C̄P₀)·ρ` to first order in `ρ`; for SISO, `ρ/|S|²`.
+///
+/// **Exact (SISO).**  `Φ ↦ Φ/(1 − ΦC̄)` is a Möbius map: it sends the noise disk
+/// `|Φ' − Φ| ≤ ρ` onto a disk when `|S| > ρ|C̄|` (`1 − Φ'C̄` then stays away from 0), with
+/// radius `ρ/(|S|² − ρ²|C̄|²)` and centre `ρ²|C̄|/(|S|(|S|² − ρ²|C̄|²))` away from `P₀`; the
+/// smallest disk about `P₀` that holds it has radius `ρ/(|S|(|S| − ρ|C̄|))`, which is what
+/// SISO data get (its first-order term is `ρ/|S|²`; the two differ by the factor
+/// `1/(1 − ρ|C̄|/|S|)`).  When `|S| ≤ ρ|C̄|` the disk holds a `Φ'` with `1 = Φ'C̄`: the
+/// plant is unbounded within the noise and the datum is dropped.
+///
+/// Data with `σ_min(S) < 1e-8` (or, SISO, `|S| ≤ ρ|C̄|`) are dropped and listed.
 pub fn open_loop_equivalent(
     config: &Config,
     data: &FrfData,
@@ -157,9 +165,19 @@ pub fn open_loop_equivalent(
             continue;
         };
         if let (Some(r), Some(out_r)) = (radii, out.noise_radius.as_mut()) {
-            let m = at.c_bar.nrows();
-            let gain = DMatrix::<Complex64>::identity(m, m) + &at.c_bar * &p0;
-            out_r.push(r[i] / smin * extreme_singular_values(&gain).0);
+            let radius = if p == 1 && at.c_bar.ncols() == 1 {
+                let (s_abs, k) = (s[(0, 0)].norm(), r[i] * at.c_bar[(0, 0)].norm());
+                if s_abs <= k {
+                    dropped.push(w);
+                    continue;
+                }
+                r[i] / (s_abs * (s_abs - k))
+            } else {
+                let m = at.c_bar.nrows();
+                let gain = DMatrix::<Complex64>::identity(m, m) + &at.c_bar * &p0;
+                r[i] / smin * extreme_singular_values(&gain).0
+            };
+            out_r.push(radius);
         }
         out.omega.push(w);
         out.response.push(p0);
