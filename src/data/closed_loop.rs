@@ -24,10 +24,7 @@ pub const SPECTRA_COLUMNS: [&str; 4] = ["re_y", "im_y", "re_r", "im_r"];
 
 /// Reads closed-loop data (FRF or `Y`/`R` spectra); every error names the file and line.
 pub fn read_closed_loop_csv(path: &Path) -> Result<FrfData> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = super::table::read_text(path)?;
     parse_closed_loop_csv(&text, path)
 }
 
@@ -81,8 +78,10 @@ pub fn parse_closed_loop_csv(text: &str, path: &Path) -> Result<FrfData> {
                 table.err(
                     line,
                     format!(
-                        "column `{}`: `{}` is not a number",
-                        table.names[c], fields[c]
+                        "column `{}`: `{}` is not a number{}",
+                        table.names[c],
+                        fields[c],
+                        super::table::decimal_hint(fields[c])
                     ),
                 )
             })?;
