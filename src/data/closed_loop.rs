@@ -14,7 +14,7 @@
 use super::frf::FrfData;
 use super::reader::parse_frf_csv;
 use super::table::Table;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::path::Path;
