@@ -111,7 +111,7 @@ fn main() -> anyhow::Result<()> {
             let noise = if noisy {
                 let (r, t): (f64, f64) = (
                     rng.gen_range(0.0..1.0),
-                    rng.gen_range(0.0..6.283185307179586),
+                    rng.gen_range(0.0..std::f64::consts::TAU),
                 );
                 Complex64::from_polar(0.8 * radius * r.sqrt(), t)
             } else {

@@ -123,7 +123,7 @@ pub fn parse_closed_loop_csv(text: &str, path: &Path) -> Result<FrfData> {
     let r_peak = rows.iter().map(|r| r.2.norm()).fold(0.0, f64::max);
     for (omega, y, r, _, line) in &rows {
         let q = *y / *r;
-        if !(r.norm() > 1e-12 * r_peak) || !q.is_finite() {
+        if r.norm() <= 1e-12 * r_peak || !q.is_finite() {
             return Err(table.err(
                 *line,
                 format!(

@@ -151,7 +151,7 @@ pub fn check_loop(
     let inf = nalgebra::DMatrix::from_fn(m + p, m + p, |i, j| lambda[i][j].at_infinity());
     let sv = inf.clone().svd(false, false).singular_values;
     let (smax, smin) = (sv.max(), sv.min());
-    if !(smin > 1e-12 * smax.max(1e-300)) {
+    if smin.is_nan() || smin <= 1e-12 * smax.max(1e-300) {
         return Err(LoopInstability::IllPosed);
     }
     let det = scaled_determinant(&lambda);
