@@ -170,9 +170,23 @@ fn compare_works_on_the_open_loop_equivalent() {
         .unwrap();
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    // The model is the rigid body, the data have a 15 % gain error and a flexible mode:
-    // the misfit is far from zero and peaks near 49 rad/s.
-    assert!(rep.to_string().contains("misfit"), "{rep}");
+    // At 0.1 rad/s the plant recovered from Φ and C̄ is P₀ ≈ 1.15/s² = −115 (true plant of
+    // examples/closed_loop_data.rs) and the nominal is P̂ = 1/s² = −100: misfit 0.13.
+    let row = &rep["rows"][0];
+    assert!((row["omega"].as_f64().unwrap() - 0.1).abs() < 1e-12);
+    let d = [
+        row["data"][0].as_f64().unwrap(),
+        row["data"][1].as_f64().unwrap(),
+    ];
+    assert!((d[0] + 115.0).abs() < 0.01 && d[1].abs() < 0.1, "{row}");
+    assert!(
+        (row["model"][0].as_f64().unwrap() + 100.0).abs() < 1e-9,
+        "{row}"
+    );
+    assert!(
+        (row["misfit"].as_f64().unwrap() - 15.0 / 115.0).abs() < 1e-3,
+        "{row}"
+    );
 }
 
 fn bad(config: &str, data: Option<&str>) -> (Output, PathBuf, tempfile::TempDir) {
@@ -245,4 +259,64 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
         }
         assert!(!out.exists(), "nothing may be written: {err}");
     }
+}
+
+#[test]
+fn mimo_closed_loop_frf_runs_noise_free_and_refuses_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = r#"data = "d.csv"
+[closed_loop]
+plant = [[{ num = [2], den = [1, 1] }, { num = [0.5], den = [1, 3] }],
+         [{ num = [0.3], den = [1, 2] }, { num = [1], den = [1, 0.5] }]]
+controller = [[{ num = [3, 1], den = [1, 4] }, 0.2],
+              [0.1, { num = [2], den = [0.1, 1] }]]
+"#;
+    let c = dir.path().join("mimo.toml");
+    std::fs::write(&c, config).unwrap();
+    // Data: the nominal closed loop of a plant with 10 % more gain on output 1.
+    let model = rshape::model::Config::load(&c)
+        .unwrap()
+        .closed_loop
+        .unwrap();
+    let mut csv =
+        String::from("omega_rad_s,re_1_1,im_1_1,re_1_2,im_1_2,re_2_1,im_2_1,re_2_2,im_2_2\n");
+    for w in rshape::system::logspace(0.01, 100.0, 30) {
+        let at = model.at(w).unwrap();
+        let mut p = at.p_hat.clone();
+        p.row_mut(0).scale_mut(1.1);
+        let s = nalgebra::DMatrix::identity(2, 2) + &p * &at.c_bar;
+        let phi = s.lu().solve(&p).unwrap();
+        csv.push_str(&format!("{w}"));
+        for i in 0..2 {
+            for j in 0..2 {
+                csv.push_str(&format!(",{},{}", phi[(i, j)].re, phi[(i, j)].im));
+            }
+        }
+        csv.push('\n');
+    }
+    std::fs::write(dir.path().join("d.csv"), csv).unwrap();
+    let out = dir.path().join("out");
+    let o = bin()
+        .arg("run")
+        .arg(&c)
+        .args(["--order", "2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let rep = json(&out.join("report.json"));
+    assert_eq!(rep["method"], "closed_loop_theorem1");
+    assert_eq!(rep["size"], serde_json::json!([2, 2]));
+    assert!(rep["max_r_min"].as_f64().unwrap() > 0.0);
+    let out2 = dir.path().join("out2");
+    let o = bin()
+        .arg("run")
+        .arg(&c)
+        .args(["--noise-radius", "0.01", "--out"])
+        .arg(&out2)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("SISO"), "{}", stderr(&o));
+    assert!(!out2.exists());
 }
