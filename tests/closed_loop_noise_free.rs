@@ -329,3 +329,32 @@ experiment_controller = [[0.9]]
     );
     assert!(e.contains("[closed_loop]"), "{e}");
 }
+
+#[test]
+fn a_datum_no_plant_of_the_set_explains_gets_inf() {
+    // E = (1 − ΦC̄)D_c + ΦN_c = 0 at Φ* = −D_c/(N_c − C̄D_c): the plant P₀ = Φ*/(1 − Φ*C̄)
+    // has 1 + P₀C = 0 (a closed-loop pole of (P₀, C) at jω), and no finite Δ̄ exists.
+    let cfg = config(&format!("{SISO}{RETUNED}"));
+    let cl = cfg.closed_loop.as_ref().unwrap();
+    let w = 3.0;
+    let at = cl.at(w).unwrap();
+    let (nc, dc, cb) = (at.n_c[(0, 0)], at.d_c[(0, 0)], at.c_bar[(0, 0)]);
+    let phi = -dc / (nc - cb * dc);
+    let p = phi / (1.0 - phi * cb);
+    assert!((1.0 + p * at.c[(0, 0)]).norm() < 1e-12);
+    let db = delta_bar(&at, &one(phi));
+    assert!(db.delta.is_none() && db.v_min.is_infinite());
+    let d = FrfData {
+        path: PathBuf::from("x.csv"),
+        omega: vec![w],
+        response: vec![one(phi)],
+        noise_radius: None,
+        lines: vec![2],
+    };
+    let env = closed_loop_envelope(cl, &d, None, &VBisection::default()).unwrap();
+    assert!(env.envelope.r_min[0].is_infinite());
+    // With noise around it, some nearby Φ' is explained: finite.
+    let env =
+        closed_loop_envelope(cl, &d, Some(&[0.01 * phi.norm()]), &VBisection::default()).unwrap();
+    assert!(env.envelope.r_min[0].is_finite());
+}
