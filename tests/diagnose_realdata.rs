@@ -157,4 +157,21 @@ fn factor_form_configs_compare_and_diagnose() {
         err.contains("cannot be converted") && err.lines().count() == 1,
         "{err}"
     );
+    // Closed-loop configs reach diagnose through the open-loop equivalent (here a standard
+    // factorization, which diagnose cannot extend: the same one-line reason).
+    let out = Command::new(exe)
+        .args([
+            "diagnose",
+            "configs/closed_loop_retuned_noisy.toml",
+            "--max-effects",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("standard factorization") && err.lines().count() == 1,
+        "{err}"
+    );
 }

@@ -58,14 +58,18 @@ fn rel_to(target: &Path, from_dir: &Path) -> PathBuf {
 }
 
 /// The data channels to diagnose: the selected one, or every channel of MIMO data.
-fn channels(a: &DiagnoseArgs, inputs: &super::common::Inputs) -> Result<Channels> {
+fn channels(
+    a: &DiagnoseArgs,
+    inputs: &super::common::Inputs,
+    noise: Option<f64>,
+) -> Result<Channels> {
     let config = &inputs.config;
     let data = &inputs.data;
     let chan = channel_arg(&a.channel)?;
     if chan.is_none() && config.raw.channel.is_none() && (data.outputs() > 1 || data.inputs() > 1) {
-        return Ok(Channels::all(config, data, a.input.noise_radius)?);
+        return Ok(Channels::all(config, data, noise)?);
     }
-    let siso = prepare(config, data, chan, a.input.noise_radius)?;
+    let siso = prepare(config, data, chan, noise)?;
     Ok(Channels::from_siso(&siso)?)
 }
 
@@ -78,7 +82,23 @@ fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
 
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
-    let inputs = a.input.load()?;
+    let mut inputs = a.input.load()?;
+    let mut noise = a.input.noise_radius;
+    if inputs.config.closed_loop.is_some() {
+        // Closed-loop data: diagnose the plant recovered from Φ and C̄ with the radii
+        // propagated to it, as `compare` does.
+        let radii = crate::pipeline::integration::noise_radii(&inputs.config, &inputs.data, noise)?;
+        let eq = crate::pipeline::closed_loop::open_loop_equivalent(
+            &inputs.config,
+            &inputs.data,
+            radii.as_deref(),
+        )?;
+        inputs.data = eq.data;
+        inputs.config.raw.noise = Default::default();
+        inputs.config.noise_std = None;
+        inputs.config.r = None;
+        noise = None;
+    }
     let config = &inputs.config;
     let base = match &config.physical {
         Some(p) => p.clone(),
@@ -99,7 +119,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             p
         }
     };
-    let data = channels(a, &inputs)?;
+    let data = channels(a, &inputs, noise)?;
     let settings = Settings {
         max_effects: a.max_effects.max(1),
         beam: a.beam.max(1),
