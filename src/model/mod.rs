@@ -3,6 +3,7 @@ pub mod config;
 pub mod factorization;
 pub mod noise;
 pub mod physical;
+pub mod plant;
 
 pub use config::Config;
 pub use factorization::{Factorization, FactorizationKind, FactorsAt};
