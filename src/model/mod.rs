@@ -1,5 +1,6 @@
 //! Nominal models: coprime factorizations, the uncertainty bound `r`, and the TOML config.
 pub mod config;
+pub mod controller;
 pub mod factorization;
 pub mod noise;
 pub mod physical;

@@ -2,6 +2,8 @@
 //! matrices and state-space models, all evaluated on the imaginary axis.
 pub mod eig;
 pub mod freq_eval;
+pub mod hinf;
+pub mod interconnect;
 pub mod linalg;
 pub mod ncf;
 pub mod polynomial;
