@@ -142,10 +142,27 @@ impl PlantSection {
             let g = TfMatrix::from_rows(tfs).ok_or("[plant] tf is not rectangular")?;
             StateSpace::from_tf_matrix(&g).minimal(1e-10)
         } else if inline {
-            let (Some(a), Some(b), Some(c)) = (&self.a, &self.b, &self.c) else {
-                return Err("[plant]: a state space needs a, b and c (d defaults to zero)".into());
-            };
-            state_space(a, b, c, self.d.as_deref(), "[plant]")?
+            match (&self.a, &self.b, &self.c, &self.d) {
+                (Some(a), Some(b), Some(c), d) => state_space(a, b, c, d.as_deref(), "[plant]")?,
+                // A static gain: d alone.
+                (None, None, None, Some(d)) => {
+                    let d = matrix(d, "[plant] d", 0)?;
+                    let ss = StateSpace {
+                        a: DMatrix::zeros(0, 0),
+                        b: DMatrix::zeros(0, d.ncols()),
+                        c: DMatrix::zeros(d.nrows(), 0),
+                        d,
+                    };
+                    ss.validate("[plant]").map_err(|e| e.to_string())?;
+                    ss
+                }
+                _ => {
+                    return Err(
+                        "[plant]: a state space needs a, b and c (d defaults to zero), or d alone for a static gain"
+                            .into(),
+                    )
+                }
+            }
         } else {
             let path = base.join(self.file.as_ref().expect("checked"));
             let text = std::fs::read_to_string(&path)
