@@ -228,3 +228,40 @@ fn no_stabilizing_solution_is_a_clear_error() {
     let e = Config::load(&cfg).unwrap_err().to_string();
     assert!(e.contains("B must be 2×1"), "{e}");
 }
+
+#[test]
+fn every_subcommand_runs_on_a_plant_config() {
+    use common::{rshape, stdout};
+    let cfg = repo("configs/plant_first.toml");
+    let cfg = cfg.to_str().unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let d = |s: &str| dir.path().join(s).to_str().unwrap().to_string();
+    std::fs::create_dir_all(dir.path().join("sets")).unwrap();
+    std::fs::copy(
+        repo("configs/plant_first.csv"),
+        dir.path().join("sets/a.csv"),
+    )
+    .unwrap();
+    let runs: Vec<Vec<String>> = vec![
+        vec!["envelope".into(), cfg.into(), "--out".into(), d("env")],
+        vec!["check".into(), cfg.into()],
+        vec!["fit".into(), cfg.into(), "--out".into(), d("fit")],
+        vec!["run".into(), cfg.into(), "--out".into(), d("run")],
+        vec![
+            "batch".into(),
+            cfg.into(),
+            "--data-dir".into(),
+            d("sets"),
+            "--out".into(),
+            d("batch"),
+        ],
+        vec!["compare".into(), cfg.into()],
+    ];
+    for args in runs {
+        let a: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        let out = rshape(&a);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {}", stdout(&out));
+    }
+    assert!(dir.path().join("run/r.json").exists());
+    assert!(dir.path().join("batch/summary.csv").exists());
+}
