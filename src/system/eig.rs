@@ -8,6 +8,63 @@ use num_complex::Complex64;
 /// Cap on the QR sweeps of the Schur iteration (nalgebra counts them per matrix).
 const MAX_SWEEPS: usize = 100_000;
 
+/// Diagonal balancing (Parlett & Reinsch 1969, as LAPACK `gebal` without permutations):
+/// powers of two `d` such that `D⁻¹AD` has rows and columns of comparable norms. The
+/// similarity is exact in floating point; it makes eigenvalues and the Hessenberg
+/// reduction accurate for realizations with widely spread entries (companion forms).
+pub fn balancing(a: &DMatrix<f64>) -> Vec<f64> {
+    let n = a.nrows();
+    let mut m = a.clone();
+    let mut d = vec![1.0; n];
+    for _ in 0..100 {
+        let mut converged = true;
+        for i in 0..n {
+            let mut c = 0.0;
+            let mut r = 0.0;
+            for j in 0..n {
+                if j != i {
+                    c += m[(j, i)].abs();
+                    r += m[(i, j)].abs();
+                }
+            }
+            if c == 0.0 || r == 0.0 || !(c.is_finite() && r.is_finite()) {
+                continue;
+            }
+            let s = c + r;
+            let mut f = 1.0;
+            let mut cc = c;
+            let mut rr = r;
+            while cc < rr / 2.0 {
+                f *= 2.0;
+                cc *= 2.0;
+                rr /= 2.0;
+            }
+            while cc >= rr * 2.0 {
+                f /= 2.0;
+                cc /= 2.0;
+                rr *= 2.0;
+            }
+            if cc + rr < 0.95 * s {
+                converged = false;
+                d[i] *= f;
+                for j in 0..n {
+                    m[(j, i)] *= f;
+                    m[(i, j)] /= f;
+                }
+            }
+        }
+        if converged {
+            break;
+        }
+    }
+    d
+}
+
+/// `D⁻¹AD` for the diagonal `d` of [`balancing`].
+pub fn apply_balancing(a: &DMatrix<f64>, d: &[f64]) -> DMatrix<f64> {
+    DMatrix::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)] * d[j] / d[i])
+}
+
 /// All eigenvalues of a real square matrix (real Schur form, Francis double-shift QR with a
 /// sweep cap). Fails with a one-line error when the iteration does not converge.
 pub fn eigenvalues(a: &DMatrix<f64>, what: &str) -> Result<Vec<Complex64>> {

@@ -19,8 +19,9 @@ pub struct FreqEvaluator {
 }
 
 impl FreqEvaluator {
-    /// Reduces `A` to Hessenberg form once.
+    /// Balances `A` (exact diagonal similarity) and reduces it to Hessenberg form once.
     pub fn new(ss: &StateSpace) -> Self {
+        let ss = &ss.balanced();
         let n = ss.a.nrows();
         if n == 0 {
             return Self {
@@ -54,53 +55,66 @@ impl FreqEvaluator {
             return Some(y);
         }
         let k = self.qtb.ncols();
-        let mut m = DMatrix::from_fn(n, n, |i, j| {
-            let v = Complex64::new(-self.h[(i, j)], 0.0);
-            if i == j {
-                v + s
-            } else {
-                v
+        // Row-major copies so that the row operations below run over contiguous memory.
+        let mut m: Vec<Complex64> = Vec::with_capacity(n * n);
+        for i in 0..n {
+            for j in 0..n {
+                let v = Complex64::new(-self.h[(i, j)], 0.0);
+                m.push(if i == j { v + s } else { v });
             }
-        });
-        let mut x = self.qtb.map(|v| Complex64::new(v, 0.0));
+        }
+        let mut x: Vec<Complex64> = Vec::with_capacity(n * k);
+        for i in 0..n {
+            for j in 0..k {
+                x.push(Complex64::new(self.qtb[(i, j)], 0.0));
+            }
+        }
         let scale = self.h.amax().max(s.norm()).max(f64::MIN_POSITIVE);
         // Gaussian elimination with partial pivoting on an upper Hessenberg matrix: only
-        // rows k and k+1 compete for the pivot.
+        // rows c and c+1 compete for the pivot.
         for c in 0..n.saturating_sub(1) {
-            if m[(c + 1, c)].norm() > m[(c, c)].norm() {
-                m.swap_rows(c, c + 1);
-                x.swap_rows(c, c + 1);
+            if m[(c + 1) * n + c].norm() > m[c * n + c].norm() {
+                for j in c..n {
+                    m.swap(c * n + j, (c + 1) * n + j);
+                }
+                for j in 0..k {
+                    x.swap(c * k + j, (c + 1) * k + j);
+                }
             }
-            let piv = m[(c, c)];
+            let piv = m[c * n + c];
             if piv.norm() <= 1e-300 {
                 continue;
             }
-            let l = m[(c + 1, c)] / piv;
+            let l = m[(c + 1) * n + c] / piv;
             if l != Complex64::new(0.0, 0.0) {
-                m[(c + 1, c)] = Complex64::new(0.0, 0.0);
-                for j in c + 1..n {
-                    let t = m[(c, j)];
-                    m[(c + 1, j)] -= l * t;
+                m[(c + 1) * n + c] = Complex64::new(0.0, 0.0);
+                let (top, bottom) = m.split_at_mut((c + 1) * n);
+                let src = &top[c * n + c + 1..c * n + n];
+                let dst = &mut bottom[c + 1..n];
+                for (d, s) in dst.iter_mut().zip(src) {
+                    *d -= l * s;
                 }
                 for j in 0..k {
-                    let t = x[(c, j)];
-                    x[(c + 1, j)] -= l * t;
+                    let t = x[c * k + j];
+                    x[(c + 1) * k + j] -= l * t;
                 }
             }
         }
         for i in (0..n).rev() {
-            let piv = m[(i, i)];
+            let piv = m[i * n + i];
             if piv.norm() <= f64::EPSILON * scale * 1e-3 {
                 return None;
             }
+            let row = &m[i * n + i + 1..i * n + n];
             for j in 0..k {
-                let mut acc = x[(i, j)];
-                for l in i + 1..n {
-                    acc -= m[(i, l)] * x[(l, j)];
+                let mut acc = x[i * k + j];
+                for (off, a) in row.iter().enumerate() {
+                    acc -= a * x[(i + 1 + off) * k + j];
                 }
-                x[(i, j)] = acc / piv;
+                x[i * k + j] = acc / piv;
             }
         }
+        let x = DMatrix::from_row_slice(n, k, &x);
         let cq = self.cq.map(|v| Complex64::new(v, 0.0));
         y += cq * x;
         y.iter().all(|v| v.is_finite()).then_some(y)

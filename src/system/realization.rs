@@ -14,6 +14,18 @@ impl StateSpace {
         self.a.nrows()
     }
 
+    /// The same system after diagonal balancing of `A` (an exact similarity by powers of
+    /// two, see [`super::eig::balancing`]).
+    pub fn balanced(&self) -> StateSpace {
+        let d = super::eig::balancing(&self.a);
+        StateSpace {
+            a: super::eig::apply_balancing(&self.a, &d),
+            b: DMatrix::from_fn(self.b.nrows(), self.b.ncols(), |i, j| self.b[(i, j)] / d[i]),
+            c: DMatrix::from_fn(self.c.nrows(), self.c.ncols(), |i, j| self.c[(i, j)] * d[j]),
+            d: self.d.clone(),
+        }
+    }
+
     /// Checks that the four matrices fit together (`A` n×n, `B` n×m, `C` p×n, `D` p×m) and
     /// that every entry is finite; `what` names the source in the message.
     pub fn validate(&self, what: &str) -> Result<()> {
