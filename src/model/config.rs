@@ -174,6 +174,12 @@ pub struct RawConfig {
     /// The noise model.
     #[serde(default)]
     pub noise: NoiseSection,
+    /// The closed-loop uncertainty model (Crowder & de Callafon), instead of `[model]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<super::closed_loop::ClosedLoopSection>,
+    /// The weight `V` of the closed-loop model (eq. (2)), the analogue of `[r]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v: Option<RSection>,
 }
 
 /// A loaded, validated config.
@@ -193,6 +199,9 @@ pub struct Config {
     pub physical: Option<super::physical::PhysicalModel>,
     /// The noise std file (resolved) and its factor.
     pub noise_std: Option<(PathBuf, f64)>,
+    /// The closed-loop model when the config has `[closed_loop]`; then `factorization` is
+    /// its open-loop equivalent and `r` holds the weight `V` of `[v]`.
+    pub closed_loop: Option<super::closed_loop::ClosedLoopModel>,
 }
 
 fn tf_rows(
@@ -248,10 +257,11 @@ impl Config {
                 None => err(msg),
             }
         })?;
+        let closed_loop = super::closed_loop::from_raw(&raw).map_err(err)?;
         let plant_factorization = match &raw.plant {
-            Some(_) if raw.model.is_some() || raw.physical.is_some() => {
+            Some(_) if raw.model.is_some() || raw.physical.is_some() || closed_loop.is_some() => {
                 return Err(err(
-                    "give the model as one of [model], [physical] or [plant], not several".into(),
+                    "give the model as one of [model], [physical], [plant] or [closed_loop], not several".into(),
                 ))
             }
             Some(pl) => Some(
@@ -262,6 +272,14 @@ impl Config {
         };
         let (factorization, physical) = match (&raw.model, &raw.physical) {
             _ if plant_factorization.is_some() => (plant_factorization.expect("checked"), None),
+            (None, None) if closed_loop.is_some() => (
+                closed_loop
+                    .as_ref()
+                    .map(|c| c.open_loop_factorization())
+                    .expect("checked")
+                    .map_err(err)?,
+                None,
+            ),
             (Some(m), None) => (Self::build_factorization(m).map_err(err)?, None),
             (None, Some(ph)) => {
                 ph.validate().map_err(err)?;
@@ -282,13 +300,17 @@ impl Config {
                 return Err(err("[channel] output and input are 1-based".into()));
             }
         }
-        let r = match &raw.r {
+        let r = match if closed_loop.is_some() {
+            &raw.v
+        } else {
+            &raw.r
+        } {
             Some(r) => {
                 let tf = TfEntry::Rational(RationalEntry {
                     num: r.num.clone(),
                     den: r.den.clone(),
                 })
-                .to_tf("[r]")
+                .to_tf(if closed_loop.is_some() { "[v]" } else { "[r]" })
                 .map_err(err)?;
                 Some(tf)
             }
@@ -321,6 +343,7 @@ impl Config {
             data,
             physical,
             noise_std,
+            closed_loop,
         })
     }
 
