@@ -121,7 +121,7 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
     }
     let poles = eigenvalues(&ss.a, "H∞ norm: poles")?;
     let abscissa = spectral_abscissa(&poles);
-    if !(abscissa < 0.0) {
+    if abscissa.is_nan() || abscissa >= 0.0 {
         return Err(Error::Invalid(format!(
             "H∞ norm: the system is not stable (pole with real part {abscissa:.3e}); the norm is infinite"
         )));

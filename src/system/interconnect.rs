@@ -40,7 +40,7 @@ impl StateSpace {
         } else {
             nalgebra::DVector::zeros(1)
         };
-        if p != m || !(sv.min() > 1e-12 * sv.max()) {
+        if p != m || sv.min().is_nan() || sv.min() <= 1e-12 * sv.max() {
             return Err(Error::Invalid(format!(
                 "{what} is not biproper (its value at s = ∞ is singular), so it has no proper inverse"
             )));
@@ -95,7 +95,7 @@ pub fn negative_feedback(p: &StateSpace, k: &StateSpace, m_u: usize) -> Result<S
     let dw = p.d.columns(m_u, mw);
     let e = DMatrix::<f64>::identity(m_u, m_u) + &k.d * du;
     let sv = e.clone().svd(false, false).singular_values;
-    if !(sv.min() > 1e-12 * sv.max().max(1.0)) {
+    if sv.min().is_nan() || sv.min() <= 1e-12 * sv.max().max(1.0) {
         return Err(Error::Invalid(
             "the feedback loop is ill-posed: I + K(∞)·G(∞) is singular".into(),
         ));

@@ -199,7 +199,7 @@ impl StateSpace {
         let mut idx: Vec<usize> = (0..hsv.len()).collect();
         idx.sort_by(|a, b| hsv[*b].total_cmp(&hsv[*a]));
         let keep = &idx[..order];
-        if !(hsv[keep[order - 1]] > 0.0) {
+        if hsv[keep[order - 1]].is_nan() || hsv[keep[order - 1]] <= 0.0 {
             return Err(Error::Invalid(format!(
                 "balanced truncation: Hankel singular value {order} is zero; choose a smaller order"
             )));

@@ -210,7 +210,7 @@ pub fn care(
         .iter()
         .map(|v| v.abs())
         .fold(f64::INFINITY, f64::min);
-    if !(rmin > 1e-13 * rmax) {
+    if rmin.is_nan() || rmin <= 1e-13 * rmax {
         return Err(Error::Invalid(format!(
             "{what}: the stable invariant subspace of the Hamiltonian is not a graph (an unstable mode is unobservable or uncontrollable): no stabilizing solution"
         )));
@@ -232,7 +232,7 @@ pub fn care(
         let cand = &x + dx;
         let cand = (&cand + cand.transpose()) * 0.5;
         let r2 = relative_residual(a, g, q, &cand);
-        if !(r2 < residual) {
+        if r2.is_nan() || r2 >= residual {
             break;
         }
         newton_steps += 1;
@@ -243,13 +243,13 @@ pub fn care(
             break;
         }
     }
-    if !(residual < RESIDUAL_TOL) {
+    if residual.is_nan() || residual >= RESIDUAL_TOL {
         return Err(Error::Invalid(format!(
             "{what}: relative residual {residual:.1e} after refinement (above {RESIDUAL_TOL:.0e}): the equation is too ill-conditioned or has no stabilizing solution"
         )));
     }
     let abscissa = spectral_abscissa(&eigenvalues(&(a - g * &x), what)?);
-    if !(abscissa < 0.0) {
+    if abscissa.is_nan() || abscissa >= 0.0 {
         return Err(Error::Invalid(format!(
             "{what}: the solution is not stabilizing (closed-loop eigenvalue with real part {abscissa:.3e}): an unstable mode is unobservable or uncontrollable"
         )));
