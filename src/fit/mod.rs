@@ -11,6 +11,7 @@
 //! * [`engine`]: one order — candidates, failures recorded and skipped;
 //! * [`between`]: the no-dip rule between data, proved by interval branch-and-bound;
 //! * [`certificate`]: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
+//! * [`realization`]: a balanced cascade state-space realization of `r` for the exports;
 //! * [`order`]: the order sweep and the automatic order choice;
 //! * [`run`]: fit + certificate + exports, for the CLI.
 //!
@@ -23,6 +24,7 @@ pub mod certificate;
 pub(crate) mod engine;
 pub mod order;
 pub mod problem;
+pub mod realization;
 pub mod run;
 pub mod spectral;
 
