@@ -227,7 +227,7 @@ mod tests {
             };
             let got = ss.freq(w).unwrap()[(0, 0)];
             assert!(
-                (got - want).norm() <= 1e-13 * want.norm(),
+                (got - want).norm() <= 1e-12 * want.norm(),
                 "{w}: {got} vs {want}"
             );
         }
