@@ -9,7 +9,7 @@
 //! * a real pole `p` with a real zero `z`: `(s − z)/(s − p) = 1 + (p − z)/(s − p)`;
 //! * a complex pole pair `σ ± jω` with two zeros: `1 + (c₁s + c₀)/((s − σ)² + ω²)` in the
 //!   real modal form `A = [[σ, ω], [−ω, σ]]`;
-//! * two real poles with a complex zero pair: `A = [[p₁, 0], [1, p₂]]` (a chain);
+//! * two real poles with a complex zero pair: `A = [[p₁, 0], [α, p₂]]`, `α = √|p₁p₂|` (a chain);
 //!
 //! each with its input and output gains balanced (`|B| = |C|`), and the gain `g` spread
 //! evenly over the sections.  The series connection is block lower triangular.
@@ -71,13 +71,15 @@ fn second_order(z: (Complex64, Complex64), p: (Complex64, Complex64), k: f64) ->
         }
     } else {
         let (p1, p2) = (p.0.re, p.1.re);
-        // B = [β; 0], A = [[p₁, 0], [1, p₂]]: x₁ = β/(s − p₁), x₂ = x₁/(s − p₂);
-        // y = β(γ₁(s − p₂) + γ₂)/((s − p₁)(s − p₂)).
+        // B = [β; 0], A = [[p₁, 0], [α, p₂]]: x₁ = β/(s − p₁), x₂ = αx₁/(s − p₂);
+        // y = β(γ₁(s − p₂) + αγ₂)/((s − p₁)(s − p₂)).
+        // The chain coupling α = √|p₁p₂| keeps both states of the order of the input.
+        let alpha = (p1 * p2).abs().sqrt().max(f64::MIN_POSITIVE);
         let g1b = c1;
-        let g2b = c0 + c1 * p2;
+        let g2b = (c0 + c1 * p2) / alpha;
         let beta = (g1b.abs() + g2b.abs()).sqrt().max(f64::MIN_POSITIVE);
         Section {
-            a: DMatrix::from_row_slice(2, 2, &[p1, 0.0, 1.0, p2]),
+            a: DMatrix::from_row_slice(2, 2, &[p1, 0.0, alpha, p2]),
             b: DMatrix::from_row_slice(2, 1, &[beta, 0.0]),
             c: DMatrix::from_row_slice(1, 2, &[g1b / beta, g2b / beta]),
             d: k,
@@ -105,11 +107,8 @@ pub fn realize(r: &Zpk) -> StateSpace {
     let (mut zp, mut zr) = split(&r.zeros);
     let (pp, mut pr) = split(&r.poles);
     let n_sec = pp.len() + pr.len();
-    let k = if n_sec == 0 {
-        r.gain
-    } else {
-        r.gain.abs().powf(1.0 / n_sec as f64)
-    };
+    // Sections are built with unit gain; |g| is spread evenly over them below.
+    let k = 1.0;
     let sign = r.gain.signum();
     let mut secs: Vec<Section> = Vec::new();
     // Each section pairs poles with the zeros nearest in modulus, so that every section
@@ -164,6 +163,11 @@ pub fn realize(r: &Zpk) -> StateSpace {
             c: DMatrix::zeros(1, 0),
             d: DMatrix::from_element(1, 1, r.gain),
         };
+    }
+    let kk = r.gain.abs().powf(1.0 / secs.len() as f64);
+    for s in secs.iter_mut() {
+        s.c *= kk;
+        s.d *= kk;
     }
     if let Some(last) = secs.last_mut() {
         last.c *= sign;
