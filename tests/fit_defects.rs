@@ -6,7 +6,8 @@
 //! * 5: an envelope rising two decades per decade over the top three decades of the band
 //!   was declared infeasible at orders 1–3 although the constant r meets every bound.
 //! * 6: the state-space realization in `r.json` agrees with `num/den` (and the poles and
-//!   zeros) to 1e-12 relative on a dense grid.
+//!   zeros) to 1e-12 relative on a dense grid (relative to `max(|r(jω)|, |r(∞)|)` where the
+//!   feedthrough cancels, the limit of any realization with `D ≠ 0`).
 use num_complex::Complex64;
 use rshape::consistency::{Envelope, EnvelopeMethod};
 use rshape::fit::realization::realize;
@@ -126,8 +127,11 @@ fn state_space_agrees_with_num_den_to_1e_12() {
             let want = zpk_eval(&z, w);
             let tf = f.r.freq(w);
             let got = ss.freq(w).unwrap()[(0, 0)];
-            let e_ss = (got - want).norm() / want.norm();
-            let e_tf = (got - tf).norm() / tf.norm();
+            // Any realization with a feedthrough evaluates y = Cx + Du, which cancels where
+            // |r(jω)| ≪ |r(∞)|: the relative accuracy there is ε·|r(∞)|/|r(jω)| at best.
+            let cancel = (f.gain.abs() / want.norm()).max(1.0);
+            let e_ss = (got - want).norm() / want.norm() / cancel;
+            let e_tf = (got - tf).norm() / tf.norm() / cancel;
             worst = worst.max(e_ss).max(e_tf);
             assert!(
                 e_ss <= 1e-12 && e_tf <= 1e-12,

@@ -43,7 +43,7 @@ pub(crate) struct Scored {
     pub max_log: f64,
     /// Area objective `Σ w_i |r|²/r_min²`.
     pub area: f64,
-    /// `max |r|²/U` over the grid (the minimax level reached).
+    /// `max |r|²/U` over the data (the minimax level reached).
     pub t: f64,
     /// Where the candidate came from.
     pub origin: String,
@@ -69,7 +69,7 @@ impl Prepared {
         let (mut t, mut coverage, mut a1_ratio) = (0.0f64, f64::INFINITY, f64::INFINITY);
         for p in &self.grid {
             let m2 = zpk.mag(p.w).powi(2);
-            if let Some(u) = p.upper {
+            if let Some(u) = p.upper.filter(|_| p.kind == PointKind::Datum) {
                 t = t.max(m2 / u);
             }
             if p.lower > 0.0 {
@@ -114,13 +114,13 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
-/// The level `max A/(U·B)` over the grid points with an upper bound reached by `(A, B)`
+/// The level `max A/(U·B)` over the data with a bound reached by `(A, B)`
 /// (`+∞` when `B ≤ 0` somewhere, which a feasible max-slack solution never has).
 fn achieved_level(phi: &[Vec<f64>], grid: &[GridPoint], a: &[f64], b: &[f64]) -> f64 {
     let dot = |r: &[f64], c: &[f64]| r.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
     let mut t = 0.0f64;
     for (ph, g) in phi.iter().zip(grid) {
-        if let Some(u) = g.upper {
+        if let Some(u) = g.upper.filter(|_| g.kind == PointKind::Datum) {
             let bv = dot(ph, b);
             if !(bv > 0.0) {
                 return f64::INFINITY;
