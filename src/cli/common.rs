@@ -2,7 +2,7 @@
 
 use crate::consistency::noisy::BisectionSettings;
 use crate::consistency::{noise_free_envelope, noisy_envelope, Envelope};
-use crate::data::{read_frf_csv, FrfData};
+use crate::data::FrfData;
 use crate::model::noise::noise_radii;
 use crate::model::Config;
 use anyhow::{anyhow, Result};
@@ -44,7 +44,7 @@ impl InputArgs {
                     self.config.display()
                 )
             })?;
-        let mut data = read_frf_csv(&path)?;
+        let mut data = crate::pipeline::closed_loop::read_data(&config, &path)?;
         let f = &config.factorization;
         if let Some(ch) = config.raw.channel {
             let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
@@ -81,6 +81,12 @@ impl InputArgs {
 pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope> {
     let f = &inputs.config.factorization;
     let data = &inputs.data;
+    if inputs.config.closed_loop.is_some() {
+        let radii = crate::pipeline::integration::noise_radii(&inputs.config, data, cli_noise)?;
+        let (env, _, _) =
+            crate::pipeline::closed_loop::envelope(&inputs.config, data, radii.as_deref())?;
+        return Ok(env);
+    }
     match noise_radii(cli_noise, Some(&inputs.config), data)? {
         Some(radii) if radii.iter().any(|r| *r > 0.0) => {
             if data.outputs() != 1 || data.inputs() != 1 {

@@ -10,15 +10,12 @@
 
 use super::table::Table;
 use crate::consistency::{Envelope, EnvelopeMethod};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use std::path::Path;
 
 /// Reads an envelope CSV file.
 pub fn read_envelope_csv(path: &Path) -> Result<Envelope> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = super::table::read_text(path)?;
     parse_envelope_csv(&text, path)
 }
 

@@ -7,7 +7,7 @@
 
 use super::frf::FrfData;
 use super::table::Table;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::collections::HashMap;
@@ -23,10 +23,7 @@ enum Part {
 
 /// Reads an FRF CSV file; every error names the file and the line.
 pub fn read_frf_csv(path: &Path) -> Result<FrfData> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = super::table::read_text(path)?;
     parse_frf_csv(&text, path)
 }
 
@@ -110,7 +107,12 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
             let v: f64 = fields[col].parse().map_err(|_| {
                 err(
                     line,
-                    format!("column `{}`: `{}` is not a number", names[col], fields[col]),
+                    format!(
+                        "column `{}`: `{}` is not a number{}",
+                        names[col],
+                        fields[col],
+                        super::table::decimal_hint(fields[col])
+                    ),
                 )
             })?;
             if !v.is_finite() {

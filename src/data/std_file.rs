@@ -19,10 +19,7 @@ pub struct StdData {
 
 /// Reads a std file; every error names the file and the line.
 pub fn read_std_csv(path: &Path) -> Result<StdData> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = super::table::read_text(path)?;
     let table = Table::parse(&text, path, "freq_hz,std_1_1")?;
     let err = |line: usize, msg: String| table.err(line, msg);
     let (hline, names) = (table.header_line, &table.names);
@@ -49,7 +46,11 @@ pub fn read_std_csv(path: &Path) -> Result<StdData> {
             let v: f64 = f.parse().map_err(|_| {
                 err(
                     line,
-                    format!("column `{}`: `{f}` is not a number", names[c]),
+                    format!(
+                        "column `{}`: `{f}` is not a number{}",
+                        names[c],
+                        super::table::decimal_hint(f)
+                    ),
                 )
             })?;
             if !v.is_finite() || v < 0.0 || (c == 0 && v <= 0.0) {
