@@ -65,7 +65,7 @@ fn lightly_damped_zero_pair_between_two_data_fails() {
 
 fn unit(seed: &[f64], order: usize) -> Zpk {
     // Roots: pairs with damping 10^(-4..0) and natural frequencies 10^(-1..2), or real.
-    let mut roots = |k: usize| -> Vec<Complex64> {
+    let roots = |k: usize| -> Vec<Complex64> {
         let mut v = Vec::new();
         let mut i = 0;
         while v.len() < order {

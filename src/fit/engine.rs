@@ -473,11 +473,14 @@ pub(crate) fn fit_order(
     }
 }
 
+/// Drops one constraint family from a grid point.
+type Relax = fn(&mut GridPoint);
+
 /// When no level is feasible: which constraint family blocks it.  Each family is dropped in
 /// turn and the level `t = 1e24` tried again; the families whose removal makes it feasible
 /// are named (the data lower bounds, the no-dip bounds between data, the floor, A1).
 fn blocking_families(phi: &[Vec<f64>], grid: &[GridPoint], init: &[bool], max_iter: u32) -> String {
-    let families: [(&str, fn(&mut GridPoint)); 4] = [
+    let families: [(&str, Relax); 4] = [
         ("the lower bounds at the data", |g| {
             if g.kind == PointKind::Datum {
                 g.lower = 0.0;
