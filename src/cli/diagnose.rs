@@ -52,6 +52,12 @@ fn rel_to(target: &Path, from_dir: &Path) -> PathBuf {
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     let inputs = a.input.load()?;
+    // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄.
+    let inputs = crate::pipeline::closed_loop::discovery_inputs(
+        inputs.config,
+        inputs.data,
+        a.input.noise_radius,
+    )?;
     let config = &inputs.config;
     let base = config.physical.clone().ok_or_else(|| {
         anyhow!(
@@ -63,7 +69,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         config,
         &inputs.data,
         channel_arg(&a.channel)?,
-        a.input.noise_radius,
+        inputs.noise_radius,
     )?;
     let d = diagnose(&base, &siso, a.max_effects.max(1))?;
     if let (Some(k), Some(out)) = (a.apply, &a.write) {
@@ -73,7 +79,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         let revised = refit_nominal(&applied, &siso.omega, &siso.g, &radius).model;
         let gm: Vec<_> = siso.omega.iter().map(|w| revised.eval_siso(*w)).collect();
         let (_, rms_refit, _, inv_refit) = crate::diagnose::compare::misfit(&siso, &gm);
-        let mut raw = config.raw.clone();
+        let mut raw = inputs.raw.clone();
         let c = &d.candidates[k - 1];
         raw.physical = Some(revised);
         raw.name = Some(format!(
