@@ -73,7 +73,11 @@ fn setup(dir: &Path) -> PathBuf {
 fn diagnose_finds_the_missing_mode_from_closed_loop_data() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = setup(dir.path());
-    let o = bin().args(["diagnose", "--json"]).arg(&cfg).output().unwrap();
+    let o = bin()
+        .args(["diagnose", "--json"])
+        .arg(&cfg)
+        .output()
+        .unwrap();
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -92,6 +96,7 @@ fn diagnose_finds_the_missing_mode_from_closed_loop_data() {
     // The rigid-body nominal fails on the recovered plant; the mode brings it to the noise.
     let before = d["before"]["misfit_rms"].as_f64().unwrap();
     let after = top["misfit_rms_after"].as_f64().unwrap();
+    println!("closed-loop diagnose: mode ω_n = {w:.4} rad/s, ζ = {z:.5}; misfit_rms {before:.3} -> {after:.3}");
     assert!(before > 10.0, "before {before}");
     assert!(after < 2.0, "after {after}");
 
@@ -116,7 +121,11 @@ fn diagnose_finds_the_missing_mode_from_closed_loop_data() {
     assert_eq!(ph.mode.len(), 1);
     assert!((ph.mode[0].omega_n - OMEGA_N).abs() < 0.005 * OMEGA_N);
     // The revised nominal now explains the closed-loop data: compare on it is consistent.
-    let o = bin().args(["compare", "--json"]).arg(&out).output().unwrap();
+    let o = bin()
+        .args(["compare", "--json"])
+        .arg(&out)
+        .output()
+        .unwrap();
     assert_eq!(o.status.code(), Some(0));
     let rep: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(rep["verdict"], "consistent", "{rep:#}");

@@ -29,6 +29,7 @@
 //! stabilizes `P̂`).
 pub mod physical_nominal;
 pub mod stability;
+pub mod stability_ss;
 
 use super::config::TfEntry;
 use crate::system::{TfMatrix, TransferFunction};

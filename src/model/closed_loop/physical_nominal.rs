@@ -37,12 +37,17 @@ pub fn rcf_from_modal(f: &Factorization) -> Result<RightFactors, String> {
     for k in 0..n {
         for j in 0..n {
             if j != k && !f.m.entry(k, j).num.is_zero() {
-                return Err("[physical] with [closed_loop]: the modal factor M̃ must be diagonal".into());
+                return Err(
+                    "[physical] with [closed_loop]: the modal factor M̃ must be diagonal".into(),
+                );
             }
         }
         let (mk, nk) = (f.m.entry(k, k), f.n.entry(k, 0));
         if !nk.num.is_zero() && nk.den != mk.den {
-            return Err("[physical] with [closed_loop]: rows of Ñ and M̃ must share their denominators".into());
+            return Err(
+                "[physical] with [closed_loop]: rows of Ñ and M̃ must share their denominators"
+                    .into(),
+            );
         }
         d_prod = d_prod.mul(&mk.num);
         q_prod = q_prod.mul(&mk.den);
@@ -105,7 +110,10 @@ mod tests {
         for w in [0.01, 0.7, 29.0, 30.0, 31.0, 1e3] {
             let want = ph.eval_siso(w);
             let got = rcf.value(w).unwrap()[(0, 0)];
-            assert!((got - want).norm() <= 1e-9 * want.norm(), "{w}: {got} vs {want}");
+            assert!(
+                (got - want).norm() <= 1e-9 * want.norm(),
+                "{w}: {got} vs {want}"
+            );
         }
         assert!(super::super::stability::is_stable(&rcf.n));
         assert!(super::super::stability::is_stable(&rcf.d));
