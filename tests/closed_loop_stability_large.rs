@@ -8,7 +8,6 @@
 use nalgebra::{DMatrix, Matrix4};
 use num_complex::Complex64;
 use rshape::model::closed_loop::stability::{check_loop_with, LoopInstability, LoopRoute};
-use rshape::model::closed_loop::stability_ss::eigenvalues;
 use rshape::system::{TfMatrix, TransferFunction};
 
 /// Unstable poles `a_i`, stable poles `−b_i` of `p_i = 1/((s − a_i)(s + b_i))`.
@@ -240,32 +239,4 @@ fn state_space_and_polynomial_routes_agree_on_small_loops() {
         stable >= 1 && unstable >= 1,
         "{stable} stable, {unstable} unstable"
     );
-}
-
-#[test]
-fn capped_eigenvalues_match_a_companion_matrix() {
-    // Companion matrix of (s + 1)(s − 2)(s² + 0.002 s + 1e4): eigenvalues known in closed form.
-    let roots = [
-        Complex64::new(-1.0, 0.0),
-        Complex64::new(2.0, 0.0),
-        Complex64::new(-0.001, (1e4f64 - 1e-6).sqrt()),
-        Complex64::new(-0.001, -(1e4f64 - 1e-6).sqrt()),
-    ];
-    let p = rshape::system::Polynomial::from_roots(&roots);
-    let c = p.coeffs();
-    let mut m = DMatrix::zeros(4, 4);
-    for j in 0..4 {
-        m[(0, j)] = -c[j + 1] / c[0];
-    }
-    for i in 1..4 {
-        m[(i, i - 1)] = 1.0;
-    }
-    let ev = eigenvalues(&m).unwrap();
-    for r in roots {
-        let best = ev
-            .iter()
-            .map(|z| (z - r).norm())
-            .fold(f64::INFINITY, f64::min);
-        assert!(best < 1e-9 * r.norm().max(1.0), "{r}: {ev:?}");
-    }
 }

@@ -12,112 +12,24 @@
 //! lie in `Re s < 0`.  Hence `Λ` is a unit of RH∞ (the loop is internally stable) iff
 //! every eigenvalue of `A_×` lies in `Re s < 0`, and the eigenvalues of `A_×` in
 //! `Re s ≥ 0` are exactly the closed-loop poles there.  The realization need not be
-//! minimal.  Eigenvalues come from nalgebra's real Schur form with a capped iteration
-//! (`try_new`), after a diagonal balancing of `A_×`.
+//! minimal.  The realization is [`StateSpace::from_tf_matrix`] (one controllable-canonical
+//! block per entry); the eigenvalues come from [`eig::eigenvalues`] (real Schur form with a
+//! capped iteration) after a diagonal balancing of `A_×`.
 
 use super::stability::LoopInstability;
-use crate::system::{StateSpace, TransferFunction};
-use nalgebra::DMatrix;
+use crate::system::{eig, StateSpace, TfMatrix, TransferFunction};
 use num_complex::Complex64;
 
 /// Largest number of states of the realization of `Λ` accepted.
 pub const MAX_STATES: usize = 1500;
 
-/// Entry-by-entry realization `(A, B, C, D)` of a square matrix of proper transfer
-/// functions (block-diagonal `A`, not minimal in general).
-pub fn realize(lambda: &[Vec<TransferFunction>]) -> StateSpace {
-    let n = lambda.len();
-    let parts: Vec<(usize, usize, StateSpace)> = lambda
-        .iter()
-        .enumerate()
-        .flat_map(|(i, row)| {
-            row.iter()
-                .enumerate()
-                .map(move |(j, t)| (i, j, StateSpace::from_tf(t)))
-        })
-        .collect();
-    let states: usize = parts.iter().map(|(_, _, s)| s.a.nrows()).sum();
-    let mut a = DMatrix::zeros(states, states);
-    let mut b = DMatrix::zeros(states, n);
-    let mut c = DMatrix::zeros(n, states);
-    let mut d = DMatrix::zeros(n, n);
-    let mut k = 0;
-    for (i, j, s) in &parts {
-        d[(*i, *j)] = s.d[(0, 0)];
-        let ns = s.a.nrows();
-        if ns == 0 || s.c.iter().all(|x| *x == 0.0) {
-            // A zero strictly proper part needs no states.
-            continue;
-        }
-        a.view_mut((k, k), (ns, ns)).copy_from(&s.a);
-        b.view_mut((k, *j), (ns, 1)).copy_from(&s.b);
-        c.view_mut((*i, k), (1, ns)).copy_from(&s.c);
-        k += ns;
-    }
-    StateSpace {
-        a: a.view((0, 0), (k, k)).into_owned(),
-        b: b.rows(0, k).into_owned(),
-        c: c.columns(0, k).into_owned(),
-        d,
-    }
-}
-
-/// Eigenvalues of a real square matrix by a balanced, capped real Schur form; `None` when
-/// the iteration does not converge within its cap.
-pub fn eigenvalues(m: &DMatrix<f64>) -> Option<Vec<Complex64>> {
-    let n = m.nrows();
-    if n == 0 {
-        return Some(Vec::new());
-    }
-    // Diagonal balancing (Parlett–Reinsch, powers of 2, capped): companion blocks mix
-    // coefficients of very different sizes.
-    let mut a = m.clone();
-    for _ in 0..50 {
-        let mut done = true;
-        for i in 0..n {
-            let c: f64 = (0..n).filter(|&k| k != i).map(|k| a[(k, i)].abs()).sum();
-            let r: f64 = (0..n).filter(|&k| k != i).map(|k| a[(i, k)].abs()).sum();
-            if c == 0.0 || r == 0.0 {
-                continue;
-            }
-            let mut f = 1.0;
-            let (mut cc, mut rr) = (c, r);
-            while cc < rr / 2.0 {
-                cc *= 2.0;
-                rr /= 2.0;
-                f *= 2.0;
-            }
-            while cc >= rr * 2.0 {
-                cc /= 2.0;
-                rr *= 2.0;
-                f /= 2.0;
-            }
-            if (cc + rr) < 0.95 * (c + r) {
-                done = false;
-                for k in 0..n {
-                    a[(k, i)] *= f;
-                    a[(i, k)] /= f;
-                }
-            }
-        }
-        if done {
-            break;
-        }
-    }
-    let schur = nalgebra::Schur::try_new(a, f64::EPSILON, 100 * n.max(10))?;
-    let ev: Vec<Complex64> = schur
-        .complex_eigenvalues()
-        .iter()
-        .map(|z| Complex64::new(z.re, z.im))
-        .collect();
-    ev.iter().all(|z| z.is_finite()).then_some(ev)
-}
-
 /// Internal stability of the loop whose `Λ` is given (rows of transfer functions), by the
 /// eigenvalues of the state matrix of `Λ⁻¹` (module docs).  `Λ(∞)` must be invertible
 /// (checked by the caller).
 pub fn check_lambda(lambda: &[Vec<TransferFunction>]) -> Result<(), LoopInstability> {
-    let ss = realize(lambda);
+    let rows = lambda.to_vec();
+    let ss =
+        StateSpace::from_tf_matrix(&TfMatrix::from_rows(rows).ok_or(LoopInstability::IllPosed)?);
     let k = ss.a.nrows();
     if k > MAX_STATES {
         return Err(LoopInstability::TooLarge(k));
@@ -126,7 +38,10 @@ pub fn check_lambda(lambda: &[Vec<TransferFunction>]) -> Result<(), LoopInstabil
         Some(x) => &ss.a - &ss.b * x,
         None => return Err(LoopInstability::IllPosed),
     };
-    let ev = eigenvalues(&a_cross).ok_or(LoopInstability::RootsDidNotConverge)?;
+    // Diagonal balancing first: companion blocks mix coefficients of very different sizes.
+    let balanced = eig::apply_balancing(&a_cross, &eig::balancing(&a_cross));
+    let ev = eig::eigenvalues(&balanced, "closed-loop poles")
+        .map_err(|_| LoopInstability::RootsDidNotConverge)?;
     let bad: Vec<Complex64> = ev
         .into_iter()
         .filter(|z| z.re >= -1e-10 * z.norm().max(1.0))
