@@ -44,24 +44,15 @@ pub fn run_compare(
     input: &InputArgs,
     channel: Option<(usize, usize)>,
 ) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
-    let mut inputs = input.load()?;
-    let mut noise = input.noise_radius;
-    if inputs.config.closed_loop.is_some() {
-        // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
-        // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
-        let radii = crate::pipeline::integration::noise_radii(&inputs.config, &inputs.data, noise)?;
-        let eq = crate::pipeline::closed_loop::open_loop_equivalent(
-            &inputs.config,
-            &inputs.data,
-            radii.as_deref(),
-        )?;
-        inputs.data = eq.data;
-        inputs.config.raw.noise = Default::default();
-        inputs.config.noise_std = None;
-        // [v] weighs the closed-loop perturbation Δ̄, not the factor perturbations of r.
-        inputs.config.r = None;
-        noise = None;
-    }
+    let inputs = input.load()?;
+    // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
+    // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
+    let inputs = crate::pipeline::closed_loop::discovery_inputs(
+        inputs.config,
+        inputs.data,
+        input.noise_radius,
+    )?;
+    let noise = inputs.noise_radius;
     let siso = prepare(&inputs.config, &inputs.data, channel, noise)?;
     let model = PlantModel::from_config(&inputs.config);
     let rep = compare(&inputs.config, &model, &siso)?;

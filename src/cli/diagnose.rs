@@ -82,23 +82,20 @@ fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
 
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
-    let mut inputs = a.input.load()?;
-    let mut noise = a.input.noise_radius;
-    if inputs.config.closed_loop.is_some() {
-        // Closed-loop data: diagnose the plant recovered from Φ and C̄ with the radii
-        // propagated to it, as `compare` does.
-        let radii = crate::pipeline::integration::noise_radii(&inputs.config, &inputs.data, noise)?;
-        let eq = crate::pipeline::closed_loop::open_loop_equivalent(
-            &inputs.config,
-            &inputs.data,
-            radii.as_deref(),
-        )?;
-        inputs.data = eq.data;
-        inputs.config.raw.noise = Default::default();
-        inputs.config.noise_std = None;
-        inputs.config.r = None;
-        noise = None;
-    }
+    let loaded = a.input.load()?;
+    // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,
+    // with the noise radii carried over to it, through the hook `compare` uses too.
+    let found = crate::pipeline::closed_loop::discovery_inputs(
+        loaded.config,
+        loaded.data,
+        a.input.noise_radius,
+    )?;
+    let noise = found.noise_radius;
+    let raw = found.raw;
+    let inputs = super::common::Inputs {
+        config: found.config,
+        data: found.data,
+    };
     let config = &inputs.config;
     let base = match &config.physical {
         Some(p) => p.clone(),
@@ -126,7 +123,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     };
     let d = diagnose_channels(&base, &data, &settings)?;
     if let (Some(k), Some(out)) = (a.apply, &a.write) {
-        write_revision(a, config, &data, &d, &base, k, out)?;
+        write_revision(a, config, &raw, &data, &d, &base, k, out)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
@@ -140,6 +137,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
 fn write_revision(
     a: &DiagnoseArgs,
     config: &crate::model::Config,
+    raw: &crate::model::config::RawConfig,
     data: &Channels,
     d: &Diagnosis,
     base: &crate::model::physical::PhysicalModel,
@@ -150,7 +148,8 @@ fn write_revision(
     let applied = apply_candidate(base, d, k)?;
     let revised = retune(&applied, data, None, false).model;
     let (rms_refit, inv_refit) = misfit_channels(&revised, data);
-    let mut raw = config.raw.clone();
+    // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
+    let mut raw = raw.clone();
     let c = &d.candidates[k - 1];
     raw.physical = Some(revised);
     raw.model = None;
