@@ -1,4 +1,4 @@
-//! Small helpers shared by the I/O code: atomic file writes.
+//! Small helpers shared by the I/O code: atomic file writes, whole or streamed.
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -39,4 +39,52 @@ fn write_via_temp(path: &Path, contents: &[u8], sync: bool) -> Result<()> {
     }
     tmp.persist(path).map_err(|e| io(e.error))?;
     Ok(())
+}
+
+/// A file written in pieces and published atomically: the bytes go to a temporary file in
+/// the target's directory; [`commit`](Self::commit) flushes, syncs and renames it over the
+/// target.  Dropped without `commit` (an error, a panic) or killed, the run leaves at most
+/// an unnamed temporary file, never a truncated file under the final name.
+pub struct AtomicFile {
+    path: std::path::PathBuf,
+    out: std::io::BufWriter<tempfile::NamedTempFile>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path` (its directory is created if needed).
+    pub fn create(path: &Path) -> Result<Self> {
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: std::io::BufWriter::with_capacity(1 << 16, tmp),
+        })
+    }
+
+    /// The writer of the contents.
+    pub fn writer(&mut self) -> &mut impl Write {
+        &mut self.out
+    }
+
+    /// Flushes, syncs and renames the file to its final name.
+    pub fn commit(self) -> Result<()> {
+        let io = |source| Error::Io {
+            path: self.path.clone(),
+            source,
+        };
+        let tmp = self.out.into_inner().map_err(|e| io(e.into_error()))?;
+        tmp.as_file().sync_all().map_err(io)?;
+        tmp.persist(&self.path).map_err(|e| io(e.error))?;
+        Ok(())
+    }
 }

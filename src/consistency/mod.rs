@@ -3,6 +3,7 @@ pub mod check;
 pub mod envelope;
 pub mod noise_free;
 pub mod noisy;
+pub mod stream;
 
 pub use check::{check, CheckReport, CheckRow};
 pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};

@@ -391,6 +391,11 @@ impl<'r> TableReader<'r> {
     pub fn first_column_is_hz(&self) -> Result<bool> {
         first_column_is_hz(&self.path, self.header_line, &self.names)
     }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
 }
 
 fn io_err(path: &Path, source: std::io::Error) -> Error {
