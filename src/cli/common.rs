@@ -7,6 +7,7 @@ use crate::data::reader::FrfRows;
 use crate::data::{read_frf_csv, FrfData};
 use crate::model::noise::noise_radii;
 use crate::model::Config;
+use crate::util::OutputManifest;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -20,7 +21,7 @@ pub struct InputArgs {
     #[arg(long)]
     pub data: Option<PathBuf>,
     /// Global noise-disk radius L_a overriding the config (noisy SISO data, Theorem 4).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub noise_radius: Option<f64>,
 }
 
@@ -142,3 +143,33 @@ pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope>
 }
 
 pub use crate::report::fmt::{fmt_g, fmt_omegas};
+
+/// Checks `--out DIR` before any work and clears the previous run's files there (see
+/// [`OutputManifest`]).  `DIR` must not be an existing file, nor the folder of an input
+/// (outputs would mix with inputs).  Keep the guard alive while the run writes.
+pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result<OutputManifest> {
+    if out.exists() && !out.is_dir() {
+        return Err(anyhow!(
+            "--out {}: is an existing file; give a folder (it is created if needed)",
+            out.display()
+        ));
+    }
+    if let Ok(o) = out.canonicalize() {
+        for input in inputs {
+            let folder = match input.canonicalize() {
+                Ok(p) if p.is_dir() => p,
+                Ok(p) => p.parent().map(|p| p.to_path_buf()).unwrap_or(p),
+                Err(_) => continue,
+            };
+            if folder == o {
+                return Err(anyhow!(
+                    "--out {}: is the folder of the input {}; outputs would mix with inputs: choose a new folder such as {}",
+                    out.display(),
+                    input.display(),
+                    out.join("out").display()
+                ));
+            }
+        }
+    }
+    Ok(OutputManifest::begin(out)?)
+}

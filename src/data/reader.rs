@@ -215,6 +215,12 @@ impl Layout {
         let mut noise_col = None;
         let (mut p, mut m) = (0, 0);
         for (col, name) in names.iter().enumerate().skip(1) {
+            if name == "omega_rad_s" || name == "freq_hz" {
+                return Err(err(format!(
+                    "column `{name}` besides `{}`: keep one frequency column, first",
+                    names[0]
+                )));
+            }
             if name == "noise_radius" {
                 if noise_col.replace(col).is_some() {
                     return Err(err(format!("column `{name}` appears twice")));
