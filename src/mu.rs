@@ -24,6 +24,7 @@
 //! `d → 0` or `∞`, repeated `σ̄`) have their own candidates; see [`mu_full_scalar`].
 
 mod search;
+pub mod two_scalar;
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector, SVD};

@@ -98,7 +98,9 @@ pub fn merge(
             merged_from: shards.to_vec(),
             timings_ms: timings,
             order,
-            factorization: config.as_ref().map(|c| &c.factorization),
+            factorization: config
+                .as_ref()
+                .and_then(crate::pipeline::closed_loop::a1_factorization),
         },
     )?;
     Ok(MergeOutcome {

@@ -5,7 +5,6 @@
 
 use super::discover::Dataset;
 use crate::consistency::{check, Envelope};
-use crate::data::read_frf_csv;
 use crate::error::{Error, Result};
 use crate::model::Config;
 use crate::pipeline::integration;
@@ -85,7 +84,7 @@ fn fill(
     out: &Path,
     res: &mut DatasetResult,
 ) -> Result<()> {
-    let data = read_frf_csv(&d.path)?;
+    let data = crate::pipeline::closed_loop::read_data(config, &d.path)?;
     if data.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no data rows",
@@ -94,7 +93,8 @@ fn fill(
     }
     res.n_data = data.len();
     let radii = integration::noise_radii(config, &data, d.noise_radius.or(opts.noise_radius))?;
-    let (env, warnings) = integration::envelope(&config.factorization, &data, radii.as_deref())?;
+    let (env, warnings, _) =
+        crate::pipeline::closed_loop::envelope(config, &data, radii.as_deref())?;
     res.warnings = warnings;
     res.max_r_min = env.r_min.iter().copied().reduce(f64::max);
     if let Some(r) = &config.r {

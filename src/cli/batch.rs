@@ -133,7 +133,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             merged_from: Vec::new(),
             timings_ms: timings,
             order: a.order,
-            factorization: Some(&config.factorization),
+            factorization: crate::pipeline::closed_loop::a1_factorization(&config),
         },
     )?;
     print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());

@@ -109,8 +109,14 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
                 list(&rep.a1_violations)
             );
         }
+        // Closed-loop configs check the weight V of [v] (Crowder & de Callafon, eq. (2)).
+        let w = if inputs.config.closed_loop.is_some() {
+            "V"
+        } else {
+            "r"
+        };
         if rep.consistent {
-            println!("consistent: r explains all {} data", rep.rows.len());
+            println!("consistent: {w} explains all {} data", rep.rows.len());
         } else {
             println!(
                 "inconsistent at {} of {} data: omega = {} rad/s",

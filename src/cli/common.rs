@@ -4,7 +4,7 @@ use crate::consistency::noisy::BisectionSettings;
 use crate::consistency::stream::noise_free_envelope_rows;
 use crate::consistency::{noise_free_envelope, noisy_envelope, Envelope};
 use crate::data::reader::FrfRows;
-use crate::data::{read_frf_csv, FrfData};
+use crate::data::FrfData;
 use crate::model::noise::noise_radii;
 use crate::model::Config;
 use crate::util::OutputManifest;
@@ -38,7 +38,7 @@ impl InputArgs {
     pub fn load(&self) -> Result<Inputs> {
         let config = Config::load(&self.config)?;
         let path = self.data_path(&config)?;
-        let mut data = read_frf_csv(&path)?;
+        let mut data = crate::pipeline::closed_loop::read_data(&config, &path)?;
         let f = &config.factorization;
         if let Some(ch) = config.raw.channel {
             let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
@@ -83,6 +83,9 @@ impl InputArgs {
     pub fn envelope_only(&self) -> Result<Envelope> {
         let config = Config::load(&self.config)?;
         self.check_noise_radius()?;
+        if config.closed_loop.is_some() {
+            return Ok(self.envelope()?.1);
+        }
         let rows = FrfRows::open(&self.data_path(&config)?)?;
         let sec = &config.raw.noise;
         sec.validate()
@@ -121,6 +124,12 @@ impl InputArgs {
 pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope> {
     let f = &inputs.config.factorization;
     let data = &inputs.data;
+    if inputs.config.closed_loop.is_some() {
+        let radii = crate::pipeline::integration::noise_radii(&inputs.config, data, cli_noise)?;
+        let (env, _, _) =
+            crate::pipeline::closed_loop::envelope(&inputs.config, data, radii.as_deref())?;
+        return Ok(env);
+    }
     match noise_radii(cli_noise, Some(&inputs.config), data)? {
         Some(radii) if radii.iter().any(|r| *r > 0.0) => {
             if data.outputs() != 1 || data.inputs() != 1 {

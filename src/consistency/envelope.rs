@@ -19,6 +19,12 @@ pub enum EnvelopeMethod {
     Theorem4Mu,
     /// Read from a file.
     File,
+    /// Closed-loop data, noise-free: `σ̄(Δ̄)` of the perturbation the datum determines
+    /// (Crowder & de Callafon, Theorem 1 and Corollaries 1–2).
+    ClosedLoopTheorem1,
+    /// Closed-loop noisy SISO data: smallest `|V|` with `μ_Δs > 1` (Crowder & de Callafon,
+    /// Theorem 2, eqs. (15)–(18)).
+    ClosedLoopTheorem2,
 }
 
 /// Per-datum smallest consistent `|r|` and the A1 limit.

@@ -1,5 +1,6 @@
 //! Consistency of data with the perturbed factorization: per-datum envelopes and checks.
 pub mod check;
+pub mod closed_loop;
 pub mod envelope;
 pub mod noise_free;
 pub mod noisy;

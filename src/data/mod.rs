@@ -1,4 +1,5 @@
 //! Measured frequency-response data: the FRF set and its CSV reader; envelope CSV files.
+pub mod closed_loop;
 pub mod envelope_csv;
 pub mod frf;
 pub mod reader;

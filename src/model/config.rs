@@ -46,7 +46,7 @@ pub struct RationalEntry {
 }
 
 impl TfEntry {
-    fn to_tf(&self, what: &str) -> std::result::Result<TransferFunction, String> {
+    pub(crate) fn to_tf(&self, what: &str) -> std::result::Result<TransferFunction, String> {
         match self {
             TfEntry::Constant(k) if k.is_finite() => Ok(TransferFunction::gain(*k)),
             TfEntry::Constant(_) => Err(format!("{what}: coefficient is not finite")),
@@ -171,6 +171,12 @@ pub struct RawConfig {
     /// The noise model.
     #[serde(default)]
     pub noise: NoiseSection,
+    /// The closed-loop uncertainty model (Crowder & de Callafon), instead of `[model]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<super::closed_loop::ClosedLoopSection>,
+    /// The weight `V` of the closed-loop model (eq. (2)), the analogue of `[r]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v: Option<RSection>,
 }
 
 /// A loaded, validated config.
@@ -190,6 +196,9 @@ pub struct Config {
     pub physical: Option<super::physical::PhysicalModel>,
     /// The noise std file (resolved) and its factor.
     pub noise_std: Option<(PathBuf, f64)>,
+    /// The closed-loop model when the config has `[closed_loop]`; then `factorization` is
+    /// its open-loop equivalent and `r` holds the weight `V` of `[v]`.
+    pub closed_loop: Option<super::closed_loop::ClosedLoopModel>,
 }
 
 fn tf_rows(
@@ -245,7 +254,16 @@ impl Config {
                 None => err(msg),
             }
         })?;
+        let closed_loop = super::closed_loop::from_raw(&raw).map_err(err)?;
         let (factorization, physical) = match (&raw.model, &raw.physical) {
+            (None, None) if closed_loop.is_some() => (
+                closed_loop
+                    .as_ref()
+                    .map(|c| c.open_loop_factorization())
+                    .expect("checked")
+                    .map_err(err)?,
+                None,
+            ),
             (Some(m), None) => (Self::build_factorization(m).map_err(err)?, None),
             (None, Some(ph)) => {
                 ph.validate().map_err(err)?;
@@ -267,13 +285,17 @@ impl Config {
                 return Err(err("[channel] output and input are 1-based".into()));
             }
         }
-        let r = match &raw.r {
+        let r = match if closed_loop.is_some() {
+            &raw.v
+        } else {
+            &raw.r
+        } {
             Some(r) => {
                 let tf = TfEntry::Rational(RationalEntry {
                     num: r.num.clone(),
                     den: r.den.clone(),
                 })
-                .to_tf("[r]")
+                .to_tf(if closed_loop.is_some() { "[v]" } else { "[r]" })
                 .map_err(err)?;
                 Some(tf)
             }
@@ -306,6 +328,7 @@ impl Config {
             data,
             physical,
             noise_std,
+            closed_loop,
         })
     }
 

@@ -1,4 +1,5 @@
 //! Nominal models: coprime factorizations, the uncertainty bound `r`, and the TOML config.
+pub mod closed_loop;
 pub mod config;
 pub mod factorization;
 pub mod noise;

@@ -1,6 +1,7 @@
 //! The `rshape run` pipeline: envelope → check of the configured `r` → fit → certificate →
 //! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
 //! writes; neither prints.
+pub mod closed_loop;
 pub mod integration;
 pub mod outputs;
 
@@ -44,6 +45,8 @@ pub struct RunOutcome {
     pub warnings: Vec<String>,
     /// Time per stage.
     pub timings: Timings,
+    /// Per-datum closed-loop diagnostics (closed-loop configs only).
+    pub closed_loop: Option<crate::consistency::closed_loop::ClosedLoopReport>,
 }
 
 /// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
@@ -58,13 +61,17 @@ pub fn run(
     let mut timings = Timings::default();
     let f = &config.factorization;
     let radii = integration::noise_radii(config, data, noise_radius)?;
-    let (envelope, mut warnings) = timings.time("envelope", || {
-        integration::envelope(f, data, radii.as_deref())
+    let (envelope, mut warnings, closed_loop) = timings.time("envelope", || {
+        closed_loop::envelope(config, data, radii.as_deref())
     })?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
         let a1 = |w: f64| f.a1_limit(w);
-        integration::fit_r(&envelope, Some(&a1), order)
+        let a1: Option<&dyn Fn(f64) -> f64> = match closed_loop::a1_factorization(config) {
+            Some(_) => Some(&a1),
+            None => None,
+        };
+        integration::fit_r(&envelope, a1, order)
             .map_err(|e| crate::report::fmt::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {
@@ -72,7 +79,7 @@ pub fn run(
     }
     let mu = match (&radii, &config.r) {
         (Some(rad), Some(r)) => {
-            timings.time("mu", || match integration::mu_per_datum(f, data, rad, r) {
+            timings.time("mu", || match closed_loop::mu(config, data, rad, r) {
                 Some(Ok(v)) => Some(v),
                 Some(Err(e)) => {
                     warnings.push(format!("μ per datum failed: {e}"));
@@ -99,5 +106,6 @@ pub fn run(
         mu,
         warnings,
         timings,
+        closed_loop,
     })
 }

@@ -32,6 +32,8 @@ pub fn r_min_label(m: EnvelopeMethod) -> &'static str {
         EnvelopeMethod::Theorem3 => "smallest |r| per datum (Thm 3)",
         EnvelopeMethod::Theorem4Mu => "smallest |r| per datum, μ bisection (Thm 4)",
         EnvelopeMethod::File => "smallest |r| per datum",
+        EnvelopeMethod::ClosedLoopTheorem1 => "|Δ̄ᵢ| from the closed-loop datum (Thm 1, Cor. 1–2)",
+        EnvelopeMethod::ClosedLoopTheorem2 => "smallest |V| per datum, closed-loop μ (Thm 2)",
     }
 }
 
@@ -77,8 +79,8 @@ pub fn write_outputs(
 pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<(String, String)>> {
     let env = &out.envelope;
     let grid = dense_grid(&env.omega);
-    let f = &config.factorization;
-    let a1: Vec<f64> = grid.iter().map(|w| f.a1_limit(*w)).collect();
+    let a1: Option<Vec<f64>> = super::closed_loop::a1_factorization(config)
+        .map(|f| grid.iter().map(|w| f.a1_limit(*w)).collect());
     let failing: Vec<bool> = match &out.check {
         Some(c) => c.rows.iter().map(|r| !r.consistent).collect(),
         None => vec![false; env.len()],
@@ -95,7 +97,12 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         name
     };
     let mut svgs = Vec::new();
-    let title = format!("Smallest consistent |r| per datum vs |r(jω)| — {name}");
+    let cl = config.closed_loop.is_some();
+    let title = if cl {
+        format!("Closed loop: |Δ_V| per datum vs |V(jω)| — {name}")
+    } else {
+        format!("Smallest consistent |r| per datum vs |r(jω)| — {name}")
+    };
     svgs.push((
         "r_vs_delta.svg".to_string(),
         r_vs_delta_svg(&RVsDeltaInput {
@@ -107,11 +114,18 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
             r_configured: config.r.as_ref(),
             r_fitted: out.fit.as_ref().ok().map(|f| &f.r),
             grid: &grid,
-            a1_on_grid: Some(&a1),
+            a1_on_grid: a1.as_deref(),
         })?,
     ));
-    let model: Vec<_> = grid.iter().map(|w| f.plant(*w)).collect();
-    let title = format!("Bode: data vs nominal model — {name}");
+    let model: Vec<_> = grid
+        .iter()
+        .map(|w| super::closed_loop::nominal_response(config, *w))
+        .collect();
+    let title = if cl {
+        format!("Bode: closed-loop data vs nominal (I + P̂C̄)⁻¹P̂ — {name}")
+    } else {
+        format!("Bode: data vs nominal model — {name}")
+    };
     svgs.push((
         "bode.svg".to_string(),
         bode_svg(&BodeInput {
@@ -124,7 +138,11 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         })?,
     ));
     if let Some(mu) = &out.mu {
-        let title = format!("μ_Γ per datum, configured r (Fig. 8) — {name}");
+        let title = if cl {
+            format!("μ_Δs per datum, configured V (Thm 2) — {name}")
+        } else {
+            format!("μ_Γ per datum, configured r (Fig. 8) — {name}")
+        };
         svgs.push((
             "mu.svg".to_string(),
             mu_svg(&MuInput {

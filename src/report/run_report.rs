@@ -83,6 +83,26 @@ pub struct RunReport {
     pub files: Vec<String>,
     /// Milliseconds per stage, and their sum under `total`.
     pub timings_ms: BTreeMap<String, f64>,
+    /// Closed-loop fields (configs with `[closed_loop]`): there `r_min` is the smallest
+    /// `|V|` per datum and `r_configured`/`r_fitted` are the weight `V`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<ClosedLoopFields>,
+}
+
+/// The closed-loop part of `report.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ClosedLoopFields {
+    /// True when the experiment used the model's controller (`C̄ = C`, `M₁₁ = 0`).
+    pub same_controller: bool,
+    /// True when the nominal's factors are the trivial `(P̂, I)`.
+    pub trivial_plant_factors: bool,
+    /// True when the controller's factors are the trivial `(C, I)`.
+    pub trivial_controller_factors: bool,
+    /// Frequencies (rad/s) of data the experiment's loop makes uninformative.
+    pub uninformative_omegas: Vec<f64>,
+    /// Per datum: `σ̄(Δ̄)` at the measured `Φ`, the experiment's sensitivity, the flag and,
+    /// for noisy data, the Theorem 2 result (`v_min`, route, μ at `|V| = 0`).
+    pub data: Vec<crate::consistency::closed_loop::ClosedLoopDatum>,
 }
 
 fn finite(x: f64) -> Option<f64> {
@@ -151,6 +171,16 @@ impl RunReport {
                 let total: f64 = t.values().sum();
                 t.insert("total".into(), total);
                 t
+            },
+            closed_loop: match (&config.closed_loop, &out.closed_loop) {
+                (Some(m), Some(rep)) => Some(ClosedLoopFields {
+                    same_controller: m.same_controller,
+                    trivial_plant_factors: m.plant.trivial,
+                    trivial_controller_factors: m.controller.trivial,
+                    uninformative_omegas: rep.uninformative(),
+                    data: rep.data.clone(),
+                }),
+                _ => None,
             },
         }
     }
