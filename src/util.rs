@@ -21,26 +21,12 @@ pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
 }
 
 fn write_via_temp(path: &Path, contents: &[u8], sync: bool) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let io = |source| Error::Io {
+    let mut file = AtomicFile::create(path)?;
+    (file.out.write_all(contents)).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    tmp.write_all(contents).map_err(io)?;
-    if sync {
-        tmp.as_file().sync_all().map_err(io)?;
-    }
-    record(path);
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+    })?;
+    file.finish(sync)
 }
 
 /// A file written in pieces and published atomically: the bytes go to a temporary file in
@@ -80,12 +66,18 @@ impl AtomicFile {
 
     /// Flushes, syncs and renames the file to its final name.
     pub fn commit(self) -> Result<()> {
+        self.finish(true)
+    }
+
+    fn finish(self, sync: bool) -> Result<()> {
         let io = |source| Error::Io {
             path: self.path.clone(),
             source,
         };
         let tmp = self.out.into_inner().map_err(|e| io(e.into_error()))?;
-        tmp.as_file().sync_all().map_err(io)?;
+        if sync {
+            tmp.as_file().sync_all().map_err(io)?;
+        }
         record(&self.path);
         tmp.persist(&self.path).map_err(|e| io(e.error))?;
         Ok(())

@@ -20,6 +20,16 @@ fn write_inputs(dir: &Path, n: usize) {
     std::fs::write(dir.join("m.toml"), cfg).unwrap();
 }
 
+fn envelope(dir: &Path, out: &Path) -> std::process::Output {
+    let cfg = dir.join("m.toml");
+    common::rshape(&[
+        "envelope",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+}
+
 fn temp_files(out: &Path) -> Vec<String> {
     std::fs::read_dir(out)
         .map(|r| {
@@ -80,12 +90,7 @@ fn sigkill_while_writing_leaves_no_truncated_file() {
     }
     assert!(caught_mid_write > 0, "never caught the run mid-write");
     // A complete run afterwards: whole file, every row.
-    let o = common::rshape(&[
-        "envelope",
-        dir.path().join("m.toml").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = envelope(dir.path(), &out);
     assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
     let env = rshape::data::read_envelope_csv(&out.join("envelope.csv")).unwrap();
     assert_eq!(env.len(), n);
@@ -106,12 +111,7 @@ fn rerun_clears_the_previous_runs_files_only() {
     std::fs::write(out.join("old_figure.svg"), "<svg/>").unwrap();
     std::fs::write(out.join("envelope.csv"), "stale").unwrap();
     std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let o = common::rshape(&[
-        "envelope",
-        dir.path().join("m.toml").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = envelope(dir.path(), &out);
     assert_eq!(o.status.code(), Some(0), "{}", common::stderr(&o));
     assert!(!out.join("old_figure.svg").exists(), "stale output kept");
     assert_eq!(
@@ -133,12 +133,7 @@ fn rerun_clears_the_previous_runs_files_only() {
         "../keep.txt\n/etc/hostname\n",
     )
     .unwrap();
-    let o = common::rshape(&[
-        "envelope",
-        dir.path().join("m.toml").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = envelope(dir.path(), &out);
     assert_eq!(o.status.code(), Some(0));
     assert!(dir.path().join("keep.txt").exists());
 }
