@@ -24,6 +24,7 @@ pub mod mu;
 pub mod pipeline;
 pub mod plot;
 pub mod report;
+pub mod stability;
 pub mod system;
 pub mod util;
 

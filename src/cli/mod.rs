@@ -22,6 +22,7 @@ pub mod fit;
 pub mod history;
 pub mod merge;
 pub mod run;
+pub mod stability;
 
 use clap::{Parser, Subcommand};
 
@@ -56,6 +57,8 @@ pub enum Command {
     History(history::HistoryArgs),
     /// Fit the smallest certified unit r(s) above the envelope (or an envelope file).
     Fit(fit::FitArgs),
+    /// Theorem 1: does a controller stabilize every plant of the set (margin with each r)?
+    Stability(stability::StabilityArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -87,6 +90,7 @@ pub fn main() -> i32 {
         Command::Diagnose(a) => diagnose::run(&a),
         Command::History(a) => history::run(&a),
         Command::Fit(a) => fit::run(&a),
+        Command::Stability(a) => stability::run(&a),
     };
     match result {
         Ok(code) => code,

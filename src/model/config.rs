@@ -162,6 +162,9 @@ pub struct RawConfig {
     /// The model described by its physics (alternative to `[model]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub physical: Option<super::physical::PhysicalModel>,
+    /// A plain plant whose normalized coprime factors are computed (alternative to `[model]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plant: Option<super::plant::PlantSection>,
     /// The SISO channel of the data to use.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub channel: Option<ChannelSection>,
@@ -255,7 +258,20 @@ impl Config {
             }
         })?;
         let closed_loop = super::closed_loop::from_raw(&raw).map_err(err)?;
+        let plant_factorization = match &raw.plant {
+            Some(_) if raw.model.is_some() || raw.physical.is_some() || closed_loop.is_some() => {
+                return Err(err(
+                    "give the model as one of [model], [physical], [plant] or [closed_loop], not several".into(),
+                ))
+            }
+            Some(pl) => Some(
+                pl.to_factorization(path.parent().unwrap_or(Path::new(".")))
+                    .map_err(err)?,
+            ),
+            None => None,
+        };
         let (factorization, physical) = match (&raw.model, &raw.physical) {
+            _ if plant_factorization.is_some() => (plant_factorization.expect("checked"), None),
             (None, None) if closed_loop.is_some() => (
                 closed_loop
                     .as_ref()
@@ -274,11 +290,10 @@ impl Config {
                     "give the model either as [model] (factors) or as [physical], not both".into(),
                 ))
             }
-            (None, None) => {
-                return Err(err(
-                    "no model: add a [model] table (factors) or a [physical] table".into(),
-                ))
-            }
+            (None, None) => return Err(err(
+                "no model: add a [model] table (factors), a [physical] table or a [plant] table"
+                    .into(),
+            )),
         };
         if let Some(ch) = &raw.channel {
             if ch.output == 0 || ch.input == 0 {

@@ -7,9 +7,11 @@
 //!   `Ñ` `n×p`, `J` diagonal `p×p`, `n ≥ p` (A3).
 
 use crate::error::{Error, Result};
+use crate::system::ncf::NormalizedLcf;
 use crate::system::{TfMatrix, TransferFunction};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
+use std::sync::Arc;
 
 /// Which factorization the model uses; it selects Theorem 2 or Theorem 3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -34,6 +36,10 @@ pub struct Factorization {
     pub n: TfMatrix,
     /// Diagonal of the input matrix `J` (`m` entries); all ones for the standard case.
     pub j: Vec<TransferFunction>,
+    /// State-space factors (normalized left coprime factorization of a `[plant]`). When
+    /// set, `M̃` and `Ñ` are evaluated from this realization, and `m`, `n` above are only
+    /// zero placeholders of the right sizes: always evaluate through [`Factorization::at`].
+    pub realization: Option<Arc<NormalizedLcf>>,
 }
 
 /// The factors evaluated at one frequency.
@@ -76,6 +82,7 @@ impl Factorization {
             m,
             n,
             j: vec![TransferFunction::gain(1.0); inputs],
+            realization: None,
         };
         f.check_proper()?;
         Ok(f)
@@ -131,9 +138,43 @@ impl Factorization {
             m,
             n,
             j,
+            realization: None,
         };
         f.check_proper()?;
         Ok(f)
+    }
+
+    /// The standard factorization by the normalized left coprime factors of a state-space
+    /// plant (`M̃M̃* + ÑÑ* = I`, see [`crate::system::ncf`]).
+    pub fn normalized(ncf: NormalizedLcf) -> Self {
+        let (p, m) = ncf.shape();
+        let zeros = |r: usize, c: usize| {
+            TfMatrix::from_rows(vec![vec![TransferFunction::gain(0.0); c]; r])
+                .expect("non-empty placeholder")
+        };
+        Self {
+            kind: FactorizationKind::Standard,
+            c: DMatrix::identity(p, p),
+            m: zeros(p, p),
+            n: zeros(p, m),
+            j: vec![TransferFunction::gain(1.0); m],
+            realization: Some(Arc::new(ncf)),
+        }
+    }
+
+    /// `M̃(jω)` and `Ñ(jω)` from whichever representation the factors have.
+    fn factor_values(&self, omega: f64) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
+        match &self.realization {
+            Some(ncf) => ncf.at(omega).unwrap_or_else(|| {
+                let (p, m) = ncf.shape();
+                let nan = Complex64::new(f64::NAN, f64::NAN);
+                (
+                    DMatrix::from_element(p, p, nan),
+                    DMatrix::from_element(p, m, nan),
+                )
+            }),
+            None => (self.m.freq(omega), self.n.freq(omega)),
+        }
     }
 
     fn check_proper(&self) -> Result<()> {
@@ -171,10 +212,11 @@ impl Factorization {
 
     /// The factors at `s = jω`.
     pub fn at(&self, omega: f64) -> FactorsAt {
+        let (m, n) = self.factor_values(omega);
         FactorsAt::new(
             self.c.map(|x| Complex64::new(x, 0.0)),
-            self.m.freq(omega),
-            self.n.freq(omega),
+            m,
+            n,
             self.j.iter().map(|t| t.freq(omega)).collect(),
         )
     }
@@ -187,7 +229,7 @@ impl Factorization {
 
     /// `σ_min(M̃(jω))`, the A1 limit on `|r(jω)|`.
     pub fn a1_limit(&self, omega: f64) -> f64 {
-        sigma_min(&self.m.freq(omega))
+        sigma_min(&self.factor_values(omega).0)
     }
 }
 

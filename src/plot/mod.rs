@@ -11,6 +11,7 @@
 pub mod bode;
 pub mod mu;
 pub mod r_vs_delta;
+pub mod stability;
 pub mod style;
 
 pub use bode::{bode_svg, BodeInput};

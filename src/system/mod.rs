@@ -1,7 +1,14 @@
 //! Linear time-invariant systems: polynomials, transfer functions, transfer-function
 //! matrices and state-space models, all evaluated on the imaginary axis.
+pub mod eig;
+pub mod freq_eval;
+pub mod hinf;
+pub mod interconnect;
 pub mod linalg;
+pub mod ncf;
 pub mod polynomial;
+pub mod realization;
+pub mod riccati;
 pub mod state_space;
 pub mod tf_matrix;
 pub mod transfer_function;

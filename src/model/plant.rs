@@ -1,0 +1,203 @@
+//! The `[plant]` table: a plain plant whose normalized left coprime factors rshape computes
+//! (see [`crate::system::ncf`] for the formulas and why this normalization is canonical).
+//!
+//! ```toml
+//! [plant]                       # one of the three forms:
+//! tf = [[{ num = [1], den = [1, 0.2, 4] }, 0.5]]   # a transfer-function matrix, or
+//! # a = [[0, 1], [-4, -0.2]]    # inline state space (rows), with b, c, d, or
+//! # b = [[0], [1]]
+//! # c = [[1, 0]]
+//! # d = [[0]]
+//! # file = "model.json"         # JSON {"A": [[..]], "B": .., "C": .., "D": ..}
+//! # reduce_order = 20           # optional: balanced truncation of a stable plant first
+//! ```
+
+use super::config::TfEntry;
+use super::factorization::Factorization;
+use crate::system::ncf::NormalizedLcf;
+use crate::system::{StateSpace, TfMatrix};
+use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The `[plant]` table.
+#[derive(Debug, Clone, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantSection {
+    /// Transfer-function matrix, rows of entries (same syntax as `[model]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tf: Option<Vec<Vec<TfEntry>>>,
+    /// State matrix `A`, rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub a: Option<Vec<Vec<f64>>>,
+    /// Input matrix `B`, rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub b: Option<Vec<Vec<f64>>>,
+    /// Output matrix `C`, rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub c: Option<Vec<Vec<f64>>>,
+    /// Feedthrough `D`, rows (default zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub d: Option<Vec<Vec<f64>>>,
+    /// A JSON file with keys `A`, `B`, `C`, `D` (row-major lists), relative to the config.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Reduce a stable plant to this many states by balanced truncation before factoring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reduce_order: Option<usize>,
+}
+
+/// The JSON state-space file (`../shared/data/slicot-*/model.json`).
+#[derive(Debug, Deserialize)]
+#[allow(non_snake_case)]
+struct SsFile {
+    A: Vec<Vec<f64>>,
+    B: Vec<Vec<f64>>,
+    C: Vec<Vec<f64>>,
+    #[serde(default)]
+    D: Option<Vec<Vec<f64>>>,
+}
+
+/// A dense matrix from rows; `cols_if_empty` sizes an empty list.
+pub(crate) fn matrix(
+    rows: &[Vec<f64>],
+    name: &str,
+    cols_if_empty: usize,
+) -> std::result::Result<DMatrix<f64>, String> {
+    if rows.is_empty() {
+        return Ok(DMatrix::zeros(0, cols_if_empty));
+    }
+    let cols = rows[0].len();
+    if let Some(i) = rows.iter().position(|r| r.len() != cols) {
+        return Err(format!(
+            "{name}: row {} has {} entries, row 1 has {cols}",
+            i + 1,
+            rows[i].len()
+        ));
+    }
+    Ok(DMatrix::from_fn(rows.len(), cols, |i, j| rows[i][j]))
+}
+
+/// `A, B, C, D` from rows; `D` defaults to zero.
+pub(crate) fn state_space(
+    a: &[Vec<f64>],
+    b: &[Vec<f64>],
+    c: &[Vec<f64>],
+    d: Option<&[Vec<f64>]>,
+    what: &str,
+) -> std::result::Result<StateSpace, String> {
+    let a = matrix(a, &format!("{what} a"), 0)?;
+    let b = matrix(b, &format!("{what} b"), 0)?;
+    let c = matrix(c, &format!("{what} c"), a.nrows())?;
+    let d = match d {
+        Some(d) => matrix(d, &format!("{what} d"), b.ncols())?,
+        None => DMatrix::zeros(c.nrows(), b.ncols()),
+    };
+    let ss = StateSpace { a, b, c, d };
+    ss.validate(what).map_err(|e| e.to_string())?;
+    Ok(ss)
+}
+
+impl PlantSection {
+    /// The plant as a state-space model (`base` resolves `file`).
+    pub fn state_space(&self, base: &Path) -> std::result::Result<StateSpace, String> {
+        let inline = self.a.is_some() || self.b.is_some() || self.c.is_some() || self.d.is_some();
+        let forms = [self.tf.is_some(), inline, self.file.is_some()];
+        if forms.iter().filter(|f| **f).count() != 1 {
+            return Err(
+                "[plant]: give exactly one of tf = [[...]], a/b/c/d, or file = \"model.json\""
+                    .into(),
+            );
+        }
+        let ss = if let Some(rows) = &self.tf {
+            let cols = rows.first().map_or(0, |r| r.len());
+            if cols == 0 {
+                return Err("[plant] tf is empty".into());
+            }
+            let mut tfs = Vec::with_capacity(rows.len());
+            for (i, row) in rows.iter().enumerate() {
+                if row.len() != cols {
+                    return Err(format!(
+                        "[plant] tf: row {} has {} entries, row 1 has {cols}",
+                        i + 1,
+                        row.len()
+                    ));
+                }
+                let r: std::result::Result<Vec<_>, String> = row
+                    .iter()
+                    .enumerate()
+                    .map(|(j, e)| e.to_tf(&format!("[plant] tf[{}][{}]", i + 1, j + 1)))
+                    .collect();
+                tfs.push(r?);
+            }
+            for (k, t) in tfs.iter().flatten().enumerate() {
+                if !t.is_proper() {
+                    return Err(format!(
+                        "[plant] tf[{}][{}] is improper (deg num > deg den); a plant must be proper",
+                        k / cols + 1,
+                        k % cols + 1
+                    ));
+                }
+            }
+            let g = TfMatrix::from_rows(tfs).ok_or("[plant] tf is not rectangular")?;
+            StateSpace::from_tf_matrix(&g).minimal(1e-10)
+        } else if inline {
+            match (&self.a, &self.b, &self.c, &self.d) {
+                (Some(a), Some(b), Some(c), d) => state_space(a, b, c, d.as_deref(), "[plant]")?,
+                // A static gain: d alone.
+                (None, None, None, Some(d)) => {
+                    let d = matrix(d, "[plant] d", 0)?;
+                    let ss = StateSpace {
+                        a: DMatrix::zeros(0, 0),
+                        b: DMatrix::zeros(0, d.ncols()),
+                        c: DMatrix::zeros(d.nrows(), 0),
+                        d,
+                    };
+                    ss.validate("[plant]").map_err(|e| e.to_string())?;
+                    ss
+                }
+                _ => {
+                    return Err(
+                        "[plant]: a state space needs a, b and c (d defaults to zero), or d alone for a static gain"
+                            .into(),
+                    )
+                }
+            }
+        } else {
+            let path = base.join(self.file.as_ref().expect("checked"));
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| format!("[plant] file {}: {e}", path.display()))?;
+            let f: SsFile = serde_json::from_str(&text).map_err(|e| {
+                format!(
+                    "[plant] file {}: {e}; expected {{\"A\": [[..]], \"B\": [[..]], \"C\": [[..]], \"D\": [[..]]}}",
+                    path.display()
+                )
+            })?;
+            state_space(
+                &f.A,
+                &f.B,
+                &f.C,
+                f.D.as_deref(),
+                &format!("[plant] file {}", path.display()),
+            )?
+        };
+        match self.reduce_order {
+            Some(k) if k < ss.states() => ss
+                .balanced_truncation(k)
+                .map(|(r, _)| r)
+                .map_err(|e| format!("[plant] reduce_order = {k}: {e}")),
+            Some(k) if k > ss.states() => Err(format!(
+                "[plant] reduce_order = {k} exceeds the {} states of the plant",
+                ss.states()
+            )),
+            _ => Ok(ss),
+        }
+    }
+
+    /// The standard factorization by the normalized left coprime factors of the plant.
+    pub fn to_factorization(&self, base: &Path) -> std::result::Result<Factorization, String> {
+        let ss = self.state_space(base)?;
+        let ncf = NormalizedLcf::new(ss).map_err(|e| format!("[plant]: {e}"))?;
+        Ok(Factorization::normalized(ncf))
+    }
+}

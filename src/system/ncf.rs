@@ -1,0 +1,135 @@
+//! The normalized left coprime factorization `G = M̃⁻¹Ñ`, `M̃M̃* + ÑÑ* = I`, of a
+//! state-space plant (McFarlane & Glover 1990; Zhou, Doyle & Glover, *Robust and Optimal
+//! Control*, Thm 13.37).
+//!
+//! With `R = I + DᵀD`, `R̃ = I + DDᵀ` and `Y ≥ 0` the stabilizing solution of the **filter
+//! Riccati equation**
+//!
+//! `(A − BDᵀR̃⁻¹C)Y + Y(A − BDᵀR̃⁻¹C)ᵀ − YCᵀR̃⁻¹CY + BR⁻¹Bᵀ = 0`,
+//!
+//! the output injection `L = −(BDᵀ + YCᵀ)R̃⁻¹` makes `A + LC` Hurwitz and
+//!
+//! `[Ñ  M̃] = [A + LC | B + LD   L ; R̃^(−1/2)C | R̃^(−1/2)D   R̃^(−1/2)]`.
+//!
+//! The normalization is canonical: it is unique up to a constant unitary left factor, it
+//! needs no choice from the user, `[Ñ M̃]` is co-inner so the Theorem 1 margin with a
+//! constant `r` is exactly the normalized-coprime-factor stability margin `b(G, K)`
+//! divided by `|r|`, and the factors exist for unstable plants (rigid-body modes,
+//! integrators) as long as `(A, C)` is detectable and `(A, B)` has no uncontrollable mode
+//! on the imaginary axis.
+
+use super::freq_eval::FreqEvaluator;
+use super::riccati::{care, CareSolution};
+use super::state_space::StateSpace;
+use crate::error::{Error, Result};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// A plant with its normalized left coprime factors in state space.
+#[derive(Debug, Clone)]
+pub struct NormalizedLcf {
+    /// The plant `G = (A, B, C, D)`.
+    pub plant: StateSpace,
+    /// The output injection `L`.
+    pub l: DMatrix<f64>,
+    /// `R̃^(1/2)`, `R̃ = I + DDᵀ`.
+    pub r_half: DMatrix<f64>,
+    /// `[Ñ M̃]` as one state-space system (`p × (m + p)`).
+    pub factors: StateSpace,
+    /// The Riccati solution with its residual and closed-loop abscissa.
+    pub riccati: CareSolution,
+    eval: FreqEvaluator,
+}
+
+/// `P^(±1/2)` of a symmetric positive definite matrix by its eigen-decomposition.
+fn spd_power(p: &DMatrix<f64>, power: f64) -> DMatrix<f64> {
+    let eig = nalgebra::linalg::SymmetricEigen::new((p + p.transpose()) * 0.5);
+    let d = DMatrix::from_diagonal(&eig.eigenvalues.map(|l| l.powf(power)));
+    &eig.eigenvectors * d * eig.eigenvectors.transpose()
+}
+
+impl NormalizedLcf {
+    /// Computes the factors; fails with a one-line error when the filter Riccati equation
+    /// has no stabilizing solution (an unstable mode that the output does not see, or a
+    /// mode on the imaginary axis that the input does not reach).
+    pub fn new(plant: StateSpace) -> Result<Self> {
+        plant.validate("plant")?;
+        let (p, m) = plant.d.shape();
+        let (a, b, c, d) = (&plant.a, &plant.b, &plant.c, &plant.d);
+        let rt = DMatrix::<f64>::identity(p, p) + d * d.transpose();
+        let r = DMatrix::<f64>::identity(m, m) + d.transpose() * d;
+        let rt_inv = spd_power(&rt, -1.0);
+        let r_inv = spd_power(&r, -1.0);
+        let abar = a - b * d.transpose() * &rt_inv * c;
+        // Filter equation in the CARE form AᵀX + XA − XGX + Q = 0 with A := Āᵀ.
+        let g = c.transpose() * &rt_inv * c;
+        let q = b * &r_inv * b.transpose();
+        let riccati = care(&abar.transpose(), &g, &q, "filter Riccati equation of the plant")
+            .map_err(|e| match e {
+                Error::Invalid(msg) => Error::Invalid(format!(
+                    "{msg}; normalized coprime factors need (A, C) detectable and no uncontrollable mode of (A, B) on the imaginary axis"
+                )),
+                other => other,
+            })?;
+        let y = &riccati.x;
+        let l = -(b * d.transpose() + y * c.transpose()) * &rt_inv;
+        let rt_mhalf = spd_power(&rt, -0.5);
+        let n = a.nrows();
+        let mut fb = DMatrix::zeros(n, m + p);
+        fb.view_mut((0, 0), (n, m)).copy_from(&(b + &l * d));
+        fb.view_mut((0, m), (n, p)).copy_from(&l);
+        let mut fd = DMatrix::zeros(p, m + p);
+        fd.view_mut((0, 0), (p, m)).copy_from(&(&rt_mhalf * d));
+        fd.view_mut((0, m), (p, p)).copy_from(&rt_mhalf);
+        let factors = StateSpace {
+            a: a + &l * c,
+            b: fb,
+            c: &rt_mhalf * c,
+            d: fd,
+        };
+        let eval = FreqEvaluator::new(&factors);
+        Ok(Self {
+            r_half: spd_power(&rt, 0.5),
+            plant,
+            l,
+            factors,
+            riccati,
+            eval,
+        })
+    }
+
+    /// Outputs `p` and inputs `m` of the plant.
+    pub fn shape(&self) -> (usize, usize) {
+        self.plant.d.shape()
+    }
+
+    /// `(M̃(jω), Ñ(jω))`; `None` only on a numerical breakdown (the factors are stable).
+    pub fn at(&self, omega: f64) -> Option<(DMatrix<Complex64>, DMatrix<Complex64>)> {
+        let (p, m) = self.shape();
+        let f = self.eval.freq(omega)?;
+        Some((
+            f.view((0, m), (p, p)).into_owned(),
+            f.view((0, 0), (p, m)).into_owned(),
+        ))
+    }
+
+    /// A realization of `[G  M̃⁻¹]` sharing the plant's states: `M̃⁻¹ = (A, −L·R̃^(1/2),
+    /// C, R̃^(1/2))`, the system seen by the perturbation in Theorem 1.
+    pub fn plant_and_m_inverse(&self) -> StateSpace {
+        let (p, m) = self.shape();
+        let n = self.plant.states();
+        let mut b = DMatrix::zeros(n, m + p);
+        b.view_mut((0, 0), (n, m)).copy_from(&self.plant.b);
+        b.view_mut((0, m), (n, p))
+            .copy_from(&(-(&self.l * &self.r_half)));
+        let mut d = DMatrix::zeros(p, m + p);
+        d.view_mut((0, 0), (p, m)).copy_from(&self.plant.d);
+        d.view_mut((0, m), (p, p)).copy_from(&self.r_half);
+        StateSpace {
+            a: self.plant.a.clone(),
+            b,
+            c: self.plant.c.clone(),
+            d,
+        }
+    }
+}

@@ -1,0 +1,315 @@
+//! Continuous-time algebraic Riccati and Lyapunov equations.
+//!
+//! `AᵀX + XA − XGX + Q = 0` (G, Q symmetric positive semidefinite) is solved for its
+//! **stabilizing** solution (A − GX Hurwitz) by the matrix sign function of the Hamiltonian
+//! `H = [A  −G; −Q  −Aᵀ]` (Roberts 1971; determinant scaling of Byers 1987): the stable
+//! invariant subspace is the null space of `sign(H) + I`, and `X` solves the overdetermined
+//! system `[W₁₂; W₂₂ + I]·X = −[W₁₁ + I; W₂₁]` (by QR). The solution is then refined by
+//! Newton–Kleinman steps (Kleinman 1968), each a Lyapunov equation solved again by the sign
+//! function. Every iteration is capped; the residual and the stabilizing property are checked
+//! after the fact, and a failure is an error, never a silent wrong solution.
+
+use super::eig::{eigenvalues, spectral_abscissa};
+use crate::error::{Error, Result};
+use nalgebra::DMatrix;
+
+/// Cap on sign-function (Newton) iterations.
+const MAX_SIGN_ITER: usize = 100;
+/// Cap on Newton–Kleinman refinement steps.
+const MAX_NEWTON_STEPS: usize = 6;
+/// Largest accepted relative residual.
+const RESIDUAL_TOL: f64 = 1e-8;
+
+/// The stabilizing solution of a Riccati equation with its checks.
+#[derive(Debug, Clone)]
+pub struct CareSolution {
+    /// The solution `X` (symmetric).
+    pub x: DMatrix<f64>,
+    /// Relative residual `‖AᵀX + XA − XGX + Q‖_F / (2‖A‖‖X‖ + ‖G‖‖X‖² + ‖Q‖)`.
+    pub residual: f64,
+    /// Spectral abscissa of `A − GX` (negative: the solution is stabilizing).
+    pub abscissa: f64,
+    /// Sign-function iterations used.
+    pub sign_iterations: usize,
+    /// Newton–Kleinman refinement steps used.
+    pub newton_steps: usize,
+}
+
+fn fro(a: &DMatrix<f64>) -> f64 {
+    a.norm()
+}
+
+fn one_norm(a: &DMatrix<f64>) -> f64 {
+    a.column_iter()
+        .map(|c| c.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
+/// Riccati residual `AᵀX + XA − XGX + Q`.
+pub fn care_residual(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+) -> DMatrix<f64> {
+    let ax = a.transpose() * x;
+    &ax + ax.transpose() - x * g * x + q
+}
+
+fn relative_residual(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    x: &DMatrix<f64>,
+) -> f64 {
+    let xn = fro(x);
+    let scale = 2.0 * fro(a) * xn + fro(g) * xn * xn + fro(q);
+    fro(&care_residual(a, g, q, x)) / scale.max(f64::MIN_POSITIVE)
+}
+
+/// Matrix sign function by the scaled Newton iteration `Z ← (cZ + (cZ)⁻¹)/2`,
+/// `c = |det Z|^(−1/n)` while far from convergence. Errors when `Z` becomes singular
+/// (eigenvalues on the imaginary axis) or the cap is reached.
+fn sign(z0: DMatrix<f64>, what: &str) -> Result<(DMatrix<f64>, usize)> {
+    let n = z0.nrows() as f64;
+    let mut z = z0;
+    let mut scaling = true;
+    for k in 1..=MAX_SIGN_ITER {
+        let lu = z.clone().lu();
+        let logdet: f64 = lu.u().diagonal().iter().map(|u| u.abs().ln()).sum();
+        let zinv = lu.try_inverse().filter(|m| m.iter().all(|v| v.is_finite()));
+        let Some(zinv) = zinv else {
+            return Err(Error::Invalid(format!(
+                "{what}: the Hamiltonian has eigenvalues on the imaginary axis (singular in the sign iteration): no stabilizing solution"
+            )));
+        };
+        let c = if scaling && logdet.is_finite() {
+            (-logdet / n).exp()
+        } else {
+            1.0
+        };
+        let next = (&z * c + zinv / c) * 0.5;
+        let change = one_norm(&(&next - &z)) / one_norm(&next).max(f64::MIN_POSITIVE);
+        z = next;
+        if change < 1e-2 {
+            scaling = false;
+        }
+        if change < 1e-13 {
+            return Ok((z, k));
+        }
+        if !change.is_finite() {
+            break;
+        }
+    }
+    Err(Error::Invalid(format!(
+        "{what}: the sign iteration did not converge in {MAX_SIGN_ITER} steps (eigenvalues on or near the imaginary axis): no stabilizing solution"
+    )))
+}
+
+/// Solves the Lyapunov equation `FᵀX + XF + Q = 0` for Hurwitz `F` by the sign function of
+/// `[Fᵀ  Q; 0  −F]`, whose (1,2) block converges to `2X`.
+pub fn lyapunov(f: &DMatrix<f64>, q: &DMatrix<f64>, what: &str) -> Result<DMatrix<f64>> {
+    let n = f.nrows() as f64;
+    let (mut fk, mut qk) = (f.clone(), q.clone());
+    let mut scaling = true;
+    for _ in 0..MAX_SIGN_ITER {
+        let lu = fk.clone().lu();
+        let logdet: f64 = lu.u().diagonal().iter().map(|u| u.abs().ln()).sum();
+        let Some(finv) = lu.try_inverse().filter(|m| m.iter().all(|v| v.is_finite())) else {
+            return Err(Error::Invalid(format!(
+                "{what}: Lyapunov equation with a singular state matrix"
+            )));
+        };
+        let c = if scaling && logdet.is_finite() {
+            (-logdet / n).exp()
+        } else {
+            1.0
+        };
+        let fnext = (&fk * c + &finv / c) * 0.5;
+        let qnext = (&qk * c + finv.transpose() * &qk * &finv / c) * 0.5;
+        let change = one_norm(&(&fnext - &fk)) / one_norm(&fnext).max(f64::MIN_POSITIVE);
+        fk = fnext;
+        qk = qnext;
+        if change < 1e-2 {
+            scaling = false;
+        }
+        if change < 1e-13 {
+            // sign(F) = −I exactly when F is Hurwitz.
+            let id = DMatrix::<f64>::identity(f.nrows(), f.nrows());
+            if one_norm(&(&fk + id)) > 1e-6 {
+                return Err(Error::Invalid(format!(
+                    "{what}: the Lyapunov state matrix is not Hurwitz"
+                )));
+            }
+            let x = qk * 0.5;
+            return Ok((&x + x.transpose()) * 0.5);
+        }
+    }
+    Err(Error::Invalid(format!(
+        "{what}: the Lyapunov sign iteration did not converge in {MAX_SIGN_ITER} steps"
+    )))
+}
+
+/// The stabilizing solution of `AᵀX + XA − XGX + Q = 0`; `what` names the equation in
+/// error messages.
+pub fn care(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    what: &str,
+) -> Result<CareSolution> {
+    let n = a.nrows();
+    if a.ncols() != n || g.shape() != (n, n) || q.shape() != (n, n) {
+        return Err(Error::Invalid(format!("{what}: A, G, Q must be {n}×{n}")));
+    }
+    if a.iter()
+        .chain(g.iter())
+        .chain(q.iter())
+        .any(|v| !v.is_finite())
+    {
+        return Err(Error::Invalid(format!(
+            "{what}: a coefficient is not finite"
+        )));
+    }
+    if n == 0 {
+        return Ok(CareSolution {
+            x: DMatrix::zeros(0, 0),
+            residual: 0.0,
+            abscissa: f64::NEG_INFINITY,
+            sign_iterations: 0,
+            newton_steps: 0,
+        });
+    }
+    let mut h = DMatrix::zeros(2 * n, 2 * n);
+    h.view_mut((0, 0), (n, n)).copy_from(a);
+    h.view_mut((0, n), (n, n)).copy_from(&(-g));
+    h.view_mut((n, 0), (n, n)).copy_from(&(-q));
+    h.view_mut((n, n), (n, n)).copy_from(&(-a.transpose()));
+    let (w, sign_iterations) = sign(h, what)?;
+    // [W12; W22 + I] X = −[W11 + I; W21]
+    let mut lhs = DMatrix::zeros(2 * n, n);
+    let mut rhs = DMatrix::zeros(2 * n, n);
+    lhs.view_mut((0, 0), (n, n))
+        .copy_from(&w.view((0, n), (n, n)));
+    lhs.view_mut((n, 0), (n, n))
+        .copy_from(&w.view((n, n), (n, n)));
+    rhs.view_mut((0, 0), (n, n))
+        .copy_from(&w.view((0, 0), (n, n)));
+    rhs.view_mut((n, 0), (n, n))
+        .copy_from(&w.view((n, 0), (n, n)));
+    for i in 0..n {
+        lhs[(n + i, i)] += 1.0;
+        rhs[(i, i)] += 1.0;
+    }
+    let qr = lhs.qr();
+    let qt_rhs = qr.q().transpose() * (-rhs);
+    let r = qr.r();
+    let rmax = r.diagonal().iter().map(|v| v.abs()).fold(0.0, f64::max);
+    let rmin = r
+        .diagonal()
+        .iter()
+        .map(|v| v.abs())
+        .fold(f64::INFINITY, f64::min);
+    if rmin.is_nan() || rmin <= 1e-13 * rmax {
+        return Err(Error::Invalid(format!(
+            "{what}: the stable invariant subspace of the Hamiltonian is not a graph (an unstable mode is unobservable or uncontrollable): no stabilizing solution"
+        )));
+    }
+    let mut x = r.solve_upper_triangular(&qt_rhs).ok_or_else(|| {
+        Error::Invalid(format!(
+            "{what}: singular subspace basis: no stabilizing solution"
+        ))
+    })?;
+    x = (&x + x.transpose()) * 0.5;
+    let mut residual = relative_residual(a, g, q, &x);
+    let mut newton_steps = 0;
+    while residual > 1e-15 && newton_steps < MAX_NEWTON_STEPS {
+        let ac = a - g * &x;
+        let res = care_residual(a, g, q, &x);
+        let Ok(dx) = lyapunov(&ac, &res, what) else {
+            break;
+        };
+        let cand = &x + dx;
+        let cand = (&cand + cand.transpose()) * 0.5;
+        let r2 = relative_residual(a, g, q, &cand);
+        if r2.is_nan() || r2 >= residual {
+            break;
+        }
+        newton_steps += 1;
+        let gain = residual / r2;
+        x = cand;
+        residual = r2;
+        if gain < 2.0 {
+            break;
+        }
+    }
+    if residual.is_nan() || residual >= RESIDUAL_TOL {
+        return Err(Error::Invalid(format!(
+            "{what}: relative residual {residual:.1e} after refinement (above {RESIDUAL_TOL:.0e}): the equation is too ill-conditioned or has no stabilizing solution"
+        )));
+    }
+    let abscissa = spectral_abscissa(&eigenvalues(&(a - g * &x), what)?);
+    if abscissa.is_nan() || abscissa >= 0.0 {
+        return Err(Error::Invalid(format!(
+            "{what}: the solution is not stabilizing (closed-loop eigenvalue with real part {abscissa:.3e}): an unstable mode is unobservable or uncontrollable"
+        )));
+    }
+    Ok(CareSolution {
+        x,
+        residual,
+        abscissa,
+        sign_iterations,
+        newton_steps,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scalar_closed_form() {
+        // a x·2 − g x² + q = 0 → x = (a + √(a² + g q))/g
+        for (a, g, q) in [(1.0, 1.0, 1.0), (-2.0, 0.5, 3.0), (5.0, 2.0, 0.0)] {
+            let s = care(
+                &DMatrix::from_element(1, 1, a),
+                &DMatrix::from_element(1, 1, g),
+                &DMatrix::from_element(1, 1, q),
+                "t",
+            )
+            .unwrap();
+            let x = (a + (a * a + g * q).sqrt()) / g;
+            assert!(
+                (s.x[(0, 0)] - x).abs() < 1e-12 * x.max(1.0),
+                "{} vs {x}",
+                s.x
+            );
+            assert!(s.abscissa < 0.0);
+        }
+    }
+
+    #[test]
+    fn lyapunov_scalar_and_matrix() {
+        let f = DMatrix::from_row_slice(2, 2, &[-1.0, 2.0, 0.0, -3.0]);
+        let q = DMatrix::from_row_slice(2, 2, &[2.0, 1.0, 1.0, 4.0]);
+        let x = lyapunov(&f, &q, "t").unwrap();
+        let r = f.transpose() * &x + &x * &f + &q;
+        assert!(r.norm() < 1e-12);
+        let unstable = DMatrix::from_row_slice(1, 1, &[1.0]);
+        assert!(lyapunov(&unstable, &DMatrix::identity(1, 1), "t").is_err());
+    }
+
+    #[test]
+    fn unobservable_unstable_mode_has_no_stabilizing_solution() {
+        // A = diag(1, -1), G = e2 e2ᵀ: the unstable mode is not reached by G.
+        let a = DMatrix::from_row_slice(2, 2, &[1.0, 0.0, 0.0, -1.0]);
+        let g = DMatrix::from_row_slice(2, 2, &[0.0, 0.0, 0.0, 1.0]);
+        let q = DMatrix::identity(2, 2);
+        let e = care(&a, &g, &q, "filter Riccati equation").unwrap_err();
+        assert!(
+            e.to_string().contains("no stabilizing solution")
+                || e.to_string().contains("not stabilizing"),
+            "{e}"
+        );
+    }
+}
