@@ -19,7 +19,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Order of the fitted r, or `auto` (sweep 0..8 and pick the smallest good order).
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: crate::fit::OrderChoice,
 }
 
@@ -66,6 +66,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     let (w, wmin) = (sym.weight, sym.weight_min);
     let mut out = pipeline::run(config, data, a.input.noise_radius, a.order)?;
     out.timings.0.insert("load".into(), load_ms);
+    let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;
     let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;
 
     let name = rep

@@ -35,8 +35,16 @@ pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
     }
     let mut bands: Vec<(f64, f64, usize)> = Vec::new();
     let mut prev_idx: Option<usize> = None;
+    // Both lists are sorted: one forward walk finds every index (linear, not quadratic).
+    let mut cursor = 0;
     for w in flagged {
-        let idx = all.iter().position(|x| x == w);
+        let idx = all[cursor..]
+            .iter()
+            .position(|x| x == w)
+            .map(|k| cursor + k);
+        if let Some(i) = idx {
+            cursor = i + 1;
+        }
         match (bands.last_mut(), prev_idx, idx) {
             (Some(b), Some(p), Some(i)) if i == p + 1 => {
                 b.1 = *w;
