@@ -181,9 +181,7 @@ pub fn care(
     h.view_mut((0, n), (n, n)).copy_from(&(-g));
     h.view_mut((n, 0), (n, n)).copy_from(&(-q));
     h.view_mut((n, n), (n, n)).copy_from(&(-a.transpose()));
-    let t0 = std::time::Instant::now();
     let (w, sign_iterations) = sign(h, what)?;
-    eprintln!("PROF sign {:?} it {}", t0.elapsed(), sign_iterations);
     // [W12; W22 + I] X = −[W11 + I; W21]
     let mut lhs = DMatrix::zeros(2 * n, n);
     let mut rhs = DMatrix::zeros(2 * n, n);
