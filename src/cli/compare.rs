@@ -1,6 +1,7 @@
 //! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
 
 use super::common::{fmt_g, InputArgs};
+use crate::diagnose::agreement::data_vs_data;
 use crate::diagnose::compare::{compare, prepare, Band, CompareReport, PlantModel};
 use crate::diagnose::figures::bode_overlay;
 use anyhow::{anyhow, Result};
@@ -19,6 +20,11 @@ pub struct CompareArgs {
     /// Write the Bode overlay (data and model) to this SVG file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Also test the data against a second experiment (data-vs-data consistency: do the
+    /// two noise disks intersect at the common frequencies?); its noise comes from the
+    /// config's rules (a `<stem>_std.csv` beside it, a noise_radius column, --noise-radius).
+    #[arg(long)]
+    pub against: Option<PathBuf>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -100,8 +106,26 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         )?;
         rep.figure = Some(path.display().to_string());
     }
+    let agreement = match &a.against {
+        Some(p) => {
+            let inputs = a.input.load()?;
+            let other = crate::data::read_frf_csv(p)?;
+            let sb = prepare(
+                &inputs.config,
+                &other,
+                Some(siso.channel),
+                a.input.noise_radius,
+            )?;
+            Some(data_vs_data(&siso, &sb)?)
+        }
+        None => None,
+    };
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rep)?);
+        let mut v = serde_json::to_value(&rep)?;
+        if let Some(ag) = &agreement {
+            v["against"] = serde_json::to_value(ag)?;
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(0);
     }
     println!("model:  {}", rep.config);
@@ -152,6 +176,22 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     );
     if let Some(f) = &rep.figure {
         println!("figure: {f}");
+    }
+    if let Some(ag) = &agreement {
+        println!(
+            "data vs data: {} against {} at {} common frequencies: distance_rms = {} (|G_a − G_b|/(r_a + r_b)), disagree at {} ({}){}",
+            rep.data,
+            ag.against,
+            ag.n_common,
+            fmt_g(ag.distance_rms),
+            crate::report::fmt::fmt_pct(ag.disagree_fraction),
+            fmt_bands(&ag.bands),
+            if ag.verdict == "agree" {
+                ": the two experiments agree within their noise"
+            } else {
+                ": the two experiments disagree by more than their noise, so no model can reach the noise on both"
+            }
+        );
     }
     Ok(0)
 }

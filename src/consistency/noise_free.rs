@@ -47,8 +47,11 @@ fn singular(a: &DMatrix<Complex64>) -> bool {
 
 /// Theorem 2, eq. (8): the minimum-norm `Δ_i` solving `Δ_i W_i = U_i`, returned with its norm.
 ///
-/// Since `W^*W = I + Φ^*Φ` is Hermitian positive definite, `(W^*W)^{-1}` is applied through
-/// its Cholesky factor: `Δ = U L^{-*} L^{-1} W^*`, never an explicit inverse.
+/// `Δ_i = U_i (W_i^*W_i)^{-1} W_i^* = U_i W_i^+` is computed from the thin Householder QR
+/// factorization `W = QR` (`Q` with orthonormal columns, `R` upper triangular):
+/// `Δ = (U R^{-1}) Q^*` and `‖Δ‖ = σ_max(U R^{-1})`.  The Gram matrix `W^*W = I + Φ^*Φ` is
+/// never formed, so the error grows like `cond(W)·ε`, not `cond(W)²·ε` (GitHub issue 11).
+/// `W = [−I; −Φ]` has full column rank (`σ_min(W) ≥ 1`), so `R` is always invertible.
 pub fn min_norm_perturbation(
     f: &FactorsAt,
     phi: &DMatrix<Complex64>,
@@ -56,59 +59,41 @@ pub fn min_norm_perturbation(
     if f.m_singular() {
         return Err(AssumptionFailure::MSingular);
     }
-    let m_in = phi.ncols();
-    let u = &f.n - &f.m * phi;
-    let gram = DMatrix::<Complex64>::identity(m_in, m_in) + phi.adjoint() * phi;
-    let chol = gram
-        .cholesky()
-        .expect("I + Φ*Φ is Hermitian positive definite");
-    // Z = U L^{-*}: solve L Zᴴ = Uᴴ.
-    let zh = chol
-        .l()
-        .solve_lower_triangular(&u.adjoint())
-        .expect("L has a positive diagonal");
-    let norm = zh.clone().svd(false, false).singular_values.max();
-    // Δ = Z L^{-1} W^*, with W^* = [−I  −Φ^*].
-    let y = chol
-        .l()
-        .adjoint()
-        .solve_upper_triangular(&zh)
-        .expect("L has a positive diagonal")
-        .adjoint();
-    let p = phi.nrows();
-    let mut delta = DMatrix::zeros(p, m_in + p);
-    delta.view_mut((0, 0), (p, m_in)).copy_from(&(-&y));
-    delta
-        .view_mut((0, m_in), (p, p))
-        .copy_from(&(-(&y * phi.adjoint())));
+    let (zh, q) = qr_z(f, phi);
+    let norm = spectral_norm(&zh);
+    let delta = zh.adjoint() * q.adjoint();
     Ok((delta, norm))
 }
 
 /// Theorem 2: the smallest `|r(jω)|` consistent with the datum, `‖Δ_i‖` of eq. (8).
 ///
-/// `‖Δ_i‖² = λ_max(U (W^*W)^{-1} U^*)`, so only `Z = U L^{-*}` (with `W^*W = LL^*`) is
-/// needed: `‖Δ_i‖ = σ_max(Z)`; `Δ_i` itself is not formed.
+/// `‖Δ_i‖ = ‖U W^+‖ = σ_max(U R^{-1})` with `W = QR` (see [`min_norm_perturbation`]);
+/// `Δ_i` itself is not formed.
 pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, AssumptionFailure> {
     if f.m_singular() {
         return Err(AssumptionFailure::MSingular);
     }
-    let (zh, _) = cholesky_z(f, phi);
+    let (zh, _) = qr_z(f, phi);
     Ok(spectral_norm(&zh))
 }
 
-/// `Zᴴ = L^{-1} Uᴴ` with `U = Ñ − M̃Φ` and `I + Φ^*Φ = LL^*`; also returns `L`.
-fn cholesky_z(f: &FactorsAt, phi: &DMatrix<Complex64>) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
-    let m_in = phi.ncols();
+/// `Zᴴ = R^{-*} Uᴴ` with `U = Ñ − M̃Φ` and the thin QR `W = [−I; −Φ] = QR`; also returns `Q`.
+/// A non-finite datum gives a non-finite `Z` (never a panic).
+fn qr_z(f: &FactorsAt, phi: &DMatrix<Complex64>) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
+    let (p, m_in) = phi.shape();
     let u = &f.n - &f.m * phi;
-    let gram = DMatrix::<Complex64>::identity(m_in, m_in) + phi.adjoint() * phi;
-    let l = gram
-        .cholesky()
-        .expect("I + Φ*Φ is Hermitian positive definite")
-        .unpack();
-    let zh = l
+    let mut w = DMatrix::<Complex64>::zeros(m_in + p, m_in);
+    for k in 0..m_in {
+        w[(k, k)] = Complex64::new(-1.0, 0.0);
+    }
+    w.view_mut((m_in, 0), (p, m_in)).copy_from(&(-phi));
+    let qr = w.qr();
+    let (q, r) = (qr.q(), qr.r());
+    let zh = r
+        .adjoint()
         .solve_lower_triangular(&u.adjoint())
-        .expect("L has a positive diagonal");
-    (zh, l)
+        .unwrap_or_else(|| DMatrix::from_element(m_in, p, Complex64::new(f64::NAN, 0.0)));
+    (zh, q)
 }
 
 /// The matrix `X` of Theorem 3, `F_L(P, Φ̂⁻¹) = r·X`, computed with LU solves.

@@ -173,7 +173,9 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             w: spec.w[i],
             x: spec.w[i] * spec.w[i],
             lower: spec.lower[i].max(spec.floor),
-            upper: Some(spec.lower[i].max(spec.floor)),
+            // A datum with r_min = 0 (explained by the noise alone) bounds nothing: it must
+            // not set the level either (GitHub issue 11, defect 4).
+            upper: (spec.lower[i] > 0.0).then_some(spec.lower[i]),
             a1: match (spec.a1, spec.a1_data) {
                 (Some(f), _) => Some(f(spec.w[i])),
                 (None, Some(d)) => Some(d[i]),
@@ -200,17 +202,15 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             }
             let (a, b) = (spec.lower[j], spec.lower[k]);
             let lower = if spec.no_dip { a.min(b) } else { 0.0 };
-            (
-                lower.max(spec.floor),
-                a.max(b).max(spec.floor),
-                PointKind::Band,
-            )
+            // Between two zero data there is no envelope to stay close to.
+            let upper = a.max(b);
+            (lower.max(spec.floor), upper, PointKind::Band)
         };
         pts.push(GridPoint {
             w,
             x: w * w,
             lower,
-            upper: Some(upper),
+            upper: (upper > 0.0).then_some(upper),
             a1: a1_at(w),
             kind,
             datum: None,

@@ -43,7 +43,7 @@ pub(crate) struct Scored {
     pub max_log: f64,
     /// Area objective `Σ w_i |r|²/r_min²`.
     pub area: f64,
-    /// `max |r|²/U` over the grid (the minimax level reached).
+    /// `max |r|²/U` over the data (the minimax level reached).
     pub t: f64,
     /// Where the candidate came from.
     pub origin: String,
@@ -69,7 +69,7 @@ impl Prepared {
         let (mut t, mut coverage, mut a1_ratio) = (0.0f64, f64::INFINITY, f64::INFINITY);
         for p in &self.grid {
             let m2 = zpk.mag(p.w).powi(2);
-            if let Some(u) = p.upper {
+            if let Some(u) = p.upper.filter(|_| p.kind == PointKind::Datum) {
                 t = t.max(m2 / u);
             }
             if p.lower > 0.0 {
@@ -114,13 +114,13 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
-/// The level `max A/(U·B)` over the grid points with an upper bound reached by `(A, B)`
+/// The level `max A/(U·B)` over the data with a bound reached by `(A, B)`
 /// (`+∞` when `B ≤ 0` somewhere, which a feasible max-slack solution never has).
 fn achieved_level(phi: &[Vec<f64>], grid: &[GridPoint], a: &[f64], b: &[f64]) -> f64 {
     let dot = |r: &[f64], c: &[f64]| r.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
     let mut t = 0.0f64;
     for (ph, g) in phi.iter().zip(grid) {
-        if let Some(u) = g.upper {
+        if let Some(u) = g.upper.filter(|_| g.kind == PointKind::Datum) {
             let bv = dot(ph, b);
             if !(bv > 0.0) {
                 return f64::INFINITY;
@@ -283,10 +283,14 @@ pub(crate) fn fit_order(
             }
         }
     } else {
+        let blocking = blocking_families(&phi, &prep.grid, &init, set.max_solver_iter);
+        lp_solves += 4;
         events.push(event(
             "minimax".into(),
             SolverStatus::PrimalInfeasible,
-            "no feasible level up to t = 1e24: the bounds conflict at this order (A1 or floor); other candidates tried",
+            &format!(
+                "no feasible level up to t = 1e24; {blocking}; other candidates tried (the constant r among them)"
+            ),
         ));
     }
 
@@ -408,6 +412,20 @@ pub(crate) fn fit_order(
         c.origin = format!("order {} carried over", p.zpk.order());
         cands.push(c);
     }
+    // The constant r at the largest lower bound meets every lower bound: a candidate at
+    // every order, so a level search that fails numerically never turns a feasible order
+    // into "infeasible" (GitHub issue 11, defect 5).
+    let c2 = prep.grid.iter().map(|g| g.lower).fold(0.0f64, f64::max);
+    if c2 > 0.0 && c2.is_finite() {
+        cands.push(prep.score(
+            Zpk {
+                gain: c2.sqrt(),
+                zeros: Vec::new(),
+                poles: Vec::new(),
+            },
+            "constant at the largest lower bound",
+        ));
+    }
 
     // 3. Rank: feasible (to the LP accuracy) first; never worse than the previous order.
     let ok = |c: &Scored| c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6;
@@ -452,5 +470,53 @@ pub(crate) fn fit_order(
         ranked: cands,
         events,
         lp_solves,
+    }
+}
+
+/// Drops one constraint family from a grid point.
+type Relax = fn(&mut GridPoint);
+
+/// When no level is feasible: which constraint family blocks it.  Each family is dropped in
+/// turn and the level `t = 1e24` tried again; the families whose removal makes it feasible
+/// are named (the data lower bounds, the no-dip bounds between data, the floor, A1).
+fn blocking_families(phi: &[Vec<f64>], grid: &[GridPoint], init: &[bool], max_iter: u32) -> String {
+    let families: [(&str, Relax); 4] = [
+        ("the lower bounds at the data", |g| {
+            if g.kind == PointKind::Datum {
+                g.lower = 0.0;
+            }
+        }),
+        ("the no-dip bounds between data", |g| {
+            if g.kind == PointKind::Band {
+                g.lower = 0.0;
+            }
+        }),
+        ("the floor outside the band and at 0 and infinity", |g| {
+            if matches!(g.kind, PointKind::Outside | PointKind::Infinity) {
+                g.lower = 0.0;
+            }
+        }),
+        ("A1 (|r| < sigma_min(M))", |g| g.a1 = None),
+    ];
+    let mut found = Vec::new();
+    for (name, drop) in families {
+        let relaxed: Vec<GridPoint> = grid
+            .iter()
+            .map(|g| {
+                let mut g = *g;
+                drop(&mut g);
+                g
+            })
+            .collect();
+        let mut mask = Vec::new();
+        let (st, s, _, _, _) = max_slack(phi, &relaxed, 1e24, init, &mut mask, max_iter);
+        if st.has_solution() && s >= 0.0 {
+            found.push(name);
+        }
+    }
+    if found.is_empty() {
+        "no single constraint family blocks it alone (dropping any one of data bounds, no-dip, floor, A1 does not help): the LP failed numerically or several families conflict".into()
+    } else {
+        format!("blocked by {} (feasible without it)", found.join(" / "))
     }
 }

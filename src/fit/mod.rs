@@ -9,7 +9,9 @@
 //! * [`problem`]: the Clarabel LPs (minimax step with free poles, area step with fixed poles);
 //! * [`spectral`]: spectral factorization, roots on the axis reported as errors;
 //! * [`engine`]: one order — candidates, failures recorded and skipped;
+//! * [`between`]: the no-dip rule between data, proved by interval branch-and-bound;
 //! * [`certificate`]: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
+//! * [`realization`]: a balanced cascade state-space realization of `r` for the exports;
 //! * [`order`]: the order sweep and the automatic order choice;
 //! * [`run`]: fit + certificate + exports, for the CLI.
 //!
@@ -17,10 +19,12 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod basis;
+pub mod between;
 pub mod certificate;
 pub(crate) mod engine;
 pub mod order;
 pub mod problem;
+pub mod realization;
 pub mod run;
 pub mod spectral;
 

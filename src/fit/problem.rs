@@ -2,7 +2,8 @@
 //!
 //! * **Minimax step** ([`max_slack`]): for a fixed level `t`, with both `A` and `B` free,
 //!   maximize the common slack `s` of every (row-normalized) constraint
-//!   `A − L·B ≥ s`, `t·U·B − A ≥ s`, `α·B − A ≥ s`, `B ≥ ε + s`, with `b₀ = 1`.  The level
+//!   `A − L·B ≥ s`, `t·U·B − A ≥ s` (at the data only: the level is
+//!   `max_i |r(jω_i)|²/r_min,i²`), `α·B − A ≥ s`, `B ≥ ε + s`, with `b₀ = 1`.  The level
 //!   `t` is feasible iff `s* ≥ 0`.  `max_{data} |r|²/r_min²` is quasi-convex in `(A, B)`, so
 //!   bisection on `t` gives the log-Chebyshev (minimax) fit with free poles and zeros, as
 //!   `fitmagfrd` does; unlike it, the bounds hold on the dense grid, not only at the data.
@@ -11,7 +12,7 @@
 //! * **Area step** ([`area_fixed_poles`]): with `B` fixed (the poles), minimize the
 //!   log-frequency-weighted `Σ w_i |r(jω_i)|²/r_min,i²` over `A` subject to the same bounds.
 
-use super::basis::{basis_row, GridPoint};
+use super::basis::{basis_row, GridPoint, PointKind};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus as ClStatus, SupportedConeT,
@@ -312,7 +313,11 @@ pub(crate) fn max_slack(
         for (i, p) in grid.iter().enumerate() {
             let row = match kind {
                 0 => Some((row_ab(&phi[i], 1.0, -p.lower), 0.0)),
-                1 => p.upper.map(|u| (row_ab(&phi[i], -1.0, t * u), 0.0)),
+                // The level: at the data only (the log-Chebyshev objective of the issue).
+                1 => p
+                    .upper
+                    .filter(|_| p.kind == PointKind::Datum)
+                    .map(|u| (row_ab(&phi[i], -1.0, t * u), 0.0)),
                 2 => p.a1.map(|a1| (row_ab(&phi[i], -1.0, a1), 0.0)),
                 _ => Some((row_ab(&phi[i], 0.0, 1.0), B_FLOOR)),
             };

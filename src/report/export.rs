@@ -5,7 +5,6 @@
 
 use crate::error::Result;
 use crate::fit::{FitResult, OrderRow};
-use crate::system::StateSpace;
 use crate::util::write_atomic;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -54,7 +53,11 @@ fn list(v: &[f64], sep: &str) -> String {
 
 /// The JSON text of `r.json`.
 pub fn r_json(fit: &FitResult, table: Option<&[OrderRow]>) -> String {
-    let ss = StateSpace::from_tf(&fit.r);
+    let ss = crate::fit::realization::realize(&crate::fit::Zpk {
+        gain: fit.gain,
+        zeros: fit.zeros.clone(),
+        poles: fit.poles.clone(),
+    });
     let cx = |v: &[num_complex::Complex64]| {
         v.iter()
             .map(|z| Complex { re: z.re, im: z.im })

