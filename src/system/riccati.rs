@@ -9,6 +9,7 @@
 //! function. Every iteration is capped; the residual and the stabilizing property are checked
 //! after the fact, and a failure is an error, never a silent wrong solution.
 
+use super::dense_inverse::inverse_with_logdet;
 use super::eig::{eigenvalues, spectral_abscissa};
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;
@@ -75,10 +76,7 @@ fn sign(z0: DMatrix<f64>, what: &str) -> Result<(DMatrix<f64>, usize)> {
     let mut z = z0;
     let mut scaling = true;
     for k in 1..=MAX_SIGN_ITER {
-        let lu = z.clone().lu();
-        let logdet: f64 = lu.u().diagonal().iter().map(|u| u.abs().ln()).sum();
-        let zinv = lu.try_inverse().filter(|m| m.iter().all(|v| v.is_finite()));
-        let Some(zinv) = zinv else {
+        let Some((zinv, logdet)) = inverse_with_logdet(&z) else {
             return Err(Error::Invalid(format!(
                 "{what}: the Hamiltonian has eigenvalues on the imaginary axis (singular in the sign iteration): no stabilizing solution"
             )));
@@ -113,9 +111,7 @@ pub fn lyapunov(f: &DMatrix<f64>, q: &DMatrix<f64>, what: &str) -> Result<DMatri
     let (mut fk, mut qk) = (f.clone(), q.clone());
     let mut scaling = true;
     for _ in 0..MAX_SIGN_ITER {
-        let lu = fk.clone().lu();
-        let logdet: f64 = lu.u().diagonal().iter().map(|u| u.abs().ln()).sum();
-        let Some(finv) = lu.try_inverse().filter(|m| m.iter().all(|v| v.is_finite())) else {
+        let Some((finv, logdet)) = inverse_with_logdet(&fk) else {
             return Err(Error::Invalid(format!(
                 "{what}: Lyapunov equation with a singular state matrix"
             )));
