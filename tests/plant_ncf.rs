@@ -79,6 +79,30 @@ proptest! {
     }
 }
 
+/// The cases proptest found where 1e-9 cannot hold: several unstable poles seen through one
+/// output make `‖Y‖‖C‖²` 3e7 and 9e9; the error stays below 1e-15·κ (about 4.5·ε·κ).
+#[test]
+fn ill_conditioned_random_plants_round_at_eps_kappa() {
+    for (seed, n, p, m, shift) in [
+        (262164u64, 6usize, 1usize, 1usize, 2.1150200664710375f64),
+        (564471, 4, 1, 3, 2.8026083228436462),
+        (774030, 5, 1, 2, 3.0),
+    ] {
+        let ncf = NormalizedLcf::new(random_plant(seed, n, p, m, shift)).unwrap();
+        let kappa = 1.0 + ncf.riccati.x.norm() * ncf.plant.c.norm().powi(2);
+        assert!(
+            kappa > 1e6,
+            "seed {seed}: κ = {kappa:e} is not ill-conditioned"
+        );
+        let (e_norm, e_g) = ncf_errors(&ncf, &logspace(1e-3, 1e3, 400));
+        assert!(
+            e_norm < 1e-15 * kappa,
+            "seed {seed}: {e_norm:e} at κ = {kappa:e}"
+        );
+        assert!(e_g < 1e-15 * kappa, "seed {seed}: {e_g:e} at κ = {kappa:e}");
+    }
+}
+
 #[test]
 fn unstable_first_order_matches_closed_form() {
     // G = 1/(s − 1): Y = 1 + √2, M̃ = (s − 1)/(s + √2), Ñ = 1/(s + √2).
