@@ -42,6 +42,27 @@ fn sigma_max(ev: &FreqEvaluator, omega: f64) -> f64 {
         .unwrap_or(f64::INFINITY)
 }
 
+/// The end of an iteration with no interval above the level: the peak polished by
+/// [`refine_peak`] is the norm (`Ok`), unless it rises above `level`, in which case the
+/// iteration goes on from it (`Err` carries the new `(γ, ω)`).
+fn polish(
+    ev: &FreqEvaluator,
+    gamma: f64,
+    omega: f64,
+    level: f64,
+    iterations: usize,
+) -> std::result::Result<HinfNorm, (f64, f64)> {
+    let (g2, w2) = refine_peak(ev, omega);
+    if g2 > level {
+        return Err((g2, w2));
+    }
+    Ok(HinfNorm {
+        gamma: gamma.max(g2),
+        omega: if g2 > gamma { w2 } else { omega },
+        iterations,
+    })
+}
+
 /// Golden-section search for a local maximum of `σ_max` in `[ω/(1+η), ω(1+η)]`, `η = 1e-3`.
 /// Near a sharp peak two crossing eigenvalues of `H(γ)` nearly coalesce and round-off can
 /// push them off the axis; this local search recovers the last digits.
@@ -188,17 +209,13 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         ws.sort_by(f64::total_cmp);
         ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));
         if ws.is_empty() {
-            let (g2, w2) = refine_peak(&ev, omega);
-            if g2 > level {
-                gamma = g2;
-                omega = w2;
-                continue;
+            match polish(&ev, gamma, omega, level, it) {
+                Ok(done) => return Ok(done),
+                Err((g2, w2)) => {
+                    (gamma, omega) = (g2, w2);
+                    continue;
+                }
             }
-            return Ok(HinfNorm {
-                gamma: gamma.max(g2),
-                omega: if g2 > gamma { w2 } else { omega },
-                iterations: it,
-            });
         }
         let mut improved = false;
         // σ_max exceeds the level on intervals bounded by consecutive crossings (and on
@@ -222,17 +239,13 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         if !improved {
             // The candidates bound no interval above γ: round-off touches of the peak (or
             // lightly damped eigenvalues near the axis). Polish the peak locally.
-            let (g2, w2) = refine_peak(&ev, omega);
-            if g2 > level {
-                gamma = g2;
-                omega = w2;
-                continue;
+            match polish(&ev, gamma, omega, level, it) {
+                Ok(done) => return Ok(done),
+                Err((g2, w2)) => {
+                    (gamma, omega) = (g2, w2);
+                    continue;
+                }
             }
-            return Ok(HinfNorm {
-                gamma: gamma.max(g2),
-                omega: if g2 > gamma { w2 } else { omega },
-                iterations: it,
-            });
         }
     }
     Err(Error::Invalid(format!(

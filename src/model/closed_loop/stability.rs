@@ -194,9 +194,15 @@ pub fn check_loop_with(
     if !roots.converged {
         return Err(LoopInstability::RootsDidNotConverge);
     }
-    // A root on the axis to working precision is a closed-loop pole there: not stable.
-    let bad: Vec<_> = roots
-        .roots
+    verdict(roots.roots)
+}
+
+/// The verdict from the closed-loop poles: a pole on the axis to working precision counts
+/// as unstable, like one in the right half-plane.
+pub(crate) fn verdict(
+    poles: impl IntoIterator<Item = num_complex::Complex64>,
+) -> Result<(), LoopInstability> {
+    let bad: Vec<_> = poles
         .into_iter()
         .filter(|z| z.re >= -1e-10 * z.norm().max(1.0))
         .collect();

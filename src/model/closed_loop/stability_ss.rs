@@ -18,7 +18,6 @@
 
 use super::stability::LoopInstability;
 use crate::system::{eig, StateSpace, TfMatrix, TransferFunction};
-use num_complex::Complex64;
 
 /// Largest number of states of the realization of `Λ` accepted.
 pub const MAX_STATES: usize = 1500;
@@ -42,13 +41,5 @@ pub fn check_lambda(lambda: &[Vec<TransferFunction>]) -> Result<(), LoopInstabil
     let balanced = eig::apply_balancing(&a_cross, &eig::balancing(&a_cross));
     let ev = eig::eigenvalues(&balanced, "closed-loop poles")
         .map_err(|_| LoopInstability::RootsDidNotConverge)?;
-    let bad: Vec<Complex64> = ev
-        .into_iter()
-        .filter(|z| z.re >= -1e-10 * z.norm().max(1.0))
-        .collect();
-    if bad.is_empty() {
-        Ok(())
-    } else {
-        Err(LoopInstability::RightHalfPlaneZeros(bad))
-    }
+    super::stability::verdict(ev)
 }
