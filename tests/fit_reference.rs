@@ -233,6 +233,15 @@ fn rshape_reaches_the_reference_optimum_at_every_order() {
                 pairs += 1;
                 eprintln!("envelope {k} order {order}: rshape {ours:.4}, reference {reference:.4}, gap {gap:+.4}");
                 if gap > 0.01 {
+                    if std::env::var("REF_DEBUG").is_ok() {
+                        eprintln!(
+                            "  origin {} repair {}",
+                            fit.origin, fit.certificate.repair_factor
+                        );
+                        for e in &fit.solver_events {
+                            eprintln!("  {e:?}");
+                        }
+                    }
                     failures.push(format!("envelope {k} order {order}: rshape {ours:.4} > reference {reference:.4} + 0.01"));
                 }
             }

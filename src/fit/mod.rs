@@ -23,6 +23,7 @@ pub mod between;
 pub mod certificate;
 pub(crate) mod engine;
 pub mod order;
+pub(crate) mod polyfit;
 pub mod problem;
 pub mod realization;
 pub mod run;
