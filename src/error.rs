@@ -7,8 +7,9 @@ use thiserror::Error;
 /// Errors from reading inputs and from the consistency computations.
 #[derive(Debug, Error)]
 pub enum Error {
-    /// A file could not be read or written.
-    #[error("{path}: {source}")]
+    /// A file could not be read or written.  The message says what to check; the OS
+    /// error follows as the source (`anyhow`'s `{:#}` appends it).
+    #[error("{path}: {}", io_hint(source))]
     Io {
         /// The file.
         path: PathBuf,
@@ -44,6 +45,22 @@ pub enum Error {
     /// Inputs that do not fit together (sizes, missing parts).
     #[error("{0}")]
     Invalid(String),
+}
+
+/// What to check for an I/O error, by its kind.
+fn io_hint(e: &std::io::Error) -> &'static str {
+    use std::io::ErrorKind as K;
+    match e.kind() {
+        K::NotFound => "not found: check the path",
+        K::PermissionDenied => "permission denied: check the file's and the folder's permissions",
+        K::IsADirectory => "is a folder: give a file",
+        K::NotADirectory => "a part of the path is a file, not a folder: check the path",
+        K::InvalidData => "not UTF-8 text: save the file as UTF-8",
+        K::AlreadyExists => "already exists",
+        K::StorageFull => "the disk is full: free space and run again",
+        K::ReadOnlyFilesystem => "read-only file system: choose a writable folder",
+        _ => "cannot be read or written",
+    }
 }
 
 /// Result alias of the library.

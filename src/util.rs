@@ -1,4 +1,5 @@
-//! Small helpers shared by the I/O code: atomic file writes.
+//! Small helpers shared by the I/O code: atomic file writes, whole or streamed, and the
+//! record of what a run wrote into its output folder ([`OutputManifest`]).
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -20,23 +21,135 @@ pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
 }
 
 fn write_via_temp(path: &Path, contents: &[u8], sync: bool) -> Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
-    let io = |source| Error::Io {
+    let mut file = AtomicFile::create(path)?;
+    (file.out.write_all(contents)).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(io)?;
-    tmp.write_all(contents).map_err(io)?;
-    if sync {
-        tmp.as_file().sync_all().map_err(io)?;
+    })?;
+    file.finish(sync)
+}
+
+/// A file written in pieces and published atomically: the bytes go to a temporary file in
+/// the target's directory; [`commit`](Self::commit) flushes, syncs and renames it over the
+/// target.  Dropped without `commit` (an error, a panic) or killed, the run leaves at most
+/// an unnamed temporary file, never a truncated file under the final name.
+pub struct AtomicFile {
+    path: std::path::PathBuf,
+    out: std::io::BufWriter<tempfile::NamedTempFile>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path` (its directory is created if needed).
+    pub fn create(path: &Path) -> Result<Self> {
+        let dir = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+        let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            out: std::io::BufWriter::with_capacity(1 << 16, tmp),
+        })
     }
-    tmp.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
+
+    /// The writer of the contents.
+    pub fn writer(&mut self) -> &mut impl Write {
+        &mut self.out
+    }
+
+    /// Flushes, syncs and renames the file to its final name.
+    pub fn commit(self) -> Result<()> {
+        self.finish(true)
+    }
+
+    fn finish(self, sync: bool) -> Result<()> {
+        let io = |source| Error::Io {
+            path: self.path.clone(),
+            source,
+        };
+        let tmp = self.out.into_inner().map_err(|e| io(e.into_error()))?;
+        if sync {
+            tmp.as_file().sync_all().map_err(io)?;
+        }
+        record(&self.path);
+        tmp.persist(&self.path).map_err(|e| io(e.error))?;
+        Ok(())
+    }
+}
+
+/// The output folder of the run in progress and its open manifest, while recording.
+static RECORDING: std::sync::Mutex<Option<(std::path::PathBuf, std::fs::File)>> =
+    std::sync::Mutex::new(None);
+
+/// Appends `path` to the manifest of the run in progress, before the file takes its name,
+/// so that even a run killed right after the rename is listed.
+fn record(path: &Path) {
+    let mut guard = RECORDING.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((dir, manifest)) = guard.as_mut() {
+        let abs = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+        if let Ok(rel) = abs.strip_prefix(&*dir) {
+            // Best effort: a manifest that cannot grow only means a later run clears less.
+            let _ = writeln!(manifest, "{}", rel.display());
+        }
+    }
+}
+
+/// What a run wrote into its output folder, so that a re-run into the same folder never
+/// mixes old and new files.  [`begin`](Self::begin) deletes the files the previous run
+/// listed in `DIR/rshape-outputs.txt` (only those: files of other origin are never
+/// touched), then lists each file this run writes there before it takes its final name.
+/// A run that fails or is killed thus leaves complete files of its own, never stale ones,
+/// and the next run clears them.
+pub struct OutputManifest {
+    _private: (),
+}
+
+impl OutputManifest {
+    /// The manifest's file name inside the output folder.
+    pub const FILE: &'static str = "rshape-outputs.txt";
+
+    /// Clears the files of the previous run in `dir` and starts recording this run's.
+    pub fn begin(dir: &Path) -> Result<Self> {
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| Error::Io { path, source }
+        };
+        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let dir = std::path::absolute(dir).map_err(io(dir))?;
+        let list = dir.join(Self::FILE);
+        if let Ok(old) = std::fs::read_to_string(&list) {
+            for rel in old.lines().map(Path::new) {
+                // Only plain relative paths inside the folder.
+                if rel
+                    .components()
+                    .all(|c| matches!(c, std::path::Component::Normal(_)))
+                {
+                    match std::fs::remove_file(dir.join(rel)) {
+                        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                            return Err(io(&dir.join(rel))(e))
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        let manifest = std::fs::File::create(&list).map_err(io(&list))?;
+        *RECORDING.lock().unwrap_or_else(|e| e.into_inner()) = Some((dir, manifest));
+        Ok(Self { _private: () })
+    }
+}
+
+impl Drop for OutputManifest {
+    fn drop(&mut self) {
+        if let Some((_, manifest)) = RECORDING.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            let _ = manifest.sync_all();
+        }
+    }
 }

@@ -107,6 +107,47 @@ fn run_writes_the_closed_loop_report_and_figures() {
     assert!(t.contains("Closed loop") && t.contains("Thm 2"), "{t}");
     assert!(svg_text(&out.join("mu.svg")).contains("μ_Δs"));
     assert!(!t.contains("A1 limit"));
+    // The figures and the summary say V and |Δ̄| (the closed-loop names), never r or ‖Δ‖.
+    let m = svg_text(&out.join("mu.svg"));
+    for want in [
+        "|Δ̄| per datum vs |V(jω)|",
+        "|V(jω)|, configured V = ",
+        "|V(jω)|, fitted V = ",
+        "explained by the configured V",
+        "FAILING, configured |V(jω)| ≤ |V|_min",
+        "|V|_min = 0 at ",
+    ] {
+        assert!(t.contains(want), "r_vs_delta.svg lacks `{want}`:\n{t}");
+    }
+    for want in [
+        "μ_Δs (dimensionless)",
+        "μ_Δs per datum, configured V",
+        "μ_Δs ≤ 1",
+    ] {
+        assert!(m.contains(want), "mu.svg lacks `{want}`:\n{m}");
+    }
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("max |V|_min = ") && stdout.contains("  fit       V"),
+        "{stdout}"
+    );
+    for text in [&t, &m, &stdout.to_string()] {
+        for bad in [
+            "configured r",
+            "fitted r",
+            "|r(jω)|",
+            "r_min",
+            "admissible r",
+            "μ_Γ",
+            "‖Δ",
+            "Δ_V",
+        ] {
+            assert!(
+                !text.contains(bad),
+                "closed-loop output says `{bad}`:\n{text}"
+            );
+        }
+    }
     // Noise-free: no μ figure.
     let out2 = dir.path().join("same");
     let o = bin()
@@ -319,4 +360,78 @@ controller = [[{ num = [3, 1], den = [1, 4] }, 0.2],
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("SISO"), "{}", stderr(&o));
     assert!(!out2.exists());
+}
+
+#[test]
+fn figure_symbols_follow_the_kind_of_data() {
+    use rshape::plot::{mu_svg_with, r_vs_delta_svg_with, MuInput, RVsDeltaInput, Symbols};
+    use rshape::system::TransferFunction;
+    let dir = tempfile::tempdir().unwrap();
+    let omega = [1.0, 2.0, 5.0, 10.0];
+    let r_min = [0.1, 0.0, 0.5, f64::INFINITY];
+    let failing = [false, false, true, true];
+    let r = TransferFunction::new(vec![0.2, 0.1], vec![1.0, 1.0]);
+    let grid: Vec<f64> = (0..50)
+        .map(|k| 10f64.powf(-0.2 + k as f64 / 40.0))
+        .collect();
+    let texts = |sym: &Symbols| {
+        let a = r_vs_delta_svg_with(
+            &RVsDeltaInput {
+                title: "t",
+                omega: &omega,
+                r_min: &r_min,
+                r_min_label: "per datum",
+                failing: &failing,
+                r_configured: Some(&r),
+                r_fitted: Some(&r),
+                grid: &grid,
+                a1_on_grid: None,
+            },
+            sym,
+        )
+        .unwrap();
+        let b = mu_svg_with(
+            &MuInput {
+                title: "t",
+                omega: &omega,
+                mu: &[3.0, 0.5, 1.2, 2.0],
+            },
+            sym,
+        )
+        .unwrap();
+        let (pa, pb) = (dir.path().join("a.svg"), dir.path().join("b.svg"));
+        std::fs::write(&pa, a).unwrap();
+        std::fs::write(&pb, b).unwrap();
+        format!("{}\n{}", svg_text(&pa), svg_text(&pb))
+    };
+    let open = texts(&Symbols::OPEN_LOOP);
+    let closed = texts(&Symbols::CLOSED_LOOP);
+    for want in [
+        "|r(jω)|, configured r",
+        "|r(jω)|, fitted r",
+        "configured |r(jω)| ≤ r_min",
+        "r_min = ∞: no admissible r",
+        "r_min = 0 at 1 data",
+        "μ_Γ (dimensionless)",
+        "μ_Γ per datum, configured r",
+    ] {
+        assert!(open.contains(want), "open loop lacks `{want}`:\n{open}");
+    }
+    for want in [
+        "|V(jω)|, configured V",
+        "|V(jω)|, fitted V",
+        "configured |V(jω)| ≤ |V|_min",
+        "|V|_min = ∞: no admissible V",
+        "|V|_min = 0 at 1 data",
+        "μ_Δs (dimensionless)",
+        "μ_Δs per datum, configured V",
+    ] {
+        assert!(
+            closed.contains(want),
+            "closed loop lacks `{want}`:\n{closed}"
+        );
+    }
+    for bad in ["configured r", "fitted r", "r_min", "μ_Γ", "admissible r"] {
+        assert!(!closed.contains(bad), "closed loop says `{bad}`:\n{closed}");
+    }
 }

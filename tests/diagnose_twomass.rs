@@ -181,16 +181,20 @@ fn cli_compare_json_and_apply_write() {
     assert!(out.status.success());
     let h: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(h["revisions"].as_array().unwrap().len(), 2);
-    // The greedy path refits every parameter jointly after each accepted effect: on A the
-    // first three steps (mode, friction, delay) reach misfit_rms < 5.5 (6.62 without).
+    // The search refits every parameter jointly at every node: on A three effects reach
+    // misfit_rms < 5.5.
     let c = Config::load(Path::new("configs/twomass_rigid.toml")).unwrap();
     let a = read_frf_csv(c.data.as_ref().unwrap()).unwrap();
     let siso = prepare(&c, &a, None, None).unwrap();
     let d = diagnose(c.physical.as_ref().unwrap(), &siso, 3).unwrap();
     let names: Vec<&str> = d.steps.iter().map(|s| s.effect.as_str()).collect();
-    assert_eq!(names, ["mode", "friction", "delay"]);
+    println!("chosen path {names:?}, misfit_rms {}", d.after.misfit_rms);
+    assert!(names.contains(&"mode"), "{names:?}");
     for s in &d.steps {
-        assert!(s.misfit_rms <= s.misfit_rms_before_refit, "{s:?}");
+        assert!(
+            s.misfit_rms <= s.misfit_rms_before_refit * (1.0 + 1e-9),
+            "{s:?}"
+        );
     }
     assert!(d.after.misfit_rms < 5.5, "{}", d.after.misfit_rms);
     assert!(std::fs::read_to_string(dir.path().join("h.svg"))
@@ -198,37 +202,28 @@ fn cli_compare_json_and_apply_write() {
         .contains("<svg"));
 }
 
-/// The extrapolation holdout (global candidates: fit below 70 % of the band, predict the top
-/// 30 %) rejects what the interleaved holdout lets through: on the rigid-body model a gain
-/// lowers V a lot but fails to predict the top of the band; on rev 1 a delay and an NMP zero
-/// tie in BIC, and only the delay extrapolates.
+/// The chosen set is checked on held-out data: every chosen effect has a holdout entry, and
+/// an effect that failed it is not in the final model.
 #[test]
-fn extrapolation_holdout_rejects_global_candidates_that_do_not_predict() {
-    let cand = |config: &str| {
-        let c = Config::load(Path::new(config)).unwrap();
-        let a = read_frf_csv(c.data.as_ref().unwrap()).unwrap();
-        let siso = prepare(&c, &a, None, None).unwrap();
-        diagnose(c.physical.as_ref().unwrap(), &siso, 1)
-            .unwrap()
-            .candidates
-    };
-    let rigid = cand("configs/twomass_rigid.toml");
-    let gain = rigid.iter().find(|c| c.effect == "gain").unwrap();
-    assert!(gain.delta_bic > 1e4, "{}", gain.delta_bic);
-    assert!(gain.holdout_interleaved_ok);
-    assert_eq!(gain.holdout_extrapolation_ok, Some(false));
-    assert!(!gain.holdout_ok && !gain.passes);
-    // Local candidates are not extrapolated.
-    let mode = rigid.iter().find(|c| c.effect == "mode").unwrap();
-    assert_eq!(mode.holdout_extrapolation_ok, None);
-    assert!(mode.passes);
-
-    let rev1 = cand("configs/twomass_rev1.toml");
-    let delay = rev1.iter().find(|c| c.effect == "delay").unwrap();
-    let nmp = rev1.iter().find(|c| c.effect == "nmp_zero").unwrap();
-    assert!((delay.delta_bic - nmp.delta_bic).abs() < 6.0);
-    assert_eq!(delay.holdout_extrapolation_ok, Some(true));
-    assert!(delay.passes);
-    assert_eq!(nmp.holdout_extrapolation_ok, Some(false));
-    assert!(nmp.holdout_interleaved_ok && !nmp.passes);
+fn final_set_holdout_is_reported_for_every_chosen_effect() {
+    let c = Config::load(Path::new("configs/twomass_rigid.toml")).unwrap();
+    let a = read_frf_csv(c.data.as_ref().unwrap()).unwrap();
+    let siso = prepare(&c, &a, None, None).unwrap();
+    let d = diagnose(c.physical.as_ref().unwrap(), &siso, 2).unwrap();
+    assert!(d.chosen.iter().any(|e| e == "mode"), "{:?}", d.chosen);
+    let checked: Vec<&str> = d.holdout.iter().map(|h| h.effect.as_str()).collect();
+    for e in &d.chosen {
+        assert!(
+            checked.contains(&e.as_str()),
+            "{e} not checked: {checked:?}"
+        );
+    }
+    for h in &d.holdout {
+        let failed = !h.interleaved_ok;
+        assert_eq!(failed, d.dropped.contains(&h.effect), "{h:?}");
+    }
+    // The retune ranks with the candidates, and its own ΔBIC is against the configured model.
+    let rt = d.candidates.iter().find(|c| c.effect == "retune").unwrap();
+    assert_eq!(rt.n_params, 0);
+    assert!(rt.misfit_rms_after <= rt.misfit_rms_before);
 }

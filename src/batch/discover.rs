@@ -12,6 +12,7 @@
 //! Only `data` is required; `name` defaults to the file stem and an empty or missing
 //! `noise_radius` means "as for a single run" (`--noise-radius`, the data file, the config).
 
+use crate::data::table::TableReader;
 use crate::error::{Error, Result};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -85,31 +86,16 @@ pub fn from_dir(dir: &Path) -> Result<Vec<Dataset>> {
 
 /// The datasets listed in a manifest (see the module doc for the format).
 pub fn from_manifest(file: &Path) -> Result<Vec<Dataset>> {
-    let text = std::fs::read_to_string(file).map_err(|source| Error::Io {
-        path: file.to_path_buf(),
-        source,
-    })?;
     let base = file.parent().unwrap_or(Path::new("."));
     let err = |line: usize, msg: String| Error::Data {
         path: file.to_path_buf(),
         line,
         msg,
     };
-    let mut rows = text
-        .lines()
-        .enumerate()
-        .map(|(k, l)| (k + 1, l.trim()))
-        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-    let (hl, header) = rows.next().ok_or_else(|| {
-        err(
-            1,
-            "empty manifest: expected a header `name,data,noise_radius`".into(),
-        )
-    })?;
-    let cols: Vec<String> = split_csv_line(header)
-        .into_iter()
-        .map(|c| c.trim().to_string())
-        .collect();
+    // The csv crate's parser (quotes, BOM, CRLF), as for every CSV input.
+    let mut table = TableReader::open(file, "name,data,noise_radius")?;
+    let (hl, cols) = (table.header_line, table.names.clone());
+    let header = cols.join(",");
     let col = |n: &str| cols.iter().position(|c| c == n);
     let data_col = col("data").ok_or_else(|| {
         err(hl, format!("header `{header}` has no `data` column; expected `name,data,noise_radius` (name and noise_radius optional)"))
@@ -125,8 +111,8 @@ pub fn from_manifest(file: &Path) -> Result<Vec<Dataset>> {
     }
     let (name_col, noise_col) = (col("name"), col("noise_radius"));
     let mut list = Vec::new();
-    for (line, row) in rows {
-        let f = split_csv_line(row);
+    while let Some(line) = table.next_row()? {
+        let f: Vec<&str> = table.fields().collect();
         let get = |c: Option<usize>| {
             c.and_then(|c| f.get(c))
                 .map(|s| s.trim())
@@ -178,36 +164,9 @@ fn unique(list: Vec<Dataset>) -> Result<Vec<Dataset>> {
     Ok(list)
 }
 
-/// Splits one CSV line, honouring double quotes (`""` inside quotes is a quote).
-pub fn split_csv_line(line: &str) -> Vec<String> {
-    let mut out = vec![String::new()];
-    let mut quoted = false;
-    let mut chars = line.chars().peekable();
-    while let Some(c) = chars.next() {
-        match (c, quoted) {
-            ('"', true) if chars.peek() == Some(&'"') => {
-                chars.next();
-                out.last_mut().expect("non-empty").push('"');
-            }
-            ('"', _) => quoted = !quoted,
-            (',', false) => out.push(String::new()),
-            _ => out.last_mut().expect("non-empty").push(c),
-        }
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn split_quotes() {
-        assert_eq!(
-            split_csv_line(r#"a,"b,c","d""e",f"#),
-            vec!["a", "b,c", "d\"e", "f"]
-        );
-    }
 
     #[test]
     fn safe_names() {

@@ -6,8 +6,8 @@
 //! `n_failing` (data the configured `r` does not explain), `data` (the file), `error` (one
 //! line, empty on success).
 
-use super::discover::split_csv_line;
 use super::runner::DatasetResult;
+use crate::data::table::TableReader;
 use crate::error::{Error, Result};
 use crate::report::csv::num;
 use std::fmt::Write;
@@ -87,25 +87,22 @@ pub fn render(rows: &[SummaryRow]) -> String {
 /// Parses `summary.csv` (for `rshape merge`).
 pub fn parse(text: &str, what: &str) -> Result<Vec<SummaryRow>> {
     let bad = |line: usize, m: String| Error::Invalid(format!("{what}:{line}: {m}"));
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    match lines.next() {
-        Some((_, h)) if h.trim() == HEADER => {}
-        _ => {
-            return Err(bad(
-                1,
-                format!("not a summary.csv: the header must be `{HEADER}`"),
-            ))
-        }
+    let mut table = TableReader::new(text.as_bytes(), std::path::Path::new(what), HEADER)
+        .map_err(|e| bad(1, e.to_string()))?;
+    if table.names.join(",") != HEADER {
+        return Err(bad(
+            table.header_line,
+            format!("not a summary.csv: the header must be `{HEADER}`"),
+        ));
     }
     let mut rows = Vec::new();
-    for (k, l) in lines {
-        let f = split_csv_line(l);
-        if f.len() != 9 {
-            return Err(bad(k + 1, format!("expected 9 fields, found {}", f.len())));
-        }
+    // The csv crate's parser: quoted names, paths and error messages with commas and `""`.
+    while let Some(line) = table
+        .next_row()
+        .map_err(|e| Error::Invalid(e.to_string()))?
+    {
+        let f: Vec<String> = table.fields().map(str::to_owned).collect();
+        let k = line - 1;
         let int = |s: &str| {
             s.parse::<usize>()
                 .map_err(|_| bad(k + 1, format!("`{s}` is not a count")))

@@ -31,7 +31,7 @@ pub struct BatchArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Noise radius for datasets without one in the manifest.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub noise_radius: Option<f64>,
     /// Process every N-th dataset starting at K (0-based), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
     #[arg(long, value_name = "K/N")]
@@ -40,7 +40,7 @@ pub struct BatchArgs {
     #[arg(long)]
     pub jobs: Option<usize>,
     /// Order of the r fitted above the combined envelope, or `auto` (sweep 0..8).
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: crate::fit::OrderChoice,
     /// Do not write OUT/datasets/NAME/ (only summary.csv, the combined envelope and r).
     #[arg(long)]
@@ -68,6 +68,15 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
         .transpose()?
         .unwrap_or(Shard::ALL);
     let datasets = shard.select(&all, |d| d.index);
+    let sources: Vec<&std::path::Path> = [
+        Some(a.config.as_path()),
+        a.data_dir.as_deref(),
+        a.manifest.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let _manifest = super::common::prepare_out(&a.out, &sources)?;
     let opts = runner::RunOptions {
         noise_radius: a.noise_radius,
         per_dataset_files: !a.no_dataset_files,

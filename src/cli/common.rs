@@ -1,10 +1,13 @@
 //! Arguments and loading shared by the subcommands that read a model and data.
 
 use crate::consistency::noisy::BisectionSettings;
+use crate::consistency::stream::noise_free_envelope_rows;
 use crate::consistency::{noise_free_envelope, noisy_envelope, Envelope};
+use crate::data::reader::FrfRows;
 use crate::data::FrfData;
 use crate::model::noise::noise_radii;
 use crate::model::Config;
+use crate::util::OutputManifest;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -18,7 +21,7 @@ pub struct InputArgs {
     #[arg(long)]
     pub data: Option<PathBuf>,
     /// Global noise-disk radius L_a overriding the config (noisy SISO data, Theorem 4).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub noise_radius: Option<f64>,
 }
 
@@ -34,16 +37,7 @@ impl InputArgs {
     /// Loads the config and the data (from `--data` or the config).
     pub fn load(&self) -> Result<Inputs> {
         let config = Config::load(&self.config)?;
-        let path = self
-            .data
-            .clone()
-            .or_else(|| config.data.clone())
-            .ok_or_else(|| {
-                anyhow!(
-                    "{}: no data file: add `data = \"FILE.csv\"` to the config or pass --data FILE",
-                    self.config.display()
-                )
-            })?;
+        let path = self.data_path(&config)?;
         let mut data = crate::pipeline::closed_loop::read_data(&config, &path)?;
         let f = &config.factorization;
         if let Some(ch) = config.raw.channel {
@@ -57,12 +51,61 @@ impl InputArgs {
                 data = data.channel(ch.output - 1, ch.input - 1);
             }
         }
-        if let Some(x) = self.noise_radius {
-            if !(x.is_finite() && x >= 0.0) {
-                return Err(anyhow!("--noise-radius {x}: must be a finite number ≥ 0"));
-            }
-        }
+        self.check_noise_radius()?;
         Ok(Inputs { config, data })
+    }
+
+    /// The data file: `--data`, else the config's `data`.
+    fn data_path(&self, config: &Config) -> Result<PathBuf> {
+        self.data
+            .clone()
+            .or_else(|| config.data.clone())
+            .ok_or_else(|| {
+                anyhow!(
+                    "{}: no data file: add `data = \"FILE.csv\"` to the config or pass --data FILE",
+                    self.config.display()
+                )
+            })
+    }
+
+    fn check_noise_radius(&self) -> Result<()> {
+        match self.noise_radius {
+            Some(x) if !(x.is_finite() && x >= 0.0) => {
+                Err(anyhow!("--noise-radius {x}: must be a finite number ≥ 0"))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The envelope alone, as [`envelope`](Self::envelope) computes it, but with the data
+    /// streamed when the noise-free theorems apply (no noise model, or all radii 0): then
+    /// memory stays at about 56 bytes per datum whatever the file size.
+    pub fn envelope_only(&self) -> Result<Envelope> {
+        let config = Config::load(&self.config)?;
+        self.check_noise_radius()?;
+        if config.closed_loop.is_some() {
+            return Ok(self.envelope()?.1);
+        }
+        let rows = FrfRows::open(&self.data_path(&config)?)?;
+        let sec = &config.raw.noise;
+        sec.validate()
+            .map_err(|e| anyhow!("{}: {e}", self.config.display()))?;
+        // The precedence of `model::noise::resolve_noise`: flag > config > data column.
+        let noise_free = match (self.noise_radius, sec.radius) {
+            (Some(x), _) | (None, Some(x)) => x == 0.0,
+            (None, None) => {
+                sec.output_bound.is_none() && config.noise_std.is_none() && !rows.has_noise_column()
+            }
+        };
+        if !noise_free {
+            return Ok(self.envelope()?.1);
+        }
+        let channel = config.raw.channel.map(|c| (c.output, c.input));
+        Ok(noise_free_envelope_rows(
+            &config.factorization,
+            rows,
+            channel,
+        )?)
     }
 
     /// Loads inputs and computes the envelope that fits them: noise-free (Theorem 2 or 3),
@@ -109,3 +152,33 @@ pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope>
 }
 
 pub use crate::report::fmt::{fmt_g, fmt_omegas};
+
+/// Checks `--out DIR` before any work and clears the previous run's files there (see
+/// [`OutputManifest`]).  `DIR` must not be an existing file, nor the folder of an input
+/// (outputs would mix with inputs).  Keep the guard alive while the run writes.
+pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result<OutputManifest> {
+    if out.exists() && !out.is_dir() {
+        return Err(anyhow!(
+            "--out {}: is an existing file; give a folder (it is created if needed)",
+            out.display()
+        ));
+    }
+    if let Ok(o) = out.canonicalize() {
+        for input in inputs {
+            let folder = match input.canonicalize() {
+                Ok(p) if p.is_dir() => p,
+                Ok(p) => p.parent().map(|p| p.to_path_buf()).unwrap_or(p),
+                Err(_) => continue,
+            };
+            if folder == o {
+                return Err(anyhow!(
+                    "--out {}: is the folder of the input {}; outputs would mix with inputs: choose a new folder such as {}",
+                    out.display(),
+                    input.display(),
+                    out.join("out").display()
+                ));
+            }
+        }
+    }
+    Ok(OutputManifest::begin(out)?)
+}

@@ -1,6 +1,7 @@
 //! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
 
 use super::common::{fmt_g, InputArgs};
+use crate::diagnose::agreement::data_vs_data;
 use crate::diagnose::compare::{compare, prepare, Band, CompareReport, PlantModel};
 use crate::diagnose::figures::bode_overlay;
 use anyhow::{anyhow, Result};
@@ -19,6 +20,11 @@ pub struct CompareArgs {
     /// Write the Bode overlay (data and model) to this SVG file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// Also test the data against a second experiment (data-vs-data consistency: do the
+    /// two noise disks intersect at the common frequencies?); its noise comes from the
+    /// config's rules (a `<stem>_std.csv` beside it, a noise_radius column, --noise-radius).
+    #[arg(long)]
+    pub against: Option<PathBuf>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -38,24 +44,15 @@ pub fn run_compare(
     input: &InputArgs,
     channel: Option<(usize, usize)>,
 ) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
-    let mut inputs = input.load()?;
-    let mut noise = input.noise_radius;
-    if inputs.config.closed_loop.is_some() {
-        // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
-        // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
-        let radii = crate::pipeline::integration::noise_radii(&inputs.config, &inputs.data, noise)?;
-        let eq = crate::pipeline::closed_loop::open_loop_equivalent(
-            &inputs.config,
-            &inputs.data,
-            radii.as_deref(),
-        )?;
-        inputs.data = eq.data;
-        inputs.config.raw.noise = Default::default();
-        inputs.config.noise_std = None;
-        // [v] weighs the closed-loop perturbation Δ̄, not the factor perturbations of r.
-        inputs.config.r = None;
-        noise = None;
-    }
+    let inputs = input.load()?;
+    // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
+    // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
+    let inputs = crate::pipeline::closed_loop::discovery_inputs(
+        inputs.config,
+        inputs.data,
+        input.noise_radius,
+    )?;
+    let noise = inputs.noise_radius;
     let siso = prepare(&inputs.config, &inputs.data, channel, noise)?;
     let model = PlantModel::from_config(&inputs.config);
     let rep = compare(&inputs.config, &model, &siso)?;
@@ -100,8 +97,26 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         )?;
         rep.figure = Some(path.display().to_string());
     }
+    let agreement = match &a.against {
+        Some(p) => {
+            let inputs = a.input.load()?;
+            let other = crate::data::read_frf_csv(p)?;
+            let sb = prepare(
+                &inputs.config,
+                &other,
+                Some(siso.channel),
+                a.input.noise_radius,
+            )?;
+            Some(data_vs_data(&siso, &sb)?)
+        }
+        None => None,
+    };
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&rep)?);
+        let mut v = serde_json::to_value(&rep)?;
+        if let Some(ag) = &agreement {
+            v["against"] = serde_json::to_value(ag)?;
+        }
+        println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(0);
     }
     println!("model:  {}", rep.config);
@@ -152,6 +167,22 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     );
     if let Some(f) = &rep.figure {
         println!("figure: {f}");
+    }
+    if let Some(ag) = &agreement {
+        println!(
+            "data vs data: {} against {} at {} common frequencies: distance_rms = {} (|G_a − G_b|/(r_a + r_b)), disagree at {} ({}){}",
+            rep.data,
+            ag.against,
+            ag.n_common,
+            fmt_g(ag.distance_rms),
+            crate::report::fmt::fmt_pct(ag.disagree_fraction),
+            fmt_bands(&ag.bands),
+            if ag.verdict == "agree" {
+                ": the two experiments agree within their noise"
+            } else {
+                ": the two experiments disagree by more than their noise, so no model can reach the noise on both"
+            }
+        );
     }
     Ok(0)
 }

@@ -3,8 +3,12 @@
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
-use crate::diagnose::candidates::sig;
-use crate::diagnose::{apply_candidate, diagnose, prepare, refit_nominal};
+use crate::diagnose::factor_form::physical_from_factors;
+use crate::diagnose::{
+    apply_candidate, diagnose_channels, misfit_channels, prepare, retune, Channels, Diagnosis,
+    Settings,
+};
+use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -15,12 +19,16 @@ pub struct DiagnoseArgs {
     /// Model and data.
     #[command(flatten)]
     pub input: InputArgs,
-    /// SISO channel of MIMO data, `OUT,IN` (1-based).
+    /// SISO channel of MIMO data, `OUT,IN` (1-based); without it (and without [channel])
+    /// every channel of the data is diagnosed jointly.
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
-    /// Most effects to add greedily.
+    /// Most effects to add.
     #[arg(long, default_value_t = 3)]
     pub max_effects: usize,
+    /// Effect sets kept per level of the search.
+    #[arg(long, default_value_t = 3)]
+    pub beam: usize,
     /// Add the K-th ranked candidate (1-based) and write the revised config (with --write).
     #[arg(long, requires = "write")]
     pub apply: Option<usize>,
@@ -49,119 +57,202 @@ fn rel_to(target: &Path, from_dir: &Path) -> PathBuf {
     p
 }
 
+/// The data channels to diagnose: the selected one, or every channel of MIMO data.
+fn channels(
+    a: &DiagnoseArgs,
+    inputs: &super::common::Inputs,
+    noise: Option<f64>,
+) -> Result<Channels> {
+    let config = &inputs.config;
+    let data = &inputs.data;
+    let chan = channel_arg(&a.channel)?;
+    if chan.is_none() && config.raw.channel.is_none() && (data.outputs() > 1 || data.inputs() > 1) {
+        return Ok(Channels::all(config, data, noise)?);
+    }
+    let siso = prepare(config, data, chan, noise)?;
+    Ok(Channels::from_siso(&siso)?)
+}
+
+fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
+    p.iter()
+        .map(|(n, v)| format!("{n} = {}", sig(*v)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
-    let inputs = a.input.load()?;
-    let config = &inputs.config;
-    let base = config.physical.clone().ok_or_else(|| {
-        anyhow!(
-            "{}: diagnose needs the model as [physical] (modes, rigid bodies, effects); see configs/robot_physical.toml",
-            config.path.display()
-        )
-    })?;
-    let siso = prepare(
-        config,
-        &inputs.data,
-        channel_arg(&a.channel)?,
+    let loaded = a.input.load()?;
+    // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,
+    // with the noise radii carried over to it, through the hook `compare` uses too.
+    let found = crate::pipeline::closed_loop::discovery_inputs(
+        loaded.config,
+        loaded.data,
         a.input.noise_radius,
     )?;
-    let d = diagnose(&base, &siso, a.max_effects.max(1))?;
+    let noise = found.noise_radius;
+    let raw = found.raw;
+    let inputs = super::common::Inputs {
+        config: found.config,
+        data: found.data,
+    };
+    let config = &inputs.config;
+    let base = match &config.physical {
+        Some(p) => p.clone(),
+        None => {
+            let p = physical_from_factors(&config.factorization).map_err(|why| {
+                anyhow!(
+                    "{}: diagnose adds effects to a [physical] model, and this factor form cannot be converted ({why}); `rshape compare` works on it as it is. To diagnose, write the plant as [physical] (configs/robot_physical.toml is the robot's factor form written by its physics)",
+                    config.path.display()
+                )
+            })?;
+            if !a.json {
+                println!(
+                    "{}: the [model] factor form is a modal special factorization: converted to [physical] ({} modes); effects are added to that form (--write writes [physical])",
+                    config.path.display(),
+                    p.mode.len()
+                );
+            }
+            p
+        }
+    };
+    let data = channels(a, &inputs, noise)?;
+    let settings = Settings {
+        max_effects: a.max_effects.max(1),
+        beam: a.beam.max(1),
+    };
+    let d = diagnose_channels(&base, &data, &settings)?;
     if let (Some(k), Some(out)) = (a.apply, &a.write) {
-        // The candidate, then a joint refit of every parameter (the configured ones too).
-        let applied = apply_candidate(&base, &d, k)?;
-        let radius = siso.radius.clone().unwrap_or_default();
-        let revised = refit_nominal(&applied, &siso.omega, &siso.g, &radius).model;
-        let gm: Vec<_> = siso.omega.iter().map(|w| revised.eval_siso(*w)).collect();
-        let (_, rms_refit, _, inv_refit) = crate::diagnose::compare::misfit(&siso, &gm);
-        let mut raw = config.raw.clone();
-        let c = &d.candidates[k - 1];
-        raw.physical = Some(revised);
-        raw.name = Some(format!(
-            "{} + {}",
-            raw.name
-                .clone()
-                .unwrap_or_else(|| config.path.display().to_string()),
-            c.effect
-        ));
-        let out_dir = out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        std::fs::create_dir_all(out_dir)?;
-        let base_dir = config.path.parent().unwrap_or(Path::new("."));
-        if let Some(dp) = &raw.data {
-            raw.data = Some(rel_to(&base_dir.join(dp), out_dir));
-        }
-        if let Some(sf) = &raw.noise.std_file {
-            raw.noise.std_file = Some(rel_to(&base_dir.join(sf), out_dir));
-        }
-        let text = toml::to_string_pretty(&raw)?;
-        let header = format!(
-            "# Revised by `rshape diagnose {} --apply {k}`: added {} ({}), then every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {} (effect alone) -> {} (joint refit), invalid_fraction {:.1} % -> {:.1} % -> {:.1} %.\n",
-            config.path.display(),
-            c.effect,
-            c.params
-                .iter()
-                .map(|(n, v)| format!("{n} = {}", sig(*v)))
-                .collect::<Vec<_>>()
-                .join(", "),
-            c.explanation,
-            siso.path.display(),
-            sig(c.misfit_rms_before),
-            sig(c.misfit_rms_after),
-            sig(rms_refit),
-            100.0 * c.invalid_fraction_before,
-            100.0 * c.invalid_fraction_after,
-            100.0 * inv_refit.unwrap_or(f64::NAN)
-        );
-        let full = format!("{header}{text}");
-        // The written file must load back.
-        crate::model::Config::parse(&full, out)
-            .map_err(|e| anyhow!("internal: the revised config does not parse: {e}"))?;
-        crate::util::write_atomic(out, full.as_bytes())?;
-        if !a.json {
-            println!("wrote {} (candidate {k}: {})", out.display(), c.effect);
-        }
+        write_revision(a, config, &raw, &data, &d, &base, k, out)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
         return Ok(0);
     }
-    println!(
-        "model: {}   data: {} (channel {},{}; {} data; noise: {})",
+    print_text(config, &data, &d, a.apply.is_none());
+    Ok(0)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_revision(
+    a: &DiagnoseArgs,
+    config: &crate::model::Config,
+    raw: &crate::model::config::RawConfig,
+    data: &Channels,
+    d: &Diagnosis,
+    base: &crate::model::physical::PhysicalModel,
+    k: usize,
+    out: &Path,
+) -> Result<()> {
+    // The candidate (already refit jointly when the search got to it), refit once more.
+    let applied = apply_candidate(base, d, k)?;
+    let revised = retune(&applied, data, None, false).model;
+    let (rms_refit, inv_refit) = misfit_channels(&revised, data);
+    // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
+    let mut raw = raw.clone();
+    let c = &d.candidates[k - 1];
+    raw.physical = Some(revised);
+    raw.model = None;
+    raw.name = Some(format!(
+        "{} + {}",
+        raw.name
+            .clone()
+            .unwrap_or_else(|| config.path.display().to_string()),
+        c.effect
+    ));
+    let out_dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(out_dir)?;
+    let base_dir = config.path.parent().unwrap_or(Path::new("."));
+    if let Some(dp) = &raw.data {
+        raw.data = Some(rel_to(&base_dir.join(dp), out_dir));
+    }
+    if let Some(sf) = &raw.noise.std_file {
+        raw.noise.std_file = Some(rel_to(&base_dir.join(sf), out_dir));
+    }
+    let text = toml::to_string_pretty(&raw)?;
+    let header = format!(
+        "# Revised by `rshape diagnose {} --apply {k}`: {} ({}), every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {}, invalid_fraction {} -> {}.\n",
         config.path.display(),
-        siso.path.display(),
-        siso.channel.0,
-        siso.channel.1,
-        d.n_data,
-        siso.radius_source
+        c.effect,
+        params_text(&c.params),
+        c.explanation,
+        data.path.display(),
+        sig(c.misfit_rms_before),
+        sig(rms_refit),
+        fmt_pct(c.invalid_fraction_before),
+        fmt_pct(inv_refit),
+    );
+    let full = format!("{header}{text}");
+    // The written file must load back.
+    crate::model::Config::parse(&full, out)
+        .map_err(|e| anyhow!("internal: the revised config does not parse: {e}"))?;
+    crate::util::write_atomic(out, full.as_bytes())?;
+    if !a.json {
+        println!("wrote {} (candidate {k}: {})", out.display(), c.effect);
+    }
+    Ok(())
+}
+
+fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hint_apply: bool) {
+    let chans = data
+        .entries
+        .iter()
+        .map(|(o, i)| format!("{},{}", o + 1, i + 1))
+        .collect::<Vec<_>>()
+        .join(" ");
+    println!(
+        "model: {}   data: {} (channel{} {chans}; {} frequencies; noise: {})",
+        config.path.display(),
+        data.path.display(),
+        if data.n_ch() > 1 { "s, jointly" } else { "" },
+        data.len(),
+        data.radius_source.join("; ")
     );
     println!(
-        "before: misfit_rms = {}, invalid_fraction = {:.1} %",
+        "before: misfit_rms = {}, invalid_fraction = {}",
         fmt_g(d.before.misfit_rms),
-        100.0 * d.before.invalid_fraction
+        fmt_pct(d.before.invalid_fraction)
+    );
+    if d.verdict == "consistent" {
+        println!("\nverdict: {}: {}", d.verdict, d.message);
+        return;
+    }
+    println!(
+        "retune (every configured parameter refit, nothing added): misfit_rms = {}, invalid_fraction = {}",
+        fmt_g(d.retuned.misfit_rms),
+        fmt_pct(d.retuned.invalid_fraction)
     );
     if !d.candidates.is_empty() {
-        println!("\ncandidates (ranked by ΔBIC = 2ΔV − n·ln 2F; pass = ΔBIC > 10, no more invalid data, holdout ok):");
+        println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, no more invalid data):");
         for c in &d.candidates {
+            if let Some(why) = &c.no_fit {
+                println!("{:>2}. {:<18} no fit: {why}", c.rank, c.effect);
+                continue;
+            }
             let params = c
                 .params
                 .iter()
                 .map(|(n, v)| match c.uncertainty_2sigma.get(n) {
-                    Some(u) if u.is_finite() => format!("{n} = {} ± {}", sig(*v), sig(*u)),
+                    Some(u) if u.is_finite() && *u > 0.0 => {
+                        format!("{n} = {} ± {}", sig(*v), sig(*u))
+                    }
                     _ => format!("{n} = {}", sig(*v)),
                 })
                 .collect::<Vec<_>>()
                 .join(", ");
             println!(
-                "{:>2}. {:<12} ΔBIC {:>10}  misfit_rms {} → {}  invalid {:.1} % → {:.1} %  {}{}",
+                "{:>2}. {:<18} ΔBIC {:>10}{}  misfit_rms {} → {}  invalid {} → {}  {}{}",
                 c.rank,
                 c.effect,
                 sig(c.delta_bic),
+                if c.joint_refit { "*" } else { " " },
                 sig(c.misfit_rms_before),
                 sig(c.misfit_rms_after),
-                100.0 * c.invalid_fraction_before,
-                100.0 * c.invalid_fraction_after,
+                fmt_pct(c.invalid_fraction_before),
+                fmt_pct(c.invalid_fraction_after),
                 if c.passes { "pass" } else { "-" },
                 if c.tie_with_best {
                     "  (tie with #1)"
@@ -169,8 +260,67 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
                     ""
                 }
             );
-            println!("    {params}");
+            if !params.is_empty() {
+                println!("    {params}");
+            }
+            for f in &c.flags {
+                println!("    flag: {f}");
+            }
             println!("    {}", c.explanation);
+        }
+    }
+    if !d.steps.is_empty() {
+        println!("\nchosen path (beam search, joint refit of every parameter at each node):");
+        for s in &d.steps {
+            println!(
+                "  step {}: + {} ({}) → misfit_rms {}, invalid {} (joint refit of {} parameters; before the refit {}, {})",
+                s.step,
+                s.effect,
+                params_text(&s.params),
+                sig(s.misfit_rms),
+                fmt_pct(s.invalid_fraction),
+                s.n_refit,
+                sig(s.misfit_rms_before_refit),
+                fmt_pct(s.invalid_fraction_before_refit)
+            );
+        }
+    }
+    if !d.final_effects.is_empty() {
+        println!("\nadded effects after the joint refit:");
+        for e in &d.final_effects {
+            println!("  {}: {}", e.effect, params_text(&e.params));
+        }
+    }
+    for h in &d.holdout {
+        println!(
+            "holdout {}: interleaved {}{}",
+            h.effect,
+            if h.interleaved_ok { "ok" } else { "FAILS" },
+            match h.extrapolation_ok {
+                Some(true) => ", extrapolation ok",
+                Some(false) => ", extrapolation fails",
+                None => "",
+            }
+        );
+    }
+    if !d.dropped.is_empty() {
+        println!("dropped by the holdout: {}", d.dropped.join(", "));
+    }
+    if !d.runner_up.is_empty() {
+        println!("\nrunner-up sets (BIC gap to the chosen set):");
+        for r in &d.runner_up {
+            println!(
+                "  {:<40} +{}  misfit_rms {}, invalid {}{}",
+                if r.effects.is_empty() {
+                    "(retune only)".to_string()
+                } else {
+                    r.effects.join(" + ")
+                },
+                sig(r.bic_gap),
+                sig(r.misfit_rms),
+                fmt_pct(r.invalid_fraction),
+                if r.consistent { " (consistent)" } else { "" }
+            );
         }
     }
     for t in &d.ties {
@@ -182,32 +332,18 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             t.disambiguation
         );
     }
-    if !d.steps.is_empty() {
-        println!("\ngreedy path (joint refit after each step):");
-        for s in &d.steps {
-            println!(
-                "  step {}: + {} ({}) → misfit_rms {}, invalid {:.1} % (joint refit of {} parameters; effect alone: {}, {:.1} %)",
-                s.step,
-                s.effect,
-                s.params
-                    .iter()
-                    .map(|(n, v)| format!("{n} = {}", sig(*v)))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-                sig(s.misfit_rms),
-                100.0 * s.invalid_fraction,
-                s.n_refit,
-                sig(s.misfit_rms_before_refit),
-                100.0 * s.invalid_fraction_before_refit
-            );
-        }
-    }
-    println!("\nverdict: {}: {}", d.verdict, d.message);
-    if !d.candidates.is_empty() && a.apply.is_none() {
+    println!(
+        "\nsearch: {} nodes expanded, {} joint refits, {} s (beam {})",
+        d.search.nodes_expanded,
+        d.search.joint_refits,
+        sig(d.search.seconds),
+        d.search.beam
+    );
+    println!("verdict: {}: {}", d.verdict, d.message);
+    if hint_apply && !d.candidates.is_empty() {
         println!(
             "add candidate K with: rshape diagnose {} --apply K --write NEW.toml",
             config.path.display()
         );
     }
-    Ok(0)
 }

@@ -1,9 +1,11 @@
 //! `rshape envelope CONFIG [--data FILE] --out DIR`: writes `DIR/envelope.csv`.
 
 use super::common::{fmt_g, fmt_omegas, InputArgs};
-use crate::report::envelope_csv;
+use crate::report::csv::write_envelope_csv;
+use crate::util::AtomicFile;
 use anyhow::Result;
 use clap::Args;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Arguments of `rshape envelope`.
@@ -19,14 +21,37 @@ pub struct EnvelopeArgs {
 
 /// Runs `rshape envelope`.
 pub fn run(a: &EnvelopeArgs) -> Result<i32> {
-    let (_inputs, env) = a.input.envelope()?;
+    let env = a.input.envelope_only()?;
+    let inputs: Vec<&std::path::Path> = [Some(a.input.config.as_path()), a.input.data.as_deref()]
+        .into_iter()
+        .flatten()
+        .collect();
+    let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     let path = a.out.join("envelope.csv");
-    crate::util::write_atomic(&path, envelope_csv(&env).as_bytes())?;
-    println!("{:>14} {:>14} {:>14}", "omega_rad_s", "r_min", "a1_limit");
+    let mut file = AtomicFile::create(&path)?;
+    write_envelope_csv(&env, file.writer()).map_err(|source| crate::error::Error::Io {
+        path: path.clone(),
+        source,
+    })?;
+    file.commit()?;
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    writeln!(
+        out,
+        "{:>14} {:>14} {:>14}",
+        "omega_rad_s", "r_min", "a1_limit"
+    )?;
     for (i, w) in env.omega.iter().enumerate() {
         let a1 = env.a1_limit.as_ref().map_or("-".into(), |a| fmt_g(a[i]));
-        println!("{:>14} {:>14} {:>14}", fmt_g(*w), fmt_g(env.r_min[i]), a1);
+        writeln!(
+            out,
+            "{:>14} {:>14} {:>14}",
+            fmt_g(*w),
+            fmt_g(env.r_min[i]),
+            a1
+        )?;
     }
+    out.flush()?;
+    drop(out);
     let beyond = env.beyond_a1();
     if !beyond.is_empty() {
         println!(

@@ -28,13 +28,13 @@ pub struct FitArgs {
     #[arg(long)]
     pub data: Option<PathBuf>,
     /// Global noise-disk radius L_a overriding the config.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub noise_radius: Option<f64>,
     /// Fit this envelope file (omega_rad_s,r_min[,a1_limit]) instead of a config.
     #[arg(long, conflicts_with_all = ["config", "data", "noise_radius"])]
     pub envelope: Option<PathBuf>,
     /// Order of r, or `auto` (sweep 0..8, print the table, pick the smallest good order).
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: OrderChoice,
     /// What to minimize.
     #[arg(long, value_enum, default_value = "minimax")]
@@ -66,6 +66,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     let outcome = match (&a.envelope, &a.config) {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
+            let _manifest = super::common::prepare_out(&a.out, &[path])?;
             run_fit(&env, None, &settings, a.order, &a.out)?
         }
         (None, Some(config)) => {
@@ -77,6 +78,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let (inputs, env) = input.envelope()?;
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
+            let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             run_fit(&env, Some(&a1), &settings, a.order, &a.out)?
         }
         (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),

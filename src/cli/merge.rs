@@ -17,7 +17,7 @@ pub struct MergeArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Order of the r fitted above the merged envelope, or `auto` (sweep 0..8).
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: crate::fit::OrderChoice,
 }
 

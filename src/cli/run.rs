@@ -19,7 +19,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Order of the fitted r, or `auto` (sweep 0..8 and pick the smallest good order).
-    #[arg(long, default_value = "auto")]
+    #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: crate::fit::OrderChoice,
 }
 
@@ -61,8 +61,12 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     let inputs = a.input.load()?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     let (config, data) = (&inputs.config, &inputs.data);
+    // Closed-loop configs shape the weight V of [v] (Crowder & de Callafon, eq. (2)).
+    let sym = crate::plot::Symbols::of(config.closed_loop.is_some());
+    let (w, wmin) = (sym.weight, sym.weight_min);
     let mut out = pipeline::run(config, data, a.input.noise_radius, a.order)?;
     out.timings.0.insert("load".into(), load_ms);
+    let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;
     let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;
 
     let name = rep
@@ -79,7 +83,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         if rep.noisy { "noisy" } else { "noise-free" }
     );
     outln!(
-        "  envelope  {:?}, max r_min = {}",
+        "  envelope  {:?}, max {wmin} = {}",
         rep.method,
         rep.max_r_min.map_or("-".into(), fmt_g)
     );
@@ -91,7 +95,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     }
     match rep.consistent {
         Some(true) => outln!(
-            "  check     CONSISTENT: the configured r explains all {} data",
+            "  check     CONSISTENT: the configured {w} explains all {} data",
             rep.n_data
         ),
         Some(false) => outln!(
@@ -100,18 +104,21 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             rep.n_data,
             list(&rep.failing_omegas)
         ),
-        None => outln!("  check     no [r] in the config: nothing to check"),
+        None => outln!(
+            "  check     no [{}] in the config: nothing to check",
+            w.to_lowercase()
+        ),
     }
     let coeffs = |c: &[f64]| c.iter().map(|x| fmt_g(*x)).collect::<Vec<_>>().join(", ");
     match (&out.fit, &rep.r_fitted) {
         // Up to order 3 the coefficients fit on a line; beyond, r.json has them.
         (Ok(f), Some(j)) if f.r.den.degree() <= 3 => outln!(
-            "  fit       r = ({})/({}) [{}]",
+            "  fit       {w} = ({})/({}) [{}]",
             coeffs(f.r.num.coeffs()),
             coeffs(f.r.den.coeffs()),
             fit_tag(j)
         ),
-        (Ok(_), Some(j)) => outln!("  fit       r: {} (coefficients in r.json)", fit_tag(j)),
+        (Ok(_), Some(j)) => outln!("  fit       {w}: {} (coefficients in r.json)", fit_tag(j)),
         _ => outln!(
             "  fit       failed: {}",
             rep.fit_error.clone().unwrap_or_default()

@@ -69,12 +69,17 @@ impl Envelope {
 
 /// Checks that the data have the sizes the model needs.
 pub fn check_sizes(f: &Factorization, data: &FrfData) -> Result<()> {
-    if data.outputs() != f.outputs() || data.inputs() != f.inputs() {
+    check_shape(f, &data.path, data.outputs(), data.inputs())
+}
+
+/// Checks that `p×m` data read from `path` have the sizes the model needs.
+pub fn check_shape(f: &Factorization, path: &std::path::Path, p: usize, m: usize) -> Result<()> {
+    if p != f.outputs() || m != f.inputs() {
         return Err(Error::Invalid(format!(
             "{}: the data are {}×{} (outputs×inputs) but the model is {}×{}; select a channel or fix the model",
-            data.path.display(),
-            data.outputs(),
-            data.inputs(),
+            path.display(),
+            p,
+            m,
             f.outputs(),
             f.inputs()
         )));

@@ -4,6 +4,7 @@ pub mod closed_loop;
 pub mod envelope;
 pub mod noise_free;
 pub mod noisy;
+pub mod stream;
 
 pub use check::{check, CheckReport, CheckRow};
 pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};

@@ -322,6 +322,18 @@ impl<'r> TableReader<'r> {
             if self.fields().all(str::is_empty) || self.field(0).starts_with('#') {
                 continue;
             }
+            if self.text.contains(['\n', '\r']) {
+                let k = (0..self.ends.len())
+                    .find(|&k| self.field(k).contains(['\n', '\r']))
+                    .unwrap_or(0);
+                return Err(self.err(
+                    start,
+                    format!(
+                        "field {} runs over several lines (a `\"` without its closing `\"`?): close or remove the quote",
+                        k + 1
+                    ),
+                ));
+            }
             if self.text.contains('\0') {
                 return Err(self.err(
                     start,
@@ -390,6 +402,11 @@ impl<'r> TableReader<'r> {
     /// Whether the first column is `freq_hz` (true) or `omega_rad_s` (false).
     pub fn first_column_is_hz(&self) -> Result<bool> {
         first_column_is_hz(&self.path, self.header_line, &self.names)
+    }
+
+    /// The file read.
+    pub fn path(&self) -> &Path {
+        &self.path
     }
 }
 

@@ -1,49 +1,85 @@
 //! Candidate missing effects: how each one modifies the model, its parameters (internal and
-//! SI), and how it is written back into a physical model.
+//! SI), its bounds, and how it is written back into a physical model.
 //!
-//! The current SISO model at datum `k` is held as `G_k = core_k · path_k` (the additive
-//! dynamics times the product of the path effects).  A candidate either multiplies `path`
-//! (delay, lag, gain, sign, ZOH, NMP zero) or changes `core` (added mode, shifted or
-//! re-damped mode, integrator or rigid body, feedthrough).  Positive parameters are fitted
+//! The current model at datum `k` of channel `(o, i)` is held as `G = core · path` (the
+//! additive dynamics times the product of the path effects).  A candidate either multiplies
+//! `path` (delay, lag, gain, sign, ZOH, NMP zero: on every channel, on one output or on one
+//! input, [`Sel`]) or changes `core` (added mode, shifted or re-damped mode, integrator or
+//! rigid body, feedthrough).  An added mode is the modal model of effects.md: one `ω_n`
+//! and `ζ` shared by every channel and a residue per channel.  Positive parameters are fitted
 //! in logarithms.
 
 use crate::model::physical::{
-    EffectKind, EffectSpec, Feedthrough, ModeSpec, PhysicalModel, PoleAtZeroSpec,
+    EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
 use num_complex::Complex64;
 
+pub use crate::report::fmt::{fmt_change, fmt_w, sig};
+
+/// The channels a multiplicative effect acts on (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sel {
+    /// Every channel.
+    All,
+    /// The channels of one output (a sensor effect).
+    Output(usize),
+    /// The channels of one input (an actuator effect).
+    Input(usize),
+}
+
+impl Sel {
+    /// True when the effect acts on the model entry `(output, input)`.
+    pub fn hits(&self, entry: (usize, usize)) -> bool {
+        match self {
+            Sel::All => true,
+            Sel::Output(o) => entry.0 == *o,
+            Sel::Input(i) => entry.1 == *i,
+        }
+    }
+
+    fn suffix(&self) -> String {
+        match self {
+            Sel::All => String::new(),
+            Sel::Output(o) => format!(" (output {})", o + 1),
+            Sel::Input(i) => format!(" (input {})", i + 1),
+        }
+    }
+}
+
 /// A candidate effect.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Cand {
     /// Pure delay `e^{−sτ}`; θ = [τ] (s, |τ| used).
-    Delay,
+    Delay(Sel),
     /// First-order lag; θ = [ln ω_c].
-    Lag,
+    Lag(Sel),
     /// Gain; θ = [k].
-    Gain,
+    Gain(Sel),
     /// Sign flip; no parameter.
-    Sign,
-    /// Added mode `ρ/(s² + 2ζω s + ω²)`; θ = [ln ω_n, ln ζ, ρ].
+    Sign(Sel),
+    /// Added mode `ρ_ch/(s² + 2ζω s + ω²)`; θ = [ln ω_n, ln ζ, ρ_1 … ρ_C] (one residue per
+    /// channel, shared `ω_n` and `ζ`).
     Mode,
     /// Shifted frequency of mode `i` (0-based) of the base model; θ = [ln ω_n].
     ModeShift(usize),
     /// Changed damping of mode `i`; θ = [ln ζ].
     Damping(usize),
-    /// Added `c/s^order` (order 1: integrator, 2: rigid body); θ = [c].
+    /// Added `c_ch/s^order` (order 1: integrator, 2: rigid body); θ = [c_1 … c_C].
     Integrator(u8),
-    /// Added feedthrough; θ = [d].
+    /// Added feedthrough; θ = [d_1 … d_C].
     Feedthrough,
     /// NMP zero all-pass; θ = [ln z].
-    NmpZero,
+    NmpZero(Sel),
     /// Zero-order hold; θ = [ln T].
-    Zoh,
+    Zoh(Sel),
     /// Viscous friction on rigid body `i` of the base model: `1/s²` becomes
-    /// `1/(s (s + p))`; θ = [ln p].  (An extension beyond the list.)
+    /// `1/(s (s + p))`; θ = [ln p].
     Friction(usize),
 }
 
-/// The effect names of the JSON output.
-pub const EFFECT_NAMES: [&str; 12] = [
+/// The effect names of the JSON output (`retune` is the refit of the configured parameters).
+pub const EFFECT_NAMES: [&str; 13] = [
+    "retune",
     "delay",
     "lag",
     "gain",
@@ -58,34 +94,56 @@ pub const EFFECT_NAMES: [&str; 12] = [
     "friction",
 ];
 
+/// Lower and upper bound of a damping ratio.
+pub const ZETA_BOUNDS: (f64, f64) = (1e-4, 0.7);
+
 fn clamp_zeta(z: f64) -> f64 {
-    z.clamp(1e-4, 0.7)
+    z.clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1)
+}
+
+/// The residue `c_o b_i / m` of a term at a model entry.
+pub fn residue(c: &Gains, b: &Gains, m: f64, p: usize, n_in: usize, e: (usize, usize)) -> f64 {
+    c.to_vec(p)[e.0] * b.to_vec(n_in)[e.1] / m
 }
 
 impl Cand {
     /// The effect name.
     pub fn name(&self) -> &'static str {
         match self {
-            Cand::Delay => "delay",
-            Cand::Lag => "lag",
-            Cand::Gain => "gain",
-            Cand::Sign => "sign",
+            Cand::Delay(_) => "delay",
+            Cand::Lag(_) => "lag",
+            Cand::Gain(_) => "gain",
+            Cand::Sign(_) => "sign",
             Cand::Mode => "mode",
             Cand::ModeShift(_) => "mode_shift",
             Cand::Damping(_) => "damping",
             Cand::Integrator(_) => "integrator",
             Cand::Feedthrough => "feedthrough",
-            Cand::NmpZero => "nmp_zero",
-            Cand::Zoh => "zoh",
+            Cand::NmpZero(_) => "nmp_zero",
+            Cand::Zoh(_) => "zoh",
             Cand::Friction(_) => "friction",
         }
     }
 
-    /// Number of fitted parameters.
-    pub fn n_params(&self) -> usize {
+    /// The name with the channel selection (`delay (output 2)`).
+    pub fn label(&self) -> String {
         match self {
-            Cand::Sign => 0,
-            Cand::Mode => 3,
+            Cand::Delay(s)
+            | Cand::Lag(s)
+            | Cand::Gain(s)
+            | Cand::Sign(s)
+            | Cand::NmpZero(s)
+            | Cand::Zoh(s) => format!("{}{}", self.name(), s.suffix()),
+            _ => self.name().into(),
+        }
+    }
+
+    /// Number of fitted parameters with `n_ch` channels.
+    pub fn n_params(&self, n_ch: usize) -> usize {
+        match self {
+            Cand::Sign(_) => 0,
+            Cand::Mode => 2 + n_ch,
+            Cand::Integrator(_) | Cand::Feedthrough => n_ch,
             _ => 1,
         }
     }
@@ -94,143 +152,245 @@ impl Cand {
     pub fn multiplicative(&self) -> bool {
         matches!(
             self,
-            Cand::Delay | Cand::Lag | Cand::Gain | Cand::Sign | Cand::NmpZero | Cand::Zoh
+            Cand::Delay(_)
+                | Cand::Lag(_)
+                | Cand::Gain(_)
+                | Cand::Sign(_)
+                | Cand::NmpZero(_)
+                | Cand::Zoh(_)
         )
     }
 
     /// Typical magnitude of each internal parameter (for finite differences).
     pub fn typ(&self, theta: &[f64], omega_max: f64) -> Vec<f64> {
         match self {
-            Cand::Delay => vec![1.0 / omega_max],
-            Cand::Mode => vec![1.0, 1.0, theta[2].abs().max(1e-300)],
-            Cand::Gain | Cand::Integrator(_) | Cand::Feedthrough => {
-                vec![theta[0].abs().max(1e-300)]
+            Cand::Delay(_) => vec![1.0 / omega_max],
+            Cand::Mode => {
+                let mut v = vec![1.0, 1.0];
+                v.extend(theta[2..].iter().map(|x| x.abs().max(1e-300)));
+                v
             }
-            Cand::Sign => vec![],
+            Cand::Gain(_) | Cand::Integrator(_) | Cand::Feedthrough => {
+                theta.iter().map(|x| x.abs().max(1e-300)).collect()
+            }
+            Cand::Sign(_) => vec![],
             _ => vec![1.0],
         }
     }
 
-    /// Modifies `(core, path)` at `ω` with parameters `th`; `base` gives the modes that
-    /// `ModeShift` and `Damping` refer to.
+    /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`
+    /// (effects.md step 3): an added mode resonates inside the band (an out-of-band one is a
+    /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [1e-4, 0.7]`,
+    /// corners and zeros within two decades of the band, a delay below 100/ω_min.
+    pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+        let free = (f64::NEG_INFINITY, f64::INFINITY);
+        let lz = (ZETA_BOUNDS.0.ln(), ZETA_BOUNDS.1.ln());
+        match self {
+            Cand::Delay(_) => vec![(-100.0 / w_min, 100.0 / w_min)],
+            Cand::Lag(_) | Cand::NmpZero(_) => vec![((w_min / 100.0).ln(), (w_max * 100.0).ln())],
+            Cand::Zoh(_) => vec![((0.01 / w_max).ln(), (100.0 / w_min).ln())],
+            Cand::Gain(_) => vec![(-1e3, 1e3)],
+            Cand::Sign(_) => vec![],
+            Cand::Mode => {
+                let mut v = vec![(w_min.ln(), w_max.ln()), lz];
+                v.extend(std::iter::repeat_n(free, n_ch));
+                v
+            }
+            Cand::ModeShift(_) => vec![(w_min.ln(), w_max.ln())],
+            Cand::Damping(_) => vec![lz],
+            Cand::Integrator(_) | Cand::Feedthrough => vec![free; n_ch],
+            Cand::Friction(_) => vec![((w_min / 1e3).ln(), (w_max * 10.0).ln())],
+        }
+    }
+
+    /// Modifies `(core, path)` of channel `ch` (model entry `entry`) at `ω` with parameters
+    /// `th`; `base` gives the modes that `ModeShift`, `Damping` and `Friction` refer to.
+    #[allow(clippy::too_many_arguments)]
     pub fn modify(
         &self,
         th: &[f64],
         base: &PhysicalModel,
         omega: f64,
+        ch: usize,
+        entry: (usize, usize),
         core: &mut Complex64,
         path: &mut Complex64,
     ) {
         let s = Complex64::new(0.0, omega);
         let one = Complex64::new(1.0, 0.0);
         let mode_term = |w: f64, z: f64, rho: f64| rho / (s * s + 2.0 * z * w * s + w * w);
+        let (p, m) = (base.n_outputs(), base.n_inputs());
         match self {
-            Cand::Delay => *path *= (-s * th[0].abs()).exp(),
-            Cand::Lag => *path /= one + s / th[0].exp(),
-            Cand::Gain => *path *= th[0],
-            Cand::Sign => *path = -*path,
-            Cand::NmpZero => {
+            Cand::Delay(sel) if sel.hits(entry) => *path *= (-s * th[0].abs()).exp(),
+            Cand::Lag(sel) if sel.hits(entry) => *path /= one + s / th[0].exp(),
+            Cand::Gain(sel) if sel.hits(entry) => *path *= th[0],
+            Cand::Sign(sel) if sel.hits(entry) => *path = -*path,
+            Cand::NmpZero(sel) if sel.hits(entry) => {
                 let z = th[0].exp();
                 *path *= (one - s / z) / (one + s / z)
             }
-            Cand::Zoh => {
+            Cand::Zoh(sel) if sel.hits(entry) => {
                 let t = th[0].exp();
                 let x = omega * t / 2.0;
                 let sinc = if x.abs() < 1e-8 { 1.0 } else { x.sin() / x };
                 *path *= (-s * t / 2.0).exp() * sinc
             }
-            Cand::Mode => *core += mode_term(th[0].exp(), clamp_zeta(th[1].exp()), th[2]),
+            Cand::Mode => *core += mode_term(th[0].exp(), clamp_zeta(th[1].exp()), th[2 + ch]),
             Cand::ModeShift(i) | Cand::Damping(i) => {
-                let m = &base.mode[*i];
-                let rho = m.output_gain.to_vec(1)[0] * m.input_gain.to_vec(1)[0] / m.mass;
+                let md = &base.mode[*i];
+                let rho = residue(&md.output_gain, &md.input_gain, md.mass, p, m, entry);
                 let (w, z) = match self {
-                    Cand::ModeShift(_) => (th[0].exp(), m.zeta),
-                    _ => (m.omega_n, clamp_zeta(th[0].exp())),
+                    Cand::ModeShift(_) => (th[0].exp(), md.zeta),
+                    _ => (md.omega_n, clamp_zeta(th[0].exp())),
                 };
-                *core += mode_term(w, z, rho) - mode_term(m.omega_n, m.zeta, rho);
+                *core += mode_term(w, z, rho) - mode_term(md.omega_n, md.zeta, rho);
             }
-            Cand::Integrator(order) => *core += th[0] / s.powi(*order as i32),
+            Cand::Integrator(order) => *core += th[ch] / s.powi(*order as i32),
             Cand::Friction(i) => {
                 let r = &base.rigid_body[*i];
-                let rho = r.output_gain.to_vec(1)[0] * r.input_gain.to_vec(1)[0] / r.mass;
+                let rho = residue(&r.output_gain, &r.input_gain, r.mass, p, m, entry);
                 let p0 = r.friction_pole.unwrap_or(0.0);
                 *core += rho / (s * (s + th[0].exp())) - rho / (s * (s + p0));
             }
-            Cand::Feedthrough => *core += th[0],
+            Cand::Feedthrough => *core += th[ch],
+            _ => {}
         }
     }
 
-    /// The SI parameters `(name, value)` from the internal ones, and the factor that turns
-    /// an internal standard deviation into an SI one.
-    pub fn si_params(&self, th: &[f64]) -> Vec<(&'static str, f64, f64)> {
+    /// The SI parameters `(name, value, factor)` from the internal ones; `factor` turns an
+    /// internal standard deviation into an SI one (0 for labels).  Per-channel residues are
+    /// named `rho`, `c`, `d` for one channel, else `rho_<out>_<in>` (1-based).
+    pub fn si_params(&self, th: &[f64], entries: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
         let e = |x: f64| x.exp();
+        let per_ch = |name: &str, off: usize| -> Vec<(String, f64, f64)> {
+            entries
+                .iter()
+                .enumerate()
+                .map(|(ch, (o, i))| {
+                    let n = if entries.len() == 1 {
+                        name.to_string()
+                    } else {
+                        format!("{name}_{}_{}", o + 1, i + 1)
+                    };
+                    (n, th[off + ch], 1.0)
+                })
+                .collect()
+        };
+        let one = |n: &str, v: f64, f: f64| vec![(n.to_string(), v, f)];
         match self {
-            Cand::Delay => vec![("tau_s", th[0].abs(), 1.0)],
-            Cand::Lag => vec![("omega_c", e(th[0]), e(th[0]))],
-            Cand::Gain => vec![("k", th[0], 1.0)],
-            Cand::Sign => vec![],
-            Cand::Mode => vec![
-                ("omega_n", e(th[0]), e(th[0])),
-                ("zeta", clamp_zeta(e(th[1])), clamp_zeta(e(th[1]))),
-                ("rho", th[2], 1.0),
-            ],
-            Cand::ModeShift(i) => vec![
-                ("mode", (*i + 1) as f64, 0.0),
-                ("omega_n", e(th[0]), e(th[0])),
-            ],
-            Cand::Damping(i) => vec![
-                ("mode", (*i + 1) as f64, 0.0),
-                ("zeta", clamp_zeta(e(th[0])), clamp_zeta(e(th[0]))),
-            ],
-            Cand::Integrator(o) => vec![("order", *o as f64, 0.0), ("c", th[0], 1.0)],
-            Cand::Feedthrough => vec![("d", th[0], 1.0)],
-            Cand::NmpZero => vec![("z", e(th[0]), e(th[0]))],
-            Cand::Zoh => vec![("t_s", e(th[0]), e(th[0]))],
-            Cand::Friction(i) => vec![
-                ("rigid_body", (*i + 1) as f64, 0.0),
-                ("pole", e(th[0]), e(th[0])),
-            ],
+            Cand::Delay(_) => one("tau_s", th[0].abs(), 1.0),
+            Cand::Lag(_) => one("omega_c", e(th[0]), e(th[0])),
+            Cand::Gain(_) => one("k", th[0], 1.0),
+            Cand::Sign(_) => vec![],
+            Cand::Mode => {
+                let mut v = one("omega_n", e(th[0]), e(th[0]));
+                let z = clamp_zeta(e(th[1]));
+                v.extend(one("zeta", z, z));
+                v.extend(per_ch("rho", 2));
+                v
+            }
+            Cand::ModeShift(i) => {
+                let mut v = one("mode", (*i + 1) as f64, 0.0);
+                v.extend(one("omega_n", e(th[0]), e(th[0])));
+                v
+            }
+            Cand::Damping(i) => {
+                let mut v = one("mode", (*i + 1) as f64, 0.0);
+                let z = clamp_zeta(e(th[0]));
+                v.extend(one("zeta", z, z));
+                v
+            }
+            Cand::Integrator(o) => {
+                let mut v = one("order", *o as f64, 0.0);
+                v.extend(per_ch("c", 0));
+                v
+            }
+            Cand::Feedthrough => per_ch("d", 0),
+            Cand::NmpZero(_) => one("z", e(th[0]), e(th[0])),
+            Cand::Zoh(_) => one("t_s", e(th[0]), e(th[0])),
+            Cand::Friction(i) => {
+                let mut v = one("rigid_body", (*i + 1) as f64, 0.0);
+                v.extend(one("pole", e(th[0]), e(th[0])));
+                v
+            }
         }
     }
 
-    /// Writes the effect into a physical model (SISO).
-    pub fn apply_to(&self, th: &[f64], m: &mut PhysicalModel, note: &str) {
-        let p: std::collections::HashMap<&str, f64> = self
-            .si_params(th)
-            .iter()
-            .map(|(n, v, _)| (*n, *v))
-            .collect();
-        let mut effect = |kind: EffectKind, set: &dyn Fn(&mut EffectSpec)| {
+    /// Writes the effect into a physical model.  An additive term with a residue per
+    /// channel is written as output gains (one input) or input gains (one output).
+    pub fn apply_to(
+        &self,
+        th: &[f64],
+        entries: &[(usize, usize)],
+        m: &mut PhysicalModel,
+        note: &str,
+    ) {
+        let (p_out, m_in) = (m.n_outputs(), m.n_inputs());
+        let si = self.si_params(th, entries);
+        let get = |n: &str| si.iter().find(|x| x.0 == n).map(|x| x.1).unwrap_or(0.0);
+        // (input gains, output gains) carrying the per-channel residues θ[off..].
+        let gains = |off: usize| -> (Gains, Gains) {
+            let mut v = vec![0.0; if m_in == 1 { p_out } else { m_in }];
+            for (ch, (o, i)) in entries.iter().enumerate() {
+                v[if m_in == 1 { *o } else { *i }] = th[off + ch];
+            }
+            let g = |v: Vec<f64>| {
+                if v.len() == 1 {
+                    Gains::Scalar(v[0])
+                } else {
+                    Gains::Vector(v)
+                }
+            };
+            let unit = |n: usize| g(vec![1.0; n]);
+            if m_in == 1 {
+                (unit(1), g(v))
+            } else {
+                (g(v), unit(p_out))
+            }
+        };
+        let mut effect = |kind: EffectKind, sel: &Sel, set: &dyn Fn(&mut EffectSpec)| {
             let mut e = EffectSpec::new(kind);
             set(&mut e);
+            match sel {
+                Sel::All => {}
+                Sel::Output(o) => {
+                    e.path = EffectPath::Output;
+                    e.channel = Some(o + 1);
+                }
+                Sel::Input(i) => e.channel = Some(i + 1),
+            }
             e.note = Some(note.to_string());
             m.effect.push(e);
         };
         match self {
-            Cand::Delay => effect(EffectKind::Delay, &|e| e.tau_s = Some(p["tau_s"])),
-            Cand::Lag => effect(EffectKind::Lag, &|e| e.omega_c = Some(p["omega_c"])),
-            Cand::Gain => effect(EffectKind::Gain, &|e| e.k = Some(p["k"])),
-            Cand::Sign => effect(EffectKind::Sign, &|_| {}),
-            Cand::NmpZero => effect(EffectKind::NmpZero, &|e| e.z = Some(p["z"])),
-            Cand::Zoh => effect(EffectKind::Zoh, &|e| e.t_s = Some(p["t_s"])),
-            Cand::Mode => m.mode.push(ModeSpec {
-                name: Some(note.to_string()),
-                omega_n: p["omega_n"],
-                zeta: p["zeta"],
-                mass: 1.0,
-                input_gain: crate::model::physical::Gains::Scalar(1.0),
-                output_gain: crate::model::physical::Gains::Scalar(p["rho"]),
-            }),
-            Cand::ModeShift(i) => m.mode[*i].omega_n = p["omega_n"],
-            Cand::Friction(i) => m.rigid_body[*i].friction_pole = Some(p["pole"]),
-            Cand::Damping(i) => m.mode[*i].zeta = p["zeta"],
+            Cand::Delay(s) => effect(EffectKind::Delay, s, &|e| e.tau_s = Some(get("tau_s"))),
+            Cand::Lag(s) => effect(EffectKind::Lag, s, &|e| e.omega_c = Some(get("omega_c"))),
+            Cand::Gain(s) => effect(EffectKind::Gain, s, &|e| e.k = Some(get("k"))),
+            Cand::Sign(s) => effect(EffectKind::Sign, s, &|_| {}),
+            Cand::NmpZero(s) => effect(EffectKind::NmpZero, s, &|e| e.z = Some(get("z"))),
+            Cand::Zoh(s) => effect(EffectKind::Zoh, s, &|e| e.t_s = Some(get("t_s"))),
+            Cand::Mode => {
+                let (b, c) = gains(2);
+                m.mode.push(ModeSpec {
+                    name: Some(note.to_string()),
+                    omega_n: get("omega_n"),
+                    zeta: get("zeta"),
+                    mass: 1.0,
+                    input_gain: b,
+                    output_gain: c,
+                })
+            }
+            Cand::ModeShift(i) => m.mode[*i].omega_n = get("omega_n"),
+            Cand::Friction(i) => m.rigid_body[*i].friction_pole = Some(get("pole")),
+            Cand::Damping(i) => m.mode[*i].zeta = get("zeta"),
             Cand::Integrator(o) => {
+                let (b, c) = gains(0);
                 let spec = PoleAtZeroSpec {
                     friction_pole: None,
                     name: Some(note.to_string()),
                     mass: 1.0,
-                    input_gain: crate::model::physical::Gains::Scalar(1.0),
-                    output_gain: crate::model::physical::Gains::Scalar(p["c"]),
+                    input_gain: b,
+                    output_gain: c,
                 };
                 if *o == 2 {
                     m.rigid_body.push(spec)
@@ -239,119 +399,131 @@ impl Cand {
                 }
             }
             Cand::Feedthrough => {
-                let old = match &m.feedthrough {
-                    Some(Feedthrough::Scalar(d)) => *d,
-                    Some(Feedthrough::Matrix(r)) => r[0][0],
-                    None => 0.0,
+                let mut d = match &m.feedthrough {
+                    Some(Feedthrough::Scalar(d)) => vec![vec![*d]],
+                    Some(Feedthrough::Matrix(r)) => r.clone(),
+                    None => vec![vec![0.0; m_in]; p_out],
                 };
-                m.feedthrough = Some(Feedthrough::Scalar(old + p["d"]));
+                for (ch, (o, i)) in entries.iter().enumerate() {
+                    d[*o][*i] += th[ch];
+                }
+                m.feedthrough = Some(if p_out * m_in == 1 {
+                    Feedthrough::Scalar(d[0][0])
+                } else {
+                    Feedthrough::Matrix(d)
+                });
             }
         }
     }
 }
 
-/// Formats a frequency in rad/s with Hz beside it.
-pub fn fmt_w(w: f64) -> String {
-    format!("{} rad/s ({} Hz)", sig(w), sig(w / std::f64::consts::TAU))
-}
-
-/// 4 significant digits.
-pub fn sig(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let d = (3 - x.abs().log10().floor() as i32).max(0) as usize;
-    if x.abs() >= 1e-3 && x.abs() < 1e6 {
-        format!("{x:.d$}")
-    } else {
-        format!("{x:.3e}")
-    }
-}
-
 /// A plain-language explanation of the candidate's signature in the data.
-pub fn explain(c: &Cand, th: &[f64], base: &PhysicalModel, omega: &[f64]) -> String {
-    let p: std::collections::HashMap<&str, f64> =
-        c.si_params(th).iter().map(|(n, v, _)| (*n, *v)).collect();
+pub fn explain(
+    c: &Cand,
+    th: &[f64],
+    entries: &[(usize, usize)],
+    base: &PhysicalModel,
+    omega: &[f64],
+) -> String {
+    let si = c.si_params(th, entries);
+    let p = |n: &str| {
+        si.iter()
+            .find(|x| x.0 == n)
+            .map(|x| x.1)
+            .unwrap_or(f64::NAN)
+    };
+    let list = |prefix: &str| {
+        si.iter()
+            .filter(|x| x.0.starts_with(prefix))
+            .map(|x| sig(x.1))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     let wmax = omega.last().copied().unwrap_or(1.0);
+    let on = match c {
+        Cand::Delay(s) | Cand::Lag(s) | Cand::Gain(s) | Cand::NmpZero(s) | Cand::Zoh(s) => {
+            s.suffix()
+        }
+        _ => String::new(),
+    };
     match c {
-        Cand::Delay => format!(
-            "phase falls linearly with frequency while magnitude matches: a pure delay of {} ms ({}° of extra lag at {})",
-            sig(p["tau_s"] * 1e3),
-            sig((wmax * p["tau_s"]).to_degrees()),
+        Cand::Delay(_) => format!(
+            "phase falls linearly with frequency while magnitude matches: a pure delay{on} of {} ms ({}° of extra lag at {})",
+            sig(p("tau_s") * 1e3),
+            sig((wmax * p("tau_s")).to_degrees()),
             fmt_w(wmax)
         ),
-        Cand::Lag => format!(
-            "magnitude droops and phase lags towards −90° above the corner, with no linear phase: a first-order lag (actuator or sensor) at ω_c = {}",
-            fmt_w(p["omega_c"])
+        Cand::Lag(_) => format!(
+            "magnitude droops and phase lags towards −90° above the corner, with no linear phase: a first-order lag{on} (actuator or sensor) at ω_c = {}",
+            fmt_w(p("omega_c"))
         ),
-        Cand::Gain => format!(
-            "the ratio data/model is flat in magnitude with zero phase: a gain error, k = {} ({:+.1} %)",
-            sig(p["k"]),
-            100.0 * (p["k"] - 1.0)
+        Cand::Gain(_) => format!(
+            "the ratio data/model is flat in magnitude with zero phase: a gain error{on}, k = {} ({})",
+            sig(p("k")),
+            fmt_change(p("k"))
         ),
-        Cand::Sign => "the data are the model rotated by 180° at every frequency with matching magnitude: a sign flip".into(),
+        Cand::Sign(_) => "the data are the model rotated by 180° at every frequency with matching magnitude: a sign flip".into(),
         Cand::Mode => format!(
             "the misfit peaks at {} with a half-power width 2ζω_n = {} rad/s, and data/model shows a peak–notch pair: an unmodelled mode, ω_n = {}, ζ = {}, residue {}",
-            fmt_w(p["omega_n"]),
-            sig(2.0 * p["zeta"] * p["omega_n"]),
-            fmt_w(p["omega_n"]),
-            sig(p["zeta"]),
-            sig(p["rho"])
+            fmt_w(p("omega_n")),
+            sig(2.0 * p("zeta") * p("omega_n")),
+            fmt_w(p("omega_n")),
+            sig(p("zeta")),
+            list("rho")
         ),
         Cand::ModeShift(i) => {
             let old = base.mode[*i].omega_n;
             format!(
-                "the data resonate at {} where mode {} of the model resonates at {}: the error is antisymmetric about the mode (peak at the true frequency, notch at the model's): mode {} shifted by {:+.1} %",
-                fmt_w(p["omega_n"]),
+                "the data resonate at {} where mode {} of the model resonates at {}: mode {} shifted by {}",
+                fmt_w(p("omega_n")),
                 i + 1,
                 fmt_w(old),
                 i + 1,
-                100.0 * (p["omega_n"] / old - 1.0)
+                fmt_change(p("omega_n") / old)
             )
         }
         Cand::Damping(i) => {
             let old = base.mode[*i].zeta;
             format!(
-                "the error is symmetric about mode {} at {} and the peak height is off by about ζ_model/ζ_true = {}: its damping is ζ = {} instead of {}",
+                "the error is symmetric about mode {} at {}: its damping is ζ = {} instead of {}",
                 i + 1,
                 fmt_w(base.mode[*i].omega_n),
-                sig(old / p["zeta"]),
-                sig(p["zeta"]),
+                sig(p("zeta")),
                 sig(old)
             )
         }
         Cand::Integrator(2) => format!(
-            "the error grows as 1/ω² towards low frequency (−40 dB/dec, phase of a double integrator): a missing rigid-body mode c/s², c = {}",
-            sig(p["c"])
+            "the error grows as 1/ω² towards low frequency (−40 dB/dec, phase of a double integrator): a missing rigid-body mode (or a mode below the band: a mass line) c/s², c = {}",
+            list("c")
         ),
         Cand::Integrator(_) => format!(
             "the error grows as 1/ω towards low frequency (−20 dB/dec, −90°): a missing integrator c/s, c = {}",
-            sig(p["c"])
+            list("c")
         ),
         Cand::Feedthrough => format!(
-            "the error is a constant real term, flat in frequency, that dominates where the model rolls off and moves the anti-resonances: a feedthrough (residual compliance) D = {}",
-            sig(p["d"])
+            "the error is a constant real term, flat in frequency, that dominates where the model rolls off and moves the anti-resonances: a feedthrough (residual compliance of modes above the band) D = {}",
+            list("d")
         ),
-        Cand::NmpZero => format!(
-            "magnitude matches but phase falls and saturates towards −180° (−90° at {}): a non-minimum-phase zero at z = {}",
-            fmt_w(p["z"]),
-            fmt_w(p["z"])
+        Cand::NmpZero(_) => format!(
+            "magnitude matches but phase falls and saturates towards −180° (−90° at {}): a non-minimum-phase zero{on} at z = {}",
+            fmt_w(p("z")),
+            fmt_w(p("z"))
         ),
         Cand::Friction(i) => format!(
             "the phase leads −180° at low frequency by atan(p/ω) and the lead fades with frequency, while the magnitude follows the rigid body: viscous friction on rigid body {}, pole p = c_v/J = {}",
             i + 1,
-            fmt_w(p["pole"])
+            fmt_w(p("pole"))
         ),
-        Cand::Zoh => format!(
-            "phase falls linearly (mean delay T/2 = {} ms) and magnitude droops like sinc(ωT/2) ({} dB at {}): a zero-order hold with T = {} ms (fs = {} Hz)",
-            sig(p["t_s"] * 5e2),
+        Cand::Zoh(_) => format!(
+            "phase falls linearly (mean delay T/2 = {} ms) and magnitude droops like sinc(ωT/2) ({} dB at {}): a zero-order hold{on} with T = {} ms (fs = {} Hz)",
+            sig(p("t_s") * 5e2),
             sig(20.0 * {
-                let x = wmax * p["t_s"] / 2.0;
+                let x = wmax * p("t_s") / 2.0;
                 (x.sin() / x).abs().log10()
             }),
             fmt_w(wmax),
-            sig(p["t_s"] * 1e3),
-            sig(1.0 / p["t_s"])
+            sig(p("t_s") * 1e3),
+            sig(1.0 / p("t_s"))
         ),
     }
 }

@@ -91,7 +91,7 @@ where
         for _ in 0..12 {
             let mut a = jtj.clone();
             for i in 0..n {
-                a[(i, i)] += lambda * jtj[(i, i)].max(1e-12 * dmax);
+                a[(i, i)] += lambda * jtj[(i, i)].max(1e-6 * dmax);
             }
             let step = match a.cholesky() {
                 Some(c) => c.solve(&(-&g)),

@@ -1,69 +1,72 @@
-//! What `rshape diagnose` reports: ranked candidates, ties, the greedy steps and the
-//! verdict (the JSON names of the `--json` output).
+//! What `rshape diagnose` reports: the retune, the ranked first-level candidates, the chosen
+//! effect set with its runner-ups and ties, the path that led to it, the final holdout and
+//! the verdict (the JSON names of the `--json` output).
 
 use super::candidates::Cand;
 use super::compare::Band;
-use super::engine::{Measures, Mods};
+use super::problem::Measures;
 use crate::model::physical::PhysicalModel;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-/// A fitted candidate.
+/// A fitted candidate of the first level (on top of the retuned model), or the retune.
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateReport {
-    /// Rank (1-based, by ΔBIC).
+    /// Rank (1-based, by ΔBIC against the configured model).
     pub rank: usize,
-    /// Effect name.
+    /// Effect name (`retune`, `mode`, `delay`, `delay (output 2)` …).
     pub effect: String,
-    /// Fitted parameters in SI units (frequencies in rad/s).
+    /// Fitted parameters in SI units (frequencies in rad/s); empty when there is no fit.
     pub params: BTreeMap<String, f64>,
-    /// Two standard deviations of each fitted parameter (from `(2JᵀJ)⁻¹`).
+    /// Two standard deviations of each fitted parameter (from `(2JᵀJ)⁻¹`, the candidate
+    /// fitted alone).
     pub uncertainty_2sigma: BTreeMap<String, f64>,
-    /// Cost before and after.
+    /// Cost of the configured model.
     pub v_before: f64,
-    /// Cost after.
+    /// Cost with the candidate (after the joint refit when `joint_refit`).
     pub v_after: f64,
-    /// Error measures before.
+    /// Error measures of the configured model.
     pub misfit_rms_before: f64,
-    /// After.
+    /// With the candidate.
     pub misfit_rms_after: f64,
-    /// Invalid fraction before.
+    /// Invalid fraction of the configured model.
     pub invalid_fraction_before: f64,
-    /// After.
+    /// With the candidate.
     pub invalid_fraction_after: f64,
-    /// `2(V₀ − V) − n_θ ln(2F)`.
+    /// `2(V_configured − V) − n_new·ln(2F)`: the score every candidate (the retune too) is
+    /// ranked by.
     pub delta_bic: f64,
-    /// Number of new parameters.
+    /// The same against the retuned model (the acceptance test of an added effect).
+    pub delta_bic_vs_retune: f64,
+    /// Number of new parameters (0 for the retune).
     pub n_params: usize,
-    /// Both holdout checks pass (`holdout_interleaved_ok` and, for a global candidate,
-    /// `holdout_extrapolation_ok`).
-    pub holdout_ok: bool,
-    /// Fitted on 3 of every 4 data, the held-out quarter's `V` falls.
-    pub holdout_interleaved_ok: bool,
-    /// Global (multiplicative) candidates only: fitted below 70 % of the band (log
-    /// frequency), the top 30 % is predicted better than by the model without it. `None`
-    /// for local candidates, or when either part holds fewer than 8 data.
-    pub holdout_extrapolation_ok: Option<bool>,
-    /// Passes all acceptance tests.
+    /// True when the numbers are after the joint refit of every parameter.
+    pub joint_refit: bool,
+    /// Passes: ΔBIC > 10 against the retuned model (the configured one for the retune),
+    /// invalid fraction not higher, physically plausible (no flags).
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
     pub tie_with_best: bool,
+    /// Plausibility flags (a parameter at its bound, a mode outside the band).
+    pub flags: Vec<String>,
+    /// Why there is no usable fit (`None` when there is one).
+    pub no_fit: Option<String>,
     /// Plain-language signature.
     pub explanation: String,
     /// Bands the candidate explains (invalid before, valid after).
     pub explained_bands: Vec<Band>,
-    /// The candidate itself.
+    /// The candidate (`None` for the retune).
     #[serde(skip)]
-    pub cand: Cand,
-    /// All parameters of the jointly refit model (accepted effects first).
+    pub cand: Option<Cand>,
+    /// The revised model (candidate added, jointly refit when `joint_refit`).
     #[serde(skip)]
-    pub mods: Mods,
+    pub model: PhysicalModel,
 }
 
-/// A tie between the best candidate and another.
+/// A tie between two effects or two effect sets.
 #[derive(Debug, Clone, Serialize)]
 pub struct Tie {
-    /// The two effects.
+    /// The two effects (or sets, joined by ` + `).
     pub effects: [String; 2],
     /// BIC gap.
     pub bic_gap: f64,
@@ -71,14 +74,14 @@ pub struct Tie {
     pub disambiguation: String,
 }
 
-/// One greedy step.
+/// One step of the chosen path.
 #[derive(Debug, Clone, Serialize)]
 pub struct Step {
     /// 1-based.
     pub step: usize,
-    /// Accepted effect.
+    /// Added effect.
     pub effect: String,
-    /// Its parameters (after the joint refit).
+    /// Its parameters (fitted alone on the previous model).
     pub params: BTreeMap<String, f64>,
     /// Explanation.
     pub explanation: String,
@@ -86,41 +89,110 @@ pub struct Step {
     pub misfit_rms: f64,
     /// After the step.
     pub invalid_fraction: f64,
-    /// ΔBIC of the step (the effect alone, before the joint refit).
+    /// ΔBIC of the step after the joint refit.
     pub delta_bic: f64,
-    /// `misfit_rms` with the effect added, before the joint refit of the nominal parameters.
+    /// `misfit_rms` with the effect added, before the joint refit.
     pub misfit_rms_before_refit: f64,
     /// `invalid_fraction` before the joint refit.
     pub invalid_fraction_before_refit: f64,
-    /// Number of parameters refit jointly (the model's own and every accepted effect's).
+    /// Number of parameters refit jointly.
     pub n_refit: usize,
-    /// Ties reported at this step.
+    /// Ties reported at this step (kept for compatibility; set ties are in `Diagnosis::ties`).
     pub ties: Vec<Tie>,
+}
+
+/// An effect set explored by the search.
+#[derive(Debug, Clone, Serialize)]
+pub struct EffectSet {
+    /// The effects (in the order added).
+    pub effects: Vec<String>,
+    /// `2V + n_θ ln(2F)` of the jointly refit model.
+    pub bic: f64,
+    /// BIC minus the chosen set's.
+    pub bic_gap: f64,
+    /// Measures.
+    pub misfit_rms: f64,
+    /// Measures.
+    pub invalid_fraction: f64,
+    /// Explained within the noise.
+    pub consistent: bool,
+}
+
+/// An effect in the final model, with its parameters after the joint refit.
+#[derive(Debug, Clone, Serialize)]
+pub struct FinalEffect {
+    /// Effect label.
+    pub effect: String,
+    /// Parameters (SI, rad/s).
+    pub params: BTreeMap<String, f64>,
+}
+
+/// The final-set holdout of one effect.
+#[derive(Debug, Clone, Serialize)]
+pub struct Holdout {
+    /// Effect label.
+    pub effect: String,
+    /// Fitted on 3 of every 4 data, the held-out quarter's `V` is lower with the effect than
+    /// without it.
+    pub interleaved_ok: bool,
+    /// Multiplicative effects: fitted below 70 % of the band, the top 30 % is predicted
+    /// better with it (`None` for additive effects or too few data).
+    pub extrapolation_ok: Option<bool>,
+}
+
+/// Search statistics.
+#[derive(Debug, Clone, Serialize, Default)]
+pub struct SearchStats {
+    /// Beam width.
+    pub beam: usize,
+    /// Nodes whose candidates were screened.
+    pub nodes_expanded: usize,
+    /// Joint refits of every parameter.
+    pub joint_refits: usize,
+    /// Wall time, s.
+    pub seconds: f64,
 }
 
 /// The diagnosis.
 #[derive(Debug, Clone, Serialize)]
 pub struct Diagnosis {
-    /// `consistent` (nothing to add), `effects_found`, or `no_effect_found` (inconsistent,
-    /// but no candidate passes).
+    /// `consistent` (nothing to do), `retuned` (the refit of the configured parameters
+    /// explains the data: nothing added), `effects_found`, or `no_effect_found`.
     pub verdict: String,
     /// Human summary.
     pub message: String,
-    /// Number of data.
+    /// Number of complex data (frequencies × channels).
     pub n_data: usize,
+    /// Number of channels diagnosed jointly.
+    pub n_channels: usize,
     /// Measures of the model as given.
     pub before: Measures,
-    /// Measures after the accepted effects.
+    /// Measures after the retune (no effect added).
+    pub retuned: Measures,
+    /// Measures of the final model.
     pub after: Measures,
-    /// Candidates of the first step, ranked (what `--apply K` refers to).
+    /// First-level candidates (the retune and each effect on top of it), ranked (what
+    /// `--apply K` refers to).
     pub candidates: Vec<CandidateReport>,
-    /// Ties among the first-step candidates.
+    /// Ties among the first-level candidates and between the chosen set and a runner-up.
     pub ties: Vec<Tie>,
-    /// The greedy path.
+    /// The chosen path.
     pub steps: Vec<Step>,
-    /// Expected `V` of a right model (`F − n_θ/2`), and the achieved `V`.
+    /// The chosen effect set.
+    pub chosen: Vec<String>,
+    /// The next best sets.
+    pub runner_up: Vec<EffectSet>,
+    /// Final-set holdout per effect.
+    pub holdout: Vec<Holdout>,
+    /// Effects the final holdout removed.
+    pub dropped: Vec<String>,
+    /// The added effects with their jointly refit parameters.
+    pub final_effects: Vec<FinalEffect>,
+    /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
-    /// The model after the greedy steps (effects added, everything refit jointly).
+    /// Search statistics.
+    pub search: SearchStats,
+    /// The final model (effects added, everything refit jointly).
     #[serde(skip)]
     pub final_model: PhysicalModel,
 }

@@ -191,3 +191,59 @@ pub fn open_loop_equivalent(
     }
     Ok(OpenLoopEquivalent { data: out, dropped })
 }
+
+/// What the open-loop discovery tools (`compare`, `diagnose`) work on: the config, the
+/// data and the `--noise-radius` override, after [`discovery_inputs`].
+#[derive(Debug, Clone)]
+pub struct DiscoveryInputs {
+    /// The config; for closed-loop data its noise settings are cleared (they were radii on
+    /// `Φ`, now carried by `data.noise_radius`) and `r` is `None` (`[v]` weighs `Δ̄`, not the
+    /// factor perturbations of `r`).
+    pub config: Config,
+    /// Open-loop frequency-response data of the plant, with their noise radii.
+    pub data: FrfData,
+    /// The `--noise-radius` override to pass on (`None` for closed-loop data: it was a
+    /// radius on `Φ` and is in `data.noise_radius` now).
+    pub noise_radius: Option<f64>,
+    /// The config as written, unchanged (for `diagnose --apply --write`, which writes the
+    /// revised model back into it).
+    pub raw: crate::model::config::RawConfig,
+    /// Frequencies (rad/s) dropped by [`open_loop_equivalent`].
+    pub dropped: Vec<f64>,
+}
+
+/// Turns (config, data, `--noise-radius`) into what the open-loop discovery tools need:
+/// unchanged for an open-loop config; for a closed-loop config, the open-loop equivalent
+/// `P₀ = (I − ΦC̄)⁻¹Φ` with the noise radii on `Φ` (`--noise-radius`, `[noise]`, a
+/// `noise_radius` column) propagated to `P₀` ([`open_loop_equivalent`]).  This is the one
+/// hook `compare` and `diagnose` call before their own entry points (item 6 of issue 9):
+/// the nominal `P̂` they compare with is `[physical]` (or the factors of `[closed_loop]`).
+pub fn discovery_inputs(
+    config: Config,
+    data: FrfData,
+    noise_radius: Option<f64>,
+) -> Result<DiscoveryInputs> {
+    let raw = config.raw.clone();
+    if config.closed_loop.is_none() {
+        return Ok(DiscoveryInputs {
+            config,
+            data,
+            noise_radius,
+            raw,
+            dropped: Vec::new(),
+        });
+    }
+    let radii = integration::noise_radii(&config, &data, noise_radius)?;
+    let eq = open_loop_equivalent(&config, &data, radii.as_deref())?;
+    let mut config = config;
+    config.raw.noise = Default::default();
+    config.noise_std = None;
+    config.r = None;
+    Ok(DiscoveryInputs {
+        config,
+        data: eq.data,
+        noise_radius: None,
+        raw,
+        dropped: eq.dropped,
+    })
+}

@@ -7,7 +7,9 @@ use crate::consistency::EnvelopeMethod;
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::Config;
-use crate::plot::{bode_svg, mu_svg, r_vs_delta_svg, BodeInput, MuInput, RVsDeltaInput};
+use crate::plot::{
+    bode_svg, mu_svg_with, r_vs_delta_svg_with, BodeInput, MuInput, RVsDeltaInput, Symbols,
+};
 use crate::report::envelope_csv;
 use crate::report::run_report::RunReport;
 use crate::system::logspace;
@@ -33,7 +35,9 @@ pub fn r_min_label(m: EnvelopeMethod) -> &'static str {
         EnvelopeMethod::Theorem4Mu => "smallest |r| per datum, μ bisection (Thm 4)",
         EnvelopeMethod::File => "smallest |r| per datum",
         EnvelopeMethod::ClosedLoopTheorem1 => "|Δ̄ᵢ| from the closed-loop datum (Thm 1, Cor. 1–2)",
-        EnvelopeMethod::ClosedLoopTheorem2 => "smallest |V| per datum, closed-loop μ (Thm 2)",
+        EnvelopeMethod::ClosedLoopTheorem2 => {
+            "smallest |V| per datum: min |Δ̄ᵢ| over the noise (Thm 2)"
+        }
     }
 }
 
@@ -99,23 +103,26 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
     let mut svgs = Vec::new();
     let cl = config.closed_loop.is_some();
     let title = if cl {
-        format!("Closed loop: |Δ_V| per datum vs |V(jω)| — {name}")
+        format!("Closed loop: |Δ̄| per datum vs |V(jω)| — {name}")
     } else {
         format!("Smallest consistent |r| per datum vs |r(jω)| — {name}")
     };
     svgs.push((
         "r_vs_delta.svg".to_string(),
-        r_vs_delta_svg(&RVsDeltaInput {
-            title: &title,
-            omega: &env.omega,
-            r_min: &env.r_min,
-            r_min_label: r_min_label(env.method),
-            failing: &failing,
-            r_configured: config.r.as_ref(),
-            r_fitted: out.fit.as_ref().ok().map(|f| &f.r),
-            grid: &grid,
-            a1_on_grid: a1.as_deref(),
-        })?,
+        r_vs_delta_svg_with(
+            &RVsDeltaInput {
+                title: &title,
+                omega: &env.omega,
+                r_min: &env.r_min,
+                r_min_label: r_min_label(env.method),
+                failing: &failing,
+                r_configured: config.r.as_ref(),
+                r_fitted: out.fit.as_ref().ok().map(|f| &f.r),
+                grid: &grid,
+                a1_on_grid: a1.as_deref(),
+            },
+            &Symbols::of(cl),
+        )?,
     ));
     let model: Vec<_> = grid
         .iter()
@@ -145,11 +152,14 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         };
         svgs.push((
             "mu.svg".to_string(),
-            mu_svg(&MuInput {
-                title: &title,
-                omega: &env.omega,
-                mu,
-            })?,
+            mu_svg_with(
+                &MuInput {
+                    title: &title,
+                    omega: &env.omega,
+                    mu,
+                },
+                &Symbols::of(cl),
+            )?,
         ));
     }
     Ok(svgs)

@@ -13,7 +13,9 @@ pub mod mu;
 pub mod r_vs_delta;
 pub mod stability;
 pub mod style;
+pub mod symbols;
 
 pub use bode::{bode_svg, BodeInput};
-pub use mu::{mu_svg, MuInput};
-pub use r_vs_delta::{r_vs_delta_svg, RVsDeltaInput};
+pub use mu::{mu_svg, mu_svg_with, MuInput};
+pub use r_vs_delta::{r_vs_delta_svg, r_vs_delta_svg_with, RVsDeltaInput};
+pub use symbols::Symbols;

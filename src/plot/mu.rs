@@ -3,6 +3,7 @@
 //! a datum is consistent with the model, `r` and the noise level iff `μ_Γ > 1` there.
 
 use super::style::*;
+use super::symbols::Symbols;
 use crate::error::Result;
 use plotters::prelude::*;
 
@@ -16,8 +17,15 @@ pub struct MuInput<'a> {
     pub mu: &'a [f64],
 }
 
-/// Renders `mu.svg` on log-log axes; data with `μ ≤ 1` are highlighted.
+/// Renders `mu.svg` on log-log axes with the open-loop symbols (`μ_Γ`, `r`); data with
+/// `μ ≤ 1` are highlighted.
 pub fn mu_svg(inp: &MuInput) -> Result<String> {
+    mu_svg_with(inp, &Symbols::OPEN_LOOP)
+}
+
+/// Renders `mu.svg`, naming `μ` and the weight by `sym`.
+pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
+    let (mu_name, w) = (sym.mu, sym.weight);
     let (xlo, xhi) = omega_range(inp.omega);
     let (ylo, yhi) =
         log_range(inp.mu.iter().chain(std::iter::once(&1.0)), 2.5).unwrap_or((0.1, 10.0));
@@ -30,7 +38,7 @@ pub fn mu_svg(inp: &MuInput) -> Result<String> {
             inp.title,
             (xlo, xhi),
             (ylo, yhi),
-            "μ_Γ (dimensionless)",
+            &format!("{mu_name} (dimensionless)"),
         )?;
         let s = C_GREY.stroke_width(2);
         chart
@@ -64,7 +72,7 @@ pub fn mu_svg(inp: &MuInput) -> Result<String> {
                     .map(|p| Circle::new((p.0, p.1), 3, C_BLUE.filled())),
             )
             .map_err(plot_err)?
-            .label("μ_Γ per datum, configured r (consistent)")
+            .label(format!("{mu_name} per datum, configured {w} (consistent)"))
             .legend(|(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()));
         if pts.iter().any(|p| !p.2) {
             chart
@@ -74,7 +82,7 @@ pub fn mu_svg(inp: &MuInput) -> Result<String> {
                         + Cross::new((0, 0), 4, C_RED.stroke_width(2))
                 }))
                 .map_err(plot_err)?
-                .label("μ_Γ ≤ 1: FAILING datum")
+                .label(format!("{mu_name} ≤ 1: FAILING datum"))
                 .legend(|(x, y)| {
                     EmptyElement::at((x + 12, y))
                         + Circle::new((0, 0), 6, C_RED.stroke_width(2))

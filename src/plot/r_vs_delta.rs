@@ -3,6 +3,7 @@
 //! Theorem 4 bisection values), on log-log axes, with the A1 limit `σ_min(M̃(jω))`.
 
 use super::style::{self, *};
+use super::symbols::Symbols;
 use crate::error::Result;
 use crate::system::TransferFunction;
 use plotters::prelude::*;
@@ -29,8 +30,14 @@ pub struct RVsDeltaInput<'a> {
     pub a1_on_grid: Option<&'a [f64]>,
 }
 
-/// Renders `r_vs_delta.svg`.
+/// Renders `r_vs_delta.svg` with the open-loop symbols (`r`).
 pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
+    r_vs_delta_svg_with(inp, &Symbols::OPEN_LOOP)
+}
+
+/// Renders `r_vs_delta.svg`, naming the weight and its per-datum minimum by `sym`.
+pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String> {
+    let (w, wmin) = (sym.weight, sym.weight_min);
     let mag =
         |r: &TransferFunction| -> Vec<f64> { inp.grid.iter().map(|w| r.freq(*w).norm()).collect() };
     let conf = inp.r_configured.map(mag);
@@ -88,7 +95,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 .draw_series(LineSeries::new(curve(c), s))
                 .map_err(plot_err)?
                 .label(format!(
-                    "|r(jω)|, configured r = {}",
+                    "|{w}(jω)|, configured {w} = {}",
                     tf_label(inp.r_configured.expect("set"))
                 ))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
@@ -99,7 +106,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 .draw_series(DashedLineSeries::new(curve(f), 12, 4, s))
                 .map_err(plot_err)?
                 .label(format!(
-                    "|r(jω)|, fitted r = {}",
+                    "|{w}(jω)|, fitted {w} = {}",
                     tf_label(inp.r_fitted.expect("set"))
                 ))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
@@ -119,7 +126,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
                 .map_err(plot_err)?
                 .label(if inp.r_configured.is_some() {
-                    format!("{}: explained by the configured r", inp.r_min_label)
+                    format!("{}: explained by the configured {w}", inp.r_min_label)
                 } else {
                     inp.r_min_label.to_string()
                 })
@@ -135,7 +142,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 }))
                 .map_err(plot_err)?
                 .label(format!(
-                    "{}: FAILING, configured |r(jω)| ≤ r_min",
+                    "{}: FAILING, configured |{w}(jω)| ≤ {wmin}",
                     inp.r_min_label
                 ))
                 .legend(|(x, y)| {
@@ -160,7 +167,9 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                         .map(|p| EmptyElement::at(*p) + Polygon::new(tri((0, 0)), C_RED.filled())),
                 )
                 .map_err(plot_err)?
-                .label("r_min = ∞: no admissible r explains the datum (drawn at the top)")
+                .label(format!(
+                    "{wmin} = ∞: no admissible {w} explains the datum (drawn at the top)"
+                ))
                 .legend(move |(x, y)| Polygon::new(tri((x + 12, y - 6)), C_RED.filled()));
         }
         let zeros: Vec<(f64, f64)> = inp
@@ -181,7 +190,7 @@ pub fn r_vs_delta_svg(inp: &RVsDeltaInput) -> Result<String> {
                 )
                 .map_err(plot_err)?
                 .label(format!(
-                    "r_min = 0 at {} data: explained by the noise alone (drawn at the bottom)",
+                    "{wmin} = 0 at {} data: explained by the noise alone (drawn at the bottom)",
                     zeros.len()
                 ))
                 .legend(move |(x, y)| Polygon::new(tri((x + 12, y + 4)), col.filled()));

@@ -35,8 +35,16 @@ pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
     }
     let mut bands: Vec<(f64, f64, usize)> = Vec::new();
     let mut prev_idx: Option<usize> = None;
+    // Both lists are sorted: one forward walk finds every index (linear, not quadratic).
+    let mut cursor = 0;
     for w in flagged {
-        let idx = all.iter().position(|x| x == w);
+        let idx = all[cursor..]
+            .iter()
+            .position(|x| x == w)
+            .map(|k| cursor + k);
+        if let Some(i) = idx {
+            cursor = i + 1;
+        }
         match (bands.last_mut(), prev_idx, idx) {
             (Some(b), Some(p), Some(i)) if i == p + 1 => {
                 b.1 = *w;
@@ -57,4 +65,80 @@ pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// A number with 4 significant digits (fixed notation from 1e-3 to 1e6, else scientific);
+/// a non-finite value prints as `no fit` (never `inf` or `NaN` in a report).
+pub fn sig(x: f64) -> String {
+    if !x.is_finite() {
+        return "no fit".into();
+    }
+    if x == 0.0 {
+        return "0".into();
+    }
+    let d = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+    if x.abs() >= 1e-3 && x.abs() < 1e6 {
+        format!("{x:.d$}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
+/// A frequency in rad/s with Hz beside it, 4 significant digits each.
+pub fn fmt_w(w: f64) -> String {
+    if !w.is_finite() {
+        return "no fit".into();
+    }
+    format!("{} rad/s ({} Hz)", sig(w), sig(w / std::f64::consts::TAU))
+}
+
+/// A relative change `x − 1` as a signed percentage with 3 significant digits
+/// (`+12.3 %`, `−0.412 %`); beyond ±1e4 % it prints as a factor (`×250`), and a non-finite
+/// ratio as `no fit`.
+pub fn fmt_change(ratio: f64) -> String {
+    if !ratio.is_finite() {
+        return "no fit".into();
+    }
+    let pct = 100.0 * (ratio - 1.0);
+    if pct.abs() >= 1e4 {
+        return format!("×{}", sig(ratio));
+    }
+    if pct == 0.0 {
+        return "+0 %".into();
+    }
+    let mag = pct.abs().log10().floor() as i32;
+    let mut d = (2 - mag).clamp(0, 3) as usize;
+    // −9.9999 rounds to −10.0: one decimal fewer once rounding carries into the next decade.
+    let scale = 10f64.powi(d as i32);
+    if d > 0 && (pct.abs() * scale).round() / scale >= 10f64.powi(mag + 1) {
+        d -= 1;
+    }
+    format!("{pct:+.d$} %")
+}
+
+/// A share in `[0, 1]` as a percentage with one decimal.
+pub fn fmt_pct(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".into();
+    }
+    format!("{:.1} %", 100.0 * x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_print_with_sensible_digits_and_never_as_inf() {
+        assert_eq!(sig(1234.5678), "1235");
+        assert_eq!(sig(0.012345), "0.01235");
+        assert_eq!(sig(7.5e45), "7.500e45");
+        assert_eq!(sig(f64::INFINITY), "no fit");
+        assert_eq!(fmt_change(1.05), "+5.00 %");
+        assert_eq!(fmt_change(0.9), "-10.0 %");
+        assert_eq!(fmt_change(1.6e56), "×1.600e56");
+        assert_eq!(fmt_change(f64::NAN), "no fit");
+        assert_eq!(fmt_w(f64::INFINITY), "no fit");
+        assert_eq!(fmt_pct(0.1234), "12.3 %");
+    }
 }

@@ -27,7 +27,9 @@
 //! At load time both loops `(P̂, C)` and `(P̂, C̄)` are checked for internal stability
 //! ([`stability::check_loop`]): the paper needs both (`M` of eq. (6) is stable iff `C̄`
 //! stabilizes `P̂`).
+pub mod physical_nominal;
 pub mod stability;
+pub mod stability_ss;
 
 use super::config::TfEntry;
 use crate::system::{TfMatrix, TransferFunction};
@@ -226,14 +228,27 @@ impl ClosedLoopModel {
     /// Builds and validates the model from the table: sizes, stable factors, and internal
     /// stability of `(P̂, C)` and `(P̂, C̄)`.  Every message names the key or the loop.
     pub fn build(s: &ClosedLoopSection) -> Result<Self, String> {
-        let plant = factors(
+        Self::build_with_plant(s, None)
+    }
+
+    /// As [`Self::build`], with the nominal's factors given from outside (`[physical]`,
+    /// see [`physical_nominal`]) when `[closed_loop]` does not give the plant itself.
+    pub fn build_with_plant(
+        s: &ClosedLoopSection,
+        nominal: Option<RightFactors>,
+    ) -> Result<Self, String> {
+        let own = factors(
             &s.plant,
             &s.n_hat,
             &s.d_hat,
             ("plant", "n_hat", "d_hat"),
             "the nominal plant",
-        )?
-        .ok_or("[closed_loop]: the nominal plant is missing: add plant = [[...]] (stable plant) or n_hat and d_hat (a right coprime factorization)")?;
+        )?;
+        let plant = match (own, nominal) {
+            (Some(_), Some(_)) => return Err("[closed_loop]: the nominal plant is given twice, by [physical] and by plant/n_hat/d_hat in [closed_loop]: keep one".into()),
+            (Some(f), None) | (None, Some(f)) => f,
+            (None, None) => return Err("[closed_loop]: the nominal plant is missing: add plant = [[...]] (stable plant) or n_hat and d_hat (a right coprime factorization), or give it as [physical]".into()),
+        };
         let controller = factors(
             &s.controller,
             &s.n_c,
@@ -328,9 +343,10 @@ impl ClosedLoopModel {
     }
 }
 
-/// The closed-loop model of a raw config, `None` without `[closed_loop]`.  Errors for the
-/// combinations that make no sense: `[closed_loop]` with `[model]`/`[physical]` (the nominal
-/// plant is given in `[closed_loop]`), `[r]` in a closed-loop config (the weight is `[v]`),
+/// The closed-loop model of a raw config, `None` without `[closed_loop]`.  The nominal
+/// plant is given in `[closed_loop]` or, SISO, as `[physical]`.  Errors for the
+/// combinations that make no sense: `[closed_loop]` with `[model]`, the nominal given both
+/// in `[closed_loop]` and as `[physical]`, `[r]` in a closed-loop config (the weight is `[v]`),
 /// `[v]` without `[closed_loop]`.
 pub fn from_raw(raw: &super::config::RawConfig) -> Result<Option<ClosedLoopModel>, String> {
     let Some(section) = &raw.closed_loop else {
@@ -339,8 +355,8 @@ pub fn from_raw(raw: &super::config::RawConfig) -> Result<Option<ClosedLoopModel
         }
         return Ok(None);
     };
-    if raw.model.is_some() || raw.physical.is_some() {
-        return Err("[closed_loop] gives the nominal plant itself (plant, or n_hat and d_hat): remove [model]/[physical]".into());
+    if raw.model.is_some() {
+        return Err("[closed_loop] gives the nominal plant itself (plant, or n_hat and d_hat, or a SISO [physical]): remove [model]".into());
     }
     if raw.r.is_some() {
         return Err(
@@ -352,5 +368,14 @@ pub fn from_raw(raw: &super::config::RawConfig) -> Result<Option<ClosedLoopModel
             "[channel] is not supported with [closed_loop]: give the SISO loop's data".into(),
         );
     }
-    ClosedLoopModel::build(section).map(Some)
+    // A [physical] nominal (item 6 of issue 9: `diagnose` on closed-loop data): its
+    // rational export gives the factors.
+    let nominal = match &raw.physical {
+        Some(ph) => {
+            ph.validate()?;
+            Some(physical_nominal::rcf_from_modal(&ph.to_factorization()?)?)
+        }
+        None => None,
+    };
+    ClosedLoopModel::build_with_plant(section, nominal).map(Some)
 }

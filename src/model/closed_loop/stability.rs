@@ -15,16 +15,20 @@
 //! external input at each summing junction are `Λ·[ξ; η] = [r; d]`.  Λ has stable entries,
 //! so it is a unit iff `det Λ` has no zero in `Re s ≥ 0` and `Λ(∞)` is invertible.
 //!
-//! `det Λ` is computed exactly as a polynomial: each row `i` is multiplied by the product
+//! For `m + p ≤ MAX_LOOP_SIZE`, `det Λ` is computed exactly as a polynomial: each row `i` is multiplied by the product
 //! `q_i` of its entries' denominators (Hurwitz, since the entries are stable, so no zero is
 //! added in the closed right half-plane), and the determinant of the resulting polynomial
 //! matrix is expanded by cofactors.  Its roots come from the capped Aberth iteration.  A
 //! unit `Λ` also proves that both factorizations are coprime (Λ⁻¹ stable gives the Bézout
-//! identities), so a non-coprime pair shows up here as an "unstable" loop.
+//! identities), so a non-coprime pair shows up here as an "unstable" loop.  Larger loops
+//! use the eigenvalues of the state matrix of a realization of `Λ⁻¹`
+//! ([`super::stability_ss`]); [`check_loop_with`] picks the route explicitly.
 
 use crate::system::{Polynomial, TfMatrix, TransferFunction};
 
-/// Largest `m + p` accepted (cofactor expansion is `(m+p)!`).
+/// Largest `m + p` of the exact polynomial route (cofactor expansion is `(m+p)!`); larger
+/// loops go through the eigenvalues of a state-space realization of `Λ⁻¹`
+/// ([`super::stability_ss`]).
 pub const MAX_LOOP_SIZE: usize = 7;
 
 /// Why a loop is not internally stable.
@@ -36,7 +40,7 @@ pub enum LoopInstability {
     IllPosed,
     /// The root computation did not converge within its cap.
     RootsDidNotConverge,
-    /// `m + p` exceeds [`MAX_LOOP_SIZE`].
+    /// The realization of `Λ` has more states than [`super::stability_ss::MAX_STATES`].
     TooLarge(usize),
 }
 
@@ -67,7 +71,8 @@ impl std::fmt::Display for LoopInstability {
             }
             LoopInstability::TooLarge(n) => write!(
                 f,
-                "m + p = {n} exceeds {MAX_LOOP_SIZE}: the stability check is limited to small loops"
+                "the loop's realization has {n} states, more than the {} the stability check handles",
+                super::stability_ss::MAX_STATES
             ),
         }
     }
@@ -123,6 +128,17 @@ fn neg(t: &TransferFunction) -> TransferFunction {
     }
 }
 
+/// How [`check_loop_with`] finds the zeros of `det Λ` in `Re s ≥ 0`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoopRoute {
+    /// Exact polynomial `det Λ` for `m + p ≤ MAX_LOOP_SIZE`, state space beyond.
+    Auto,
+    /// The polynomial `det Λ` by cofactors and its roots (any size: `(m+p)!` cost).
+    Polynomial,
+    /// The eigenvalues of the state matrix of a realization of `Λ⁻¹`.
+    StateSpace,
+}
+
 /// Checks that the loop of `P = N·D⁻¹` and `K = N_k·D_k⁻¹` (negative feedback) is
 /// internally stable; see the module documentation.  The factors must be stable (checked by
 /// the caller).
@@ -132,10 +148,18 @@ pub fn check_loop(
     n_k: &TfMatrix,
     d_k: &TfMatrix,
 ) -> Result<(), LoopInstability> {
+    check_loop_with(n, d, n_k, d_k, LoopRoute::Auto)
+}
+
+/// [`check_loop`] by the given route.
+pub fn check_loop_with(
+    n: &TfMatrix,
+    d: &TfMatrix,
+    n_k: &TfMatrix,
+    d_k: &TfMatrix,
+    route: LoopRoute,
+) -> Result<(), LoopInstability> {
     let (p, m) = (n.rows(), n.cols());
-    if m + p > MAX_LOOP_SIZE {
-        return Err(LoopInstability::TooLarge(m + p));
-    }
     let mut lambda: Vec<Vec<TransferFunction>> = Vec::with_capacity(m + p);
     for i in 0..m {
         let mut row: Vec<TransferFunction> = (0..m).map(|j| d.entry(i, j).clone()).collect();
@@ -153,6 +177,14 @@ pub fn check_loop(
     let (smax, smin) = (sv.max(), sv.min());
     if smin.is_nan() || smin <= 1e-12 * smax.max(1e-300) {
         return Err(LoopInstability::IllPosed);
+    }
+    let state_space = match route {
+        LoopRoute::Auto => m + p > MAX_LOOP_SIZE,
+        LoopRoute::Polynomial => false,
+        LoopRoute::StateSpace => true,
+    };
+    if state_space {
+        return super::stability_ss::check_lambda(&lambda);
     }
     let det = scaled_determinant(&lambda);
     if det.is_zero() {

@@ -1,0 +1,120 @@
+//! The data `diagnose` works on: one or several channels of an FRF set measured at the same
+//! frequencies, each with its noise radius, and the model entry each channel compares with.
+//! Several channels are diagnosed jointly (a mode has one `ω_n` and `ζ` across them).
+
+use super::compare::{prepare, Siso};
+use crate::data::FrfData;
+use crate::error::{Error, Result};
+use crate::model::Config;
+use num_complex::Complex64;
+use std::path::PathBuf;
+
+/// Channels of one FRF set with their noise radii.
+#[derive(Debug, Clone)]
+pub struct Channels {
+    /// The data file.
+    pub path: PathBuf,
+    /// Frequencies, rad/s (ascending).
+    pub omega: Vec<f64>,
+    /// Model entry `(output, input)` (0-based) of each channel.
+    pub entries: Vec<(usize, usize)>,
+    /// Measured response, `g[ch][k]`.
+    pub g: Vec<Vec<Complex64>>,
+    /// Noise radius, `radius[ch][k]`.
+    pub radius: Vec<Vec<f64>>,
+    /// Where each channel's radius came from.
+    pub radius_source: Vec<String>,
+}
+
+impl Channels {
+    /// One SISO channel (the noise radius must be known).
+    pub fn from_siso(s: &Siso) -> Result<Self> {
+        let radius = s.radius.clone().ok_or_else(|| {
+            Error::Invalid(format!(
+                "{}: diagnose needs the noise radius: pass --noise-radius X, add a noise_radius column, or [noise] radius / std_file",
+                s.path.display()
+            ))
+        })?;
+        Ok(Self {
+            path: s.path.clone(),
+            omega: s.omega.clone(),
+            entries: vec![s.model_entry],
+            g: vec![s.g.clone()],
+            radius: vec![radius],
+            radius_source: vec![s.radius_source.clone()],
+        })
+    }
+
+    /// Every channel of `data` (the model must have the data's size), each with the noise
+    /// radius the config or `--noise-radius` gives it.
+    pub fn all(config: &Config, data: &FrfData, noise_override: Option<f64>) -> Result<Self> {
+        let mut out: Option<Channels> = None;
+        for o in 1..=data.outputs() {
+            for i in 1..=data.inputs() {
+                let s = prepare(config, data, Some((o, i)), noise_override)?;
+                let c = Channels::from_siso(&s)?;
+                match &mut out {
+                    None => out = Some(c),
+                    Some(a) => {
+                        a.entries.extend(c.entries);
+                        a.g.extend(c.g);
+                        a.radius.extend(c.radius);
+                        a.radius_source.extend(c.radius_source);
+                    }
+                }
+            }
+        }
+        let out =
+            out.ok_or_else(|| Error::Invalid(format!("{}: no channel", data.path.display())))?;
+        let mut e = out.entries.clone();
+        e.sort();
+        e.dedup();
+        if e.len() != out.entries.len() {
+            return Err(Error::Invalid(format!(
+                "{}: the data have {} channels but the model {} is SISO: describe every output and input in the model, or pick one channel with --channel OUT,IN",
+                data.path.display(),
+                out.entries.len(),
+                config.path.display()
+            )));
+        }
+        Ok(out)
+    }
+
+    /// Number of channels.
+    pub fn n_ch(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// Number of frequencies.
+    pub fn len(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// True without data.
+    pub fn is_empty(&self) -> bool {
+        self.omega.is_empty()
+    }
+
+    /// Number of complex data over every channel.
+    pub fn n_data(&self) -> usize {
+        self.len() * self.n_ch()
+    }
+}
+
+/// `(misfit_rms, invalid_fraction)` of a physical model on the channels.
+pub fn misfit_channels(m: &crate::model::physical::PhysicalModel, data: &Channels) -> (f64, f64) {
+    let c: Vec<Vec<f64>> = data
+        .entries
+        .iter()
+        .enumerate()
+        .map(|(ch, e)| {
+            data.omega
+                .iter()
+                .enumerate()
+                .map(|(k, w)| (data.g[ch][k] - m.eval(*w)[*e]).norm() / data.radius[ch][k])
+                .collect()
+        })
+        .collect();
+    let me = super::problem::measures_of(&c);
+    (me.misfit_rms, me.invalid_fraction)
+}

@@ -1,0 +1,323 @@
+//! The diagnose fitting problem: data channels with noise radii, the base model split as
+//! `core · path` per channel, candidate effects on top (`Mods`), the cost
+//! `V = Σ_ch Σ_k |G_d − Ĝ(θ)|²/σ²` (`σ = r/√2`, noise uniform in the disk of radius `r`), and
+//! the bounded Levenberg–Marquardt refit of every candidate parameter.
+
+use super::candidates::Cand;
+use super::channels::Channels;
+use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
+use super::fit::lm_box;
+use crate::error::{Error, Result};
+use crate::model::physical::{EffectPath, PhysicalModel};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+use serde::Serialize;
+
+/// The fitting problem.
+pub struct Problem<'a> {
+    pub(super) base: &'a PhysicalModel,
+    pub(super) data: &'a Channels,
+    pub(super) inv_sigma: Vec<Vec<f64>>,
+    pub(super) core0: Vec<Vec<Complex64>>,
+    pub(super) path0: Vec<Vec<Complex64>>,
+}
+
+/// A model: the base plus effects with their internal parameters (concatenated).
+#[derive(Debug, Clone, Default)]
+pub struct Mods {
+    /// The effects, in order.
+    pub cands: Vec<Cand>,
+    /// Their parameters, concatenated.
+    pub theta: Vec<f64>,
+}
+
+impl Mods {
+    pub(super) fn with(&self, c: Cand, th: &[f64]) -> Mods {
+        let mut m = self.clone();
+        m.cands.push(c);
+        m.theta.extend_from_slice(th);
+        m
+    }
+}
+
+/// Error measures of a model.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Measures {
+    /// `Σ|e|²/σ²`.
+    pub v: f64,
+    /// `sqrt(mean (|e|/r)²)` over every datum of every channel.
+    pub misfit_rms: f64,
+    /// Share of data with `|e| > r`.
+    pub invalid_fraction: f64,
+}
+
+impl Measures {
+    /// Explained within the noise.
+    pub fn consistent(&self) -> bool {
+        self.invalid_fraction <= MAX_INVALID_FRACTION && self.misfit_rms <= MAX_MISFIT_RMS
+    }
+}
+
+/// The product of the path effects of `m` on model entry `entry` at `ω`.
+pub fn path_at(m: &PhysicalModel, omega: f64, entry: (usize, usize)) -> Complex64 {
+    m.effect
+        .iter()
+        .filter(|e| {
+            let idx = match e.path {
+                EffectPath::Input => entry.1,
+                EffectPath::Output => entry.0,
+            };
+            e.channel.is_none_or(|c| c == idx + 1)
+        })
+        .fold(Complex64::new(1.0, 0.0), |a, e| a * e.eval(omega))
+}
+
+/// Checks that `base` can be diagnosed on `data`: sizes agree, and with several channels
+/// the model has one input or one output (so a residue per channel is a modal `c bᵀ`).
+pub fn check_shapes(base: &PhysicalModel, data: &Channels) -> Result<()> {
+    let (p, m) = (base.n_outputs(), base.n_inputs());
+    if data.entries.iter().any(|(o, i)| *o >= p || *i >= m) {
+        return Err(Error::Invalid(format!(
+            "{}: the data channels do not fit the {p}×{m} model",
+            data.path.display()
+        )));
+    }
+    if data.n_ch() > 1 && p > 1 && m > 1 {
+        return Err(Error::Invalid(
+            "diagnose of several channels needs a model with one input or one output (each added mode gets a residue per channel); pick one channel with --channel OUT,IN".into(),
+        ));
+    }
+    Ok(())
+}
+
+impl<'a> Problem<'a> {
+    /// Sets up the problem.
+    pub fn new(base: &'a PhysicalModel, data: &'a Channels) -> Result<Self> {
+        check_shapes(base, data)?;
+        let mut core0 = Vec::new();
+        let mut path0 = Vec::new();
+        let cores: Vec<DMatrix<Complex64>> =
+            data.omega.iter().map(|w| base.eval_core(*w)).collect();
+        for e in &data.entries {
+            core0.push(cores.iter().map(|c| c[*e]).collect());
+            path0.push(data.omega.iter().map(|w| path_at(base, *w, *e)).collect());
+        }
+        Ok(Self {
+            base,
+            data,
+            inv_sigma: data
+                .radius
+                .iter()
+                .map(|r| r.iter().map(|x| std::f64::consts::SQRT_2 / x).collect())
+                .collect(),
+            core0,
+            path0,
+        })
+    }
+
+    /// Number of frequencies.
+    pub(super) fn f(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Number of channels.
+    pub(super) fn n_ch(&self) -> usize {
+        self.data.n_ch()
+    }
+
+    /// Number of complex data (for `ln(2F)` in the BIC).
+    pub(super) fn n_data(&self) -> usize {
+        self.data.n_data()
+    }
+
+    pub(super) fn omega(&self) -> &[f64] {
+        &self.data.omega
+    }
+
+    pub(super) fn omega_max(&self) -> f64 {
+        *self.data.omega.last().expect("data")
+    }
+
+    pub(super) fn omega_min(&self) -> f64 {
+        self.data.omega[0]
+    }
+
+    /// `(core, path)` of channel `ch` with `mods` applied, at datum `k` or at any `ω` with
+    /// `k = None`.
+    pub(super) fn parts(
+        &self,
+        mods: &Mods,
+        ch: usize,
+        k: Option<usize>,
+        omega: f64,
+    ) -> (Complex64, Complex64) {
+        let entry = self.data.entries[ch];
+        let (mut core, mut path) = match k {
+            Some(k) => (self.core0[ch][k], self.path0[ch][k]),
+            None => (
+                self.base.eval_core(omega)[entry],
+                path_at(self.base, omega, entry),
+            ),
+        };
+        let mut off = 0;
+        let n_ch = self.n_ch();
+        for c in &mods.cands {
+            let n = c.n_params(n_ch);
+            c.modify(
+                &mods.theta[off..off + n],
+                self.base,
+                omega,
+                ch,
+                entry,
+                &mut core,
+                &mut path,
+            );
+            off += n;
+        }
+        (core, path)
+    }
+
+    /// Model response of channel `ch` at datum `k`, or at any `ω` with `k = None`.
+    pub(super) fn eval_at(
+        &self,
+        mods: &Mods,
+        ch: usize,
+        k: Option<usize>,
+        omega: f64,
+    ) -> Complex64 {
+        let (c, p) = self.parts(mods, ch, k, omega);
+        c * p
+    }
+
+    /// Model response at the data, `[ch][k]`.
+    pub fn response(&self, mods: &Mods) -> Vec<Vec<Complex64>> {
+        (0..self.n_ch())
+            .map(|ch| {
+                (0..self.f())
+                    .map(|k| self.eval_at(mods, ch, Some(k), self.data.omega[k]))
+                    .collect()
+            })
+            .collect()
+    }
+
+    pub(super) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
+        out.clear();
+        for ch in 0..self.n_ch() {
+            for &k in mask {
+                let e = (self.data.g[ch][k] - self.eval_at(mods, ch, Some(k), self.data.omega[k]))
+                    * self.inv_sigma[ch][k];
+                out.push(e.re);
+                out.push(e.im);
+            }
+        }
+    }
+
+    pub(super) fn v(&self, mods: &Mods, mask: &[usize]) -> f64 {
+        let mut r = Vec::with_capacity(2 * mask.len() * self.n_ch());
+        self.residual(mods, mask, &mut r);
+        let v: f64 = r.iter().map(|x| x * x).sum();
+        if v.is_finite() {
+            v
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// Normalized misfit `|e|/r` per channel and datum.
+    pub(super) fn misfits(&self, mods: &Mods) -> Vec<Vec<f64>> {
+        let gm = self.response(mods);
+        (0..self.n_ch())
+            .map(|ch| {
+                (0..self.f())
+                    .map(|k| (self.data.g[ch][k] - gm[ch][k]).norm() / self.data.radius[ch][k])
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Error measures of a model on all data.
+    pub fn measures(&self, mods: &Mods) -> Measures {
+        measures_of(&self.misfits(mods))
+    }
+
+    /// Per frequency: the largest misfit over the channels, and whether any channel is
+    /// invalid there.
+    pub(super) fn invalid_flags(&self, mods: &Mods) -> (Vec<f64>, Vec<bool>) {
+        let c = self.misfits(mods);
+        let worst: Vec<f64> = (0..self.f())
+            .map(|k| c.iter().map(|ch| ch[k]).fold(0.0, f64::max))
+            .collect();
+        let flags = worst.iter().map(|x| *x > 1.0).collect();
+        (worst, flags)
+    }
+
+    /// Box bounds of every parameter of `mods`.
+    pub(super) fn bounds(&self, mods: &Mods) -> (Vec<f64>, Vec<f64>) {
+        let (mut lo, mut hi) = (Vec::new(), Vec::new());
+        for c in &mods.cands {
+            for (a, b) in c.bounds(self.n_ch(), self.omega_min(), self.omega_max()) {
+                lo.push(a);
+                hi.push(b);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Joint bounded LM fit of `mods` (all its parameters free) on the data in `mask`.
+    pub(super) fn refit(&self, mods: &Mods, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
+        if mods.theta.is_empty() {
+            return (mods.clone(), self.v(mods, mask), DMatrix::zeros(0, 0));
+        }
+        let mut typ = Vec::new();
+        let mut off = 0;
+        for c in &mods.cands {
+            let n = c.n_params(self.n_ch());
+            typ.extend(c.typ(&mods.theta[off..off + n], self.omega_max()));
+            off += n;
+        }
+        let (lo, hi) = self.bounds(mods);
+        let cands = mods.cands.clone();
+        let res = lm_box(
+            |th: &[f64], out: &mut Vec<f64>| {
+                let m = Mods {
+                    cands: cands.clone(),
+                    theta: th.to_vec(),
+                };
+                self.residual(&m, mask, out)
+            },
+            &mods.theta,
+            &typ,
+            &lo,
+            &hi,
+            80,
+        );
+        (
+            Mods {
+                cands: mods.cands.clone(),
+                theta: res.theta,
+            },
+            res.v,
+            res.jtj,
+        )
+    }
+}
+
+/// Measures from the normalized misfits `[ch][k]`.
+pub fn measures_of(c: &[Vec<f64>]) -> Measures {
+    let mut c2 = 0.0;
+    let mut bad = 0usize;
+    let mut n = 0usize;
+    for x in c.iter().flatten() {
+        c2 += x * x;
+        n += 1;
+        if *x > 1.0 {
+            bad += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    Measures {
+        v: 2.0 * c2,
+        misfit_rms: (c2 / n).sqrt(),
+        invalid_fraction: bad as f64 / n,
+    }
+}

@@ -1,0 +1,286 @@
+//! Screening the candidates on top of a model (each fitted alone, the model fixed), their
+//! physical plausibility, and where two fitted models can be told apart.
+
+use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
+use super::channels::Channels;
+use super::problem::{Measures, Mods, Problem};
+use crate::model::physical::PhysicalModel;
+use nalgebra::DMatrix;
+use std::collections::BTreeMap;
+
+/// ΔBIC a candidate needs to be accepted.
+pub const MIN_DELTA_BIC: f64 = 10.0;
+/// BIC gap under which two candidates (or two effect sets) are a tie.
+pub const TIE_BIC: f64 = 6.0;
+/// Extrapolation holdout: fit below this share of the band (log frequency), predict above.
+pub const EXTRAPOLATION_SPLIT: f64 = 0.7;
+/// Fewest data on either side of the split for the extrapolation holdout to run.
+pub const MIN_SPLIT_DATA: usize = 8;
+/// A fitted frequency beyond this factor outside the measured band is "no fit".
+pub const MAX_BAND_FACTOR: f64 = 1e6;
+
+/// Prior order among near-ties (lower first): fewer assumptions first.
+pub fn prior(c: &Cand) -> usize {
+    match c {
+        Cand::Sign(_) => 0,
+        Cand::Gain(_) => 1,
+        Cand::Delay(_) => 2,
+        Cand::Lag(_) => 3,
+        Cand::Zoh(_) => 4,
+        Cand::Feedthrough => 5,
+        Cand::Integrator(_) | Cand::Friction(_) => 6,
+        Cand::Damping(_) => 7,
+        Cand::ModeShift(_) => 8,
+        Cand::NmpZero(_) => 9,
+        Cand::Mode => 10,
+    }
+}
+
+/// SI parameters by name.
+pub fn si_map(c: &Cand, th: &[f64], entries: &[(usize, usize)]) -> BTreeMap<String, f64> {
+    c.si_params(th, entries)
+        .into_iter()
+        .map(|(n, v, _)| (n, v))
+        .collect()
+}
+
+/// The candidates tried on a model with `n_out × n_in` channels observed.  Gains, signs,
+/// mode shifts and damping changes are not in the list: the retune (refit of the model's own
+/// residues, frequencies and dampings) covers them.  With several channels, path effects are
+/// tried on every channel and on each input (a dynamic effect on one output of a
+/// multi-output model cannot be exported to the special factorization, whose `C` is constant).
+pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
+    let mut sels = vec![Sel::All];
+    if data.n_ch() > 1 {
+        let mut outs: Vec<usize> = data.entries.iter().map(|e| e.0).collect();
+        outs.dedup();
+        let mut ins: Vec<usize> = data.entries.iter().map(|e| e.1).collect();
+        ins.sort();
+        ins.dedup();
+        // A dynamic effect on one output has no place in the constant `C` of the special
+        // factorization (the export of a multi-output model), so it is not proposed there.
+        if outs.len() > 1 && base.n_outputs() == 1 {
+            sels.extend(outs.iter().map(|o| Sel::Output(*o)));
+        }
+        if ins.len() > 1 {
+            sels.extend(ins.iter().map(|i| Sel::Input(*i)));
+        }
+    }
+    let mut v = Vec::new();
+    for s in &sels {
+        v.extend([
+            Cand::Delay(*s),
+            Cand::Lag(*s),
+            Cand::NmpZero(*s),
+            Cand::Zoh(*s),
+        ]);
+    }
+    v.extend([
+        Cand::Mode,
+        Cand::Integrator(1),
+        Cand::Integrator(2),
+        Cand::Feedthrough,
+    ]);
+    for (i, r) in base.rigid_body.iter().enumerate() {
+        if r.friction_pole.is_none() {
+            v.push(Cand::Friction(i));
+        }
+    }
+    v
+}
+
+/// Physical plausibility of fitted parameters (effects.md step 3): `(flags, no_fit)`.
+/// `no_fit` is the reason the fit is unusable (non-finite, or a frequency more than
+/// [`MAX_BAND_FACTOR`] outside the band); a flag names a parameter at its bound (not
+/// identified) or a mode outside the band (a compliance or mass line, another effect).
+pub fn plausibility(
+    c: &Cand,
+    th: &[f64],
+    v: f64,
+    entries: &[(usize, usize)],
+    w_min: f64,
+    w_max: f64,
+) -> (Vec<String>, Option<String>) {
+    if !v.is_finite() || th.iter().any(|x| !x.is_finite()) {
+        return (
+            vec![],
+            Some("the fit did not converge (non-finite cost or parameter)".into()),
+        );
+    }
+    let si = si_map(c, th, entries);
+    let mut flags = Vec::new();
+    for (name, x) in &si {
+        let freq = match name.as_str() {
+            "omega_n" | "omega_c" | "z" | "pole" => Some(*x),
+            "t_s" => Some(std::f64::consts::TAU / x),
+            _ => None,
+        };
+        if let Some(w) = freq {
+            if !(w > w_min / MAX_BAND_FACTOR && w < w_max * MAX_BAND_FACTOR) {
+                return (
+                    vec![],
+                    Some(format!(
+                        "{name} runs away from the measured band ({} … {}): the data do not determine it",
+                        fmt_w(w_min),
+                        fmt_w(w_max)
+                    )),
+                );
+            }
+        }
+        if !x.is_finite() || x.abs() > 1e300 {
+            return (vec![], Some(format!("{name} is not finite")));
+        }
+    }
+    let bounds = c.bounds(entries.len(), w_min, w_max);
+    let at = |i: usize| {
+        let (lo, hi) = bounds[i];
+        let tol = 1e-3 * (1.0 + th[i].abs());
+        (th[i] - lo).abs() < tol || (hi - th[i]).abs() < tol
+    };
+    match c {
+        Cand::Mode => {
+            if at(0) {
+                let w = th[0].exp();
+                let edge = if w < (w_min * w_max).sqrt() {
+                    "below: a mass line, see the rigid_body candidate"
+                } else {
+                    "above: a compliance line, see the feedthrough candidate"
+                };
+                flags.push(format!(
+                    "ω_n at the band edge {}: the resonance is not inside the measured band ({edge})",
+                    fmt_w(w)
+                ));
+            }
+            if at(1) {
+                let z = th[1].exp().clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1);
+                flags.push(format!(
+                    "ζ at its {} bound {}: not identified",
+                    if z < 0.01 { "lower" } else { "upper" },
+                    sig(z)
+                ));
+            }
+        }
+        Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
+        Cand::Lag(_) | Cand::NmpZero(_) | Cand::Zoh(_) | Cand::Friction(_) | Cand::Delay(_)
+            if at(0) =>
+        {
+            flags.push(format!(
+                "{} at its bound: not identified",
+                si.keys().last().cloned().unwrap_or_default()
+            ))
+        }
+        _ => {}
+    }
+    (flags, None)
+}
+
+/// A candidate fitted alone on top of a model.
+#[derive(Debug, Clone)]
+pub struct Screened {
+    /// The candidate.
+    pub cand: Cand,
+    /// Its fitted parameters (on top of the model).
+    pub mods: Mods,
+    /// Cost with it.
+    pub v: f64,
+    /// Measures with it.
+    pub measures: Measures,
+    /// `2(V₀ − V) − n ln(2F)`.
+    pub delta_bic: f64,
+    /// Plausibility flags.
+    pub flags: Vec<String>,
+    /// Why the fit is unusable.
+    pub no_fit: Option<String>,
+    /// `JᵀJ` at the optimum.
+    pub jtj: DMatrix<f64>,
+}
+
+impl Problem<'_> {
+    /// Fits candidate `c` alone on top of the problem's model (multi-start).
+    pub(super) fn fit_candidate(&self, c: Cand, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
+        let cur = Mods::default();
+        let mut best: Option<(Mods, f64, DMatrix<f64>)> = None;
+        for st in self.starts(&cur, c, mask) {
+            let m = cur.with(c, &st);
+            let fit = self.refit(&m, mask);
+            if best.as_ref().is_none_or(|b| fit.1 < b.1) {
+                best = Some(fit);
+            }
+        }
+        best.expect("at least one start")
+    }
+
+    /// Fits every candidate alone on the model and sorts them by ΔBIC (best first).
+    pub(super) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
+        let all: Vec<usize> = (0..self.f()).collect();
+        let ln2f = (2.0 * self.n_data() as f64).ln();
+        let mut out: Vec<Screened> = cands
+            .iter()
+            .map(|c| {
+                let (mods, v, jtj) = self.fit_candidate(*c, &all);
+                let measures = self.measures(&mods);
+                let n = c.n_params(self.n_ch());
+                let (flags, no_fit) = plausibility(
+                    c,
+                    &mods.theta,
+                    v,
+                    &self.data.entries,
+                    self.omega_min(),
+                    self.omega_max(),
+                );
+                Screened {
+                    cand: *c,
+                    delta_bic: 2.0 * (cur.v - v) - n as f64 * ln2f,
+                    mods,
+                    v,
+                    measures,
+                    flags,
+                    no_fit,
+                    jtj,
+                }
+            })
+            .collect();
+        out.sort_by(|a, b| b.delta_bic.total_cmp(&a.delta_bic));
+        out
+    }
+}
+
+/// Where two fitted models differ by more than the (median relative) noise, beyond the band.
+pub fn disambiguate(a: &PhysicalModel, b: &PhysicalModel, data: &Channels) -> String {
+    let (wmin, wmax) = (data.omega[0], *data.omega.last().expect("data"));
+    let mut rel: Vec<f64> = (0..data.len())
+        .map(|k| data.radius[0][k] / data.g[0][k].norm().max(1e-300))
+        .collect();
+    rel.sort_by(|x, y| x.total_cmp(y));
+    let rel_noise = rel[rel.len() / 2];
+    let differs = |w: f64| {
+        let (ga, gb) = (a.eval(w), b.eval(w));
+        data.entries.iter().any(|e| {
+            let (x, y) = (ga[*e], gb[*e]);
+            (x - y).norm() > rel_noise * x.norm()
+        })
+    };
+    let above = (1..=200)
+        .map(|i| wmax * 10f64.powf(i as f64 * 2.0 / 200.0))
+        .find(|w| differs(*w));
+    let below = (1..=200)
+        .map(|i| wmin / 10f64.powf(i as f64 * 2.0 / 200.0))
+        .find(|w| differs(*w));
+    let tail = "measure there to tell them apart";
+    match (above, below) {
+        (Some(h), Some(l)) => format!(
+            "the two fitted models differ by more than the noise above {} and below {}: {tail}",
+            fmt_w(h),
+            fmt_w(l)
+        ),
+        (Some(h), None) => format!(
+            "the two fitted models differ by more than the noise above {}: {tail}",
+            fmt_w(h)
+        ),
+        (None, Some(l)) => format!(
+            "the two fitted models differ by more than the noise below {}: {tail}",
+            fmt_w(l)
+        ),
+        (None, None) => "the two fitted models agree within the noise from a hundredth of the lowest to a hundred times the highest measured frequency: lower the noise (more periods or averages) to tell them apart".into(),
+    }
+}

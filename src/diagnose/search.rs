@@ -1,0 +1,250 @@
+//! The search over effect sets: a beam search over effect sequences with a joint refit of
+//! every parameter at every node.
+//!
+//! * **Root**: the configured model retuned from a rough start ([`retune`] with the mode
+//!   grid). When it explains the data, nothing is added.
+//! * **Expansion** of a node: every candidate is fitted alone on the node's model and
+//!   scored by `ΔBIC = 2(V_node − V) − n·ln(2F)`; the best `beam + 1` that pass the screen
+//!   (ΔBIC > 10, plausible: no parameter at a bound, a mode inside the band) are written into
+//!   the model and **every** parameter is refit jointly (the node's own and the new
+//!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10 and its
+//!   invalid fraction is not higher.
+//! * **Level**: the children of all nodes, one per effect set (the best of the orders that
+//!   reach it), the `beam` lowest `BIC = 2V + n_θ·ln(2F)` kept.
+//! * **Stop** at the first level with a consistent node (fewest effects that explain the
+//!   data), when no child passes, or after `max_effects` levels. The chosen set is the best
+//!   consistent node of that level, else the lowest BIC of all; the other nodes are its
+//!   runner-ups, those within 6 of its BIC are ties.
+
+use super::candidates::Cand;
+use super::channels::Channels;
+use super::problem::{Measures, Problem};
+use super::rank::{candidate_list, si_map, Screened, MIN_DELTA_BIC};
+use super::report::Step;
+use super::retune::{retune, ADDED_NOTE};
+use crate::error::Result;
+use crate::model::physical::PhysicalModel;
+
+/// Search settings.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings {
+    /// Most effects to add.
+    pub max_effects: usize,
+    /// Nodes kept per level.
+    pub beam: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            max_effects: 3,
+            beam: 3,
+        }
+    }
+}
+
+/// A node: an effect set written into the model and jointly refit.
+#[derive(Debug, Clone)]
+pub struct Node {
+    /// The effects and their parameters when they were added (fitted alone).
+    pub effects: Vec<(Cand, Vec<f64>)>,
+    /// The jointly refit model.
+    pub model: PhysicalModel,
+    /// Its measures.
+    pub measures: Measures,
+    /// Number of parameters of the model (configured and added).
+    pub n_params: usize,
+    /// `2V + n_θ ln(2F)`.
+    pub bic: f64,
+    /// The path that led here.
+    pub steps: Vec<Step>,
+    /// The model is the configured one, not refit: a child's joint refit starts with the
+    /// mode grid of a rough start.
+    pub configured: bool,
+}
+
+impl Node {
+    /// Labels of the effects, in order.
+    pub fn labels(&self) -> Vec<String> {
+        self.effects.iter().map(|(c, _)| c.label()).collect()
+    }
+
+    fn key(&self) -> Vec<String> {
+        let mut l = self.labels();
+        l.sort();
+        l
+    }
+}
+
+/// The outcome of a search.
+pub struct SearchResult {
+    /// Every node kept, the root first.
+    pub nodes: Vec<Node>,
+    /// Index of the chosen node.
+    pub chosen: usize,
+    /// The root's screened candidates (first level) and the children made of them.
+    pub first_level: Vec<(Screened, Option<Node>)>,
+    /// Nodes expanded.
+    pub expanded: usize,
+    /// Joint refits.
+    pub joint_refits: usize,
+}
+
+/// Writes effect `c` with parameters `th` into `m`.
+pub fn add_effect(m: &PhysicalModel, c: &Cand, th: &[f64], data: &Channels) -> PhysicalModel {
+    let mut next = m.clone();
+    c.apply_to(
+        th,
+        &data.entries,
+        &mut next,
+        &format!("{ADDED_NOTE}: {}", c.label()),
+    );
+    next
+}
+
+fn bic(v: f64, n: usize, data: &Channels) -> f64 {
+    2.0 * v + n as f64 * (2.0 * data.n_data() as f64).ln()
+}
+
+/// The two roots: the configured model as it is, and retuned from a rough start.
+pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
+    let r = retune(base, data, None, true);
+    let m0 = Problem::new(base, data)?.measures(&Default::default());
+    let measures = Problem::new(&r.model, data)?.measures(&Default::default());
+    Ok([
+        Node {
+            effects: vec![],
+            bic: bic(m0.v, r.n_params, data),
+            model: base.clone(),
+            measures: m0,
+            n_params: r.n_params,
+            steps: vec![],
+            configured: true,
+        },
+        Node {
+            effects: vec![],
+            bic: bic(measures.v, r.n_params, data),
+            model: r.model,
+            measures,
+            n_params: r.n_params,
+            steps: vec![],
+            configured: false,
+        },
+    ])
+}
+
+/// Runs the beam search from the roots (the first one's screen is the first level).
+pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchResult> {
+    let ln2f = (2.0 * data.n_data() as f64).ln();
+    let mut level: Vec<usize> = (0..roots.len()).collect();
+    let mut nodes = roots;
+    let mut first_level = Vec::new();
+    let (mut expanded, mut joint_refits) = (0, 0);
+    for depth in 1..=s.max_effects {
+        if level.iter().any(|i| nodes[*i].measures.consistent()) {
+            break;
+        }
+        let mut children: Vec<Node> = Vec::new();
+        for &ni in &level {
+            let node = nodes[ni].clone();
+            let p = Problem::new(&node.model, data)?;
+            let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
+            let cands: Vec<Cand> = candidate_list(&node.model, data)
+                .into_iter()
+                .filter(|c| *c == Cand::Mode || !used.contains(c))
+                .collect();
+            let screened = p.screen(&cands, node.measures);
+            expanded += 1;
+            let mut tried = 0;
+            for sc in &screened {
+                let promising =
+                    sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
+                let mut child_node = None;
+                if promising && tried <= s.beam {
+                    tried += 1;
+                    let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
+                    let r = retune(&added, data, None, node.configured);
+                    joint_refits += 1;
+                    let m = Problem::new(&r.model, data)?.measures(&Default::default());
+                    let n_new = sc.cand.n_params(data.n_ch());
+                    // Against the best of the node and (for the configured model) its retune.
+                    let ref_v = if node.configured {
+                        nodes[1].measures.v.min(node.measures.v)
+                    } else {
+                        node.measures.v
+                    };
+                    let d_bic = 2.0 * (ref_v - m.v) - n_new as f64 * ln2f;
+                    if d_bic > MIN_DELTA_BIC && m.invalid_fraction <= node.measures.invalid_fraction
+                    {
+                        let mut effects = node.effects.clone();
+                        effects.push((sc.cand, sc.mods.theta.clone()));
+                        let mut steps = node.steps.clone();
+                        steps.push(Step {
+                            step: depth,
+                            effect: sc.cand.label(),
+                            params: si_map(&sc.cand, &sc.mods.theta, &data.entries),
+                            explanation: super::candidates::explain(
+                                &sc.cand,
+                                &sc.mods.theta,
+                                &data.entries,
+                                &node.model,
+                                &data.omega,
+                            ),
+                            misfit_rms: m.misfit_rms,
+                            invalid_fraction: m.invalid_fraction,
+                            delta_bic: d_bic,
+                            misfit_rms_before_refit: sc.measures.misfit_rms,
+                            invalid_fraction_before_refit: sc.measures.invalid_fraction,
+                            n_refit: r.n_params,
+                            ties: vec![],
+                        });
+                        let child = Node {
+                            effects,
+                            bic: bic(m.v, r.n_params, data),
+                            model: r.model,
+                            measures: m,
+                            n_params: r.n_params,
+                            steps,
+                            configured: false,
+                        };
+                        child_node = Some(child.clone());
+                        children.push(child);
+                    }
+                }
+                if depth == 1 && ni == 0 {
+                    first_level.push((sc.clone(), child_node));
+                }
+            }
+        }
+        // One node per effect set (the best order), the `beam` best kept.
+        children.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+        let mut seen = std::collections::HashSet::new();
+        children.retain(|c| seen.insert(c.key()));
+        children.truncate(s.beam.max(1));
+        if children.is_empty() {
+            break;
+        }
+        level = (nodes.len()..nodes.len() + children.len()).collect();
+        nodes.extend(children);
+    }
+    // The chosen node: the best consistent one with the fewest effects, else the lowest BIC.
+    let consistent_depth = nodes
+        .iter()
+        .filter(|n| n.measures.consistent())
+        .map(|n| n.effects.len())
+        .min();
+    let chosen = (0..nodes.len())
+        .filter(|i| {
+            consistent_depth
+                .is_none_or(|d| nodes[*i].effects.len() == d && nodes[*i].measures.consistent())
+        })
+        .min_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic))
+        .unwrap_or(0);
+    Ok(SearchResult {
+        nodes,
+        chosen,
+        first_level,
+        expanded,
+        joint_refits,
+    })
+}

@@ -1,0 +1,128 @@
+//! Starting points of each candidate's new parameters: closed-form estimates (linear least
+//! squares on the residual, one residue per channel), the best points of a 1-D grid, and for
+//! an added mode the peaks of the noise-normalized misfit (effects.md, step 3).
+
+use super::candidates::{Cand, Sel};
+use super::problem::{Mods, Problem};
+use num_complex::Complex64;
+
+impl Problem<'_> {
+    /// Starting points for the new parameters of `c`, given the current model `cur`.
+    pub(super) fn starts(&self, cur: &Mods, c: Cand, mask: &[usize]) -> Vec<Vec<f64>> {
+        let gm = self.response(cur);
+        let (wmin, wmax) = (self.omega_min(), self.omega_max());
+        let om = self.omega();
+        let n_ch = self.n_ch();
+        let w2 = |ch: usize, k: usize| self.inv_sigma[ch][k].powi(2);
+        // Linear LS of e = G_d − G_m on a basis ψ over the channels in `chs`:
+        // ρ = Re Σ ψ* e w / Σ|ψ|² w.
+        let ls = |chs: &[usize], psi: &dyn Fn(usize, usize) -> Complex64| -> f64 {
+            let (mut a, mut b) = (0.0, 0.0);
+            for &ch in chs {
+                for &k in mask {
+                    let p = psi(ch, k);
+                    a += (p.conj() * (self.data.g[ch][k] - gm[ch][k])).re * w2(ch, k);
+                    b += p.norm_sqr() * w2(ch, k);
+                }
+            }
+            if b > 0.0 && a.is_finite() {
+                a / b
+            } else {
+                0.0
+            }
+        };
+        // Best few points of a 1-D grid of the new parameter.
+        let grid_best = |grid: &[f64], keep: usize| -> Vec<Vec<f64>> {
+            let mut vs: Vec<(f64, f64)> = grid
+                .iter()
+                .map(|x| (self.v(&cur.with(c, &[*x]), mask), *x))
+                .collect();
+            let mut local: Vec<(f64, f64)> = (0..vs.len())
+                .filter(|&i| {
+                    (i == 0 || vs[i].0 <= vs[i - 1].0)
+                        && (i + 1 == vs.len() || vs[i].0 <= vs[i + 1].0)
+                })
+                .map(|i| vs[i])
+                .collect();
+            local.sort_by(|a, b| a.0.total_cmp(&b.0));
+            vs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            local
+                .into_iter()
+                .chain(vs)
+                .take(keep)
+                .map(|(_, x)| vec![x])
+                .collect()
+        };
+        let log_grid = |lo: f64, hi: f64, n: usize| -> Vec<f64> {
+            (0..n)
+                .map(|i| lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (n - 1) as f64)
+                .collect()
+        };
+        // The path of the current model at each datum (for additive bases).
+        let path_of = |ch: usize, k: usize| self.parts(cur, ch, Some(k), om[k]).1;
+        let s = |k: usize| Complex64::new(0.0, om[k]);
+        let chans: Vec<usize> = (0..n_ch).collect();
+        let sel_chans = |sel: Sel| -> Vec<usize> {
+            (0..n_ch)
+                .filter(|ch| sel.hits(self.data.entries[*ch]))
+                .collect()
+        };
+        match c {
+            Cand::Sign(_) => vec![vec![]],
+            Cand::Gain(sel) => vec![vec![1.0 + ls(&sel_chans(sel), &|ch, k| gm[ch][k])]],
+            Cand::Delay(_) => {
+                let step = 0.05 / wmax;
+                let grid: Vec<f64> = (0..=((6.0 * std::f64::consts::PI / 0.05) as usize))
+                    .map(|j| (j as f64 + 0.5) * step)
+                    .collect();
+                grid_best(&grid, 3)
+            }
+            Cand::Lag(_) | Cand::NmpZero(_) => grid_best(&log_grid(wmin / 3.0, wmax * 30.0, 40), 3),
+            Cand::Zoh(_) => grid_best(&log_grid(0.01 / wmax, 3.0 / wmax, 40), 3),
+            Cand::Integrator(o) => vec![(0..n_ch)
+                .map(|ch| ls(&[ch], &|ch, k| path_of(ch, k) / s(k).powi(o as i32)))
+                .collect()],
+            Cand::Feedthrough => vec![(0..n_ch)
+                .map(|ch| ls(&[ch], &|ch, k| path_of(ch, k)))
+                .collect()],
+            Cand::ModeShift(i) => {
+                let w0 = self.base.mode[i].omega_n;
+                let grid: Vec<f64> = (0..61)
+                    .map(|j| w0.ln() + (j as f64 - 30.0) / 60.0)
+                    .collect();
+                grid_best(&grid, 3)
+            }
+            Cand::Damping(_) => grid_best(&log_grid(1e-3, 0.7, 30), 3),
+            Cand::Friction(_) => grid_best(&log_grid(wmin / 1000.0, wmax, 40), 3),
+            Cand::Mode => {
+                // ω_n candidates: local maxima of the worst channel's |e|/r, plus a log grid
+                // over the band; residues by LS per channel.
+                let (cw, _) = self.invalid_flags(cur);
+                let f = self.f();
+                let mut peaks: Vec<(f64, f64)> = (0..f)
+                    .filter(|&k| {
+                        (k == 0 || cw[k] >= cw[k - 1]) && (k + 1 == f || cw[k] >= cw[k + 1])
+                    })
+                    .map(|k| (cw[k], om[k]))
+                    .collect();
+                peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
+                let mut ws: Vec<f64> = peaks.iter().take(4).map(|p| p.1).collect();
+                ws.extend(log_grid(wmin, wmax, 30).iter().map(|x| x.exp()));
+                let mut trials: Vec<(f64, Vec<f64>)> = Vec::new();
+                for w in ws {
+                    for z in [0.005, 0.02, 0.06, 0.2, 0.5] {
+                        let mut th = vec![w.ln(), f64::ln(z)];
+                        for ch in &chans {
+                            th.push(ls(&[*ch], &|ch, k| {
+                                path_of(ch, k) / (s(k) * s(k) + 2.0 * z * w * s(k) + w * w)
+                            }));
+                        }
+                        trials.push((self.v(&cur.with(Cand::Mode, &th), mask), th));
+                    }
+                }
+                trials.sort_by(|a, b| a.0.total_cmp(&b.0));
+                trials.into_iter().take(4).map(|t| t.1).collect()
+            }
+        }
+    }
+}

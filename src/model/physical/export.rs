@@ -1,0 +1,107 @@
+//! The rational export of a physical model: the special (modal) factorization
+//! `C·M̃⁻¹·Ñ·J` of Sec. IV-A (see the module docs of [`super`]).
+
+use super::{EffectKind, EffectPath, PhysicalModel};
+use crate::model::factorization::Factorization;
+use crate::system::{Polynomial, TfMatrix, TransferFunction};
+use nalgebra::DMatrix;
+
+impl PhysicalModel {
+    /// The special factorization `C·M̃⁻¹·Ñ·J` (rational; see the module docs).
+    pub fn to_factorization(&self) -> Result<Factorization, String> {
+        self.validate()?;
+        let (p, m) = (self.n_outputs(), self.n_inputs());
+        let a = self.factor_pole.unwrap_or(1.0);
+        let q_default = |w: f64| Polynomial::new(vec![1.0, 2.0 * w, w * w]);
+        let q = |w: f64| match &self.factor_den {
+            Some(c) => Polynomial::new(c.clone()),
+            None => q_default(w),
+        };
+        let mut m_diag = Vec::new();
+        let mut n_rows: Vec<Vec<TransferFunction>> = Vec::new();
+        let mut c_cols: Vec<Vec<f64>> = Vec::new();
+        for md in &self.mode {
+            let qk = q(md.omega_n);
+            let d = Polynomial::new(vec![
+                md.mass,
+                md.mass * 2.0 * md.zeta * md.omega_n,
+                md.mass * md.omega_n * md.omega_n,
+            ]);
+            m_diag.push(TransferFunction {
+                num: d,
+                den: qk.clone(),
+            });
+            n_rows.push(over(&md.input_gain.to_vec(m), &qk));
+            c_cols.push(md.output_gain.to_vec(p));
+        }
+        for (list, order) in [(&self.rigid_body, 2usize), (&self.integrator, 1)] {
+            for md in list {
+                let qk = if order == 2 {
+                    q(a)
+                } else {
+                    Polynomial::new(vec![1.0, a])
+                };
+                let mut num = vec![md.mass];
+                num.extend(std::iter::repeat_n(0.0, order));
+                if let Some(p) = md.friction_pole {
+                    num = vec![md.mass, md.mass * p, 0.0];
+                }
+                m_diag.push(TransferFunction {
+                    num: Polynomial::new(num),
+                    den: qk.clone(),
+                });
+                n_rows.push(over(&md.input_gain.to_vec(m), &qk));
+                c_cols.push(md.output_gain.to_vec(p));
+            }
+        }
+        if let Some(d) = self.d_matrix() {
+            for i in 0..p {
+                m_diag.push(TransferFunction::gain(1.0));
+                n_rows.push((0..m).map(|j| TransferFunction::gain(d[(i, j)])).collect());
+                let mut col = vec![0.0; p];
+                col[i] = 1.0;
+                c_cols.push(col);
+            }
+        }
+        let n = m_diag.len();
+        let c = DMatrix::from_fn(p, n, |i, k| c_cols[k][i]);
+        let order = self.pade_order.unwrap_or(6);
+        let mut j = vec![TransferFunction::gain(1.0); m];
+        for e in &self.effect {
+            if e.path == EffectPath::Output && p * m != 1 {
+                if e.kind == EffectKind::Gain || e.kind == EffectKind::Sign {
+                    return Err(format!(
+                        "[physical] effect \"{}\" on the output path of a MIMO model: fold it into the output gains for the factorization",
+                        e.kind_name()
+                    ));
+                }
+                return Err(format!(
+                    "[physical] effect \"{}\" on the output path of a MIMO model has no place in the constant C of the special factorization; move it to the input path",
+                    e.kind_name()
+                ));
+            }
+            let tf = e.to_tf(order);
+            let n_ch = if e.path == EffectPath::Input { m } else { p };
+            for (k, jk) in j.iter_mut().enumerate().take(n_ch) {
+                if e.channel.is_none_or(|c| c == k + 1) {
+                    *jk = jk.mul(&tf);
+                }
+            }
+        }
+        let mm = TfMatrix::diagonal(m_diag);
+        let nn = TfMatrix::from_rows(n_rows).ok_or("[physical]: inconsistent input gains")?;
+        Factorization::special(c, mm, nn, j).map_err(|e| format!("[physical]: {e}"))
+    }
+}
+
+/// The row of `Ñ` for one modal coordinate: constant input gains over the common
+/// denominator `q(s)` of its row of `M̃`.
+fn over(gains: &[f64], q: &Polynomial) -> Vec<TransferFunction> {
+    gains
+        .iter()
+        .map(|b| TransferFunction {
+            num: Polynomial::constant(*b),
+            den: q.clone(),
+        })
+        .collect()
+}
