@@ -198,18 +198,32 @@ fn envelope(k: usize) -> (Vec<f64>, Vec<f64>) {
     (omega, r_min)
 }
 
-/// Open (GitHub issue 11, defect 3): on this commit 74 of the 90 pairs are within 0.01
-/// decade, 16 are not (wide bands and steeply rising envelopes at low orders, where the
-/// max-slack LP in the partial-fraction basis stalls at a negative slack — a conditioning
-/// problem of the basis over 4–7 decades, not of the formulation).  Run with
+/// Still open in part (GitHub issue 11, defect 3): with the polynomial minimax candidate
+/// (`src/fit/polyfit.rs`) 82 of the 90 pairs are within 0.01 decade (74 before it); the
+/// 8 others are rising envelopes at orders 2–3 (envelopes 11, 19, 27: up to 0.94 decade,
+/// the disk form of a rising `|r|` is tiny far above the band and the LP's tolerance lets
+/// `B` change sign there, so the spectral factorization refuses the lowest levels) and
+/// orders 3, 7, 8 on envelopes 3, 5, 18, 26 (0.01–0.05 decade).  Measured on the commit
+/// that added this comment: 90 pairs, worst gap +0.94 decade, 30 s.  Run with
 /// `cargo test --test fit_reference -- --ignored --nocapture` to see the table.
 #[test]
-#[ignore = "issue 11 defect 3 is open: 16 of 90 (envelope, order) pairs above the reference by more than 0.01 decade"]
+#[ignore = "issue 11 defect 3 partly open: 8 of 90 pairs above the reference by more than 0.01 decade"]
 fn rshape_reaches_the_reference_optimum_at_every_order() {
+    sweep(0..30, 80);
+}
+
+/// The fast part of the sweep that runs in CI: envelopes 0–2 and 12–17 (smooth, jagged,
+/// noisy with zero rows; 1–7 decades), 27 pairs, all within 0.01 decade.
+#[test]
+fn rshape_reaches_the_reference_optimum_on_a_subset() {
+    sweep((0..3).chain(12..18), 24);
+}
+
+fn sweep(envelopes: impl Iterator<Item = usize>, min_pairs: usize) {
     let mut worst_gap = f64::NEG_INFINITY;
     let mut pairs = 0;
     let mut failures = Vec::new();
-    for k in 0..30 {
+    for k in envelopes {
         let (omega, r_min) = envelope(k);
         let env = Envelope {
             omega: omega.clone(),
@@ -239,6 +253,46 @@ fn rshape_reaches_the_reference_optimum_at_every_order() {
         }
     }
     eprintln!("{pairs} pairs compared; worst gap {worst_gap:+.4} decade");
-    assert!(pairs >= 80, "only {pairs} pairs had a reference level");
+    assert!(
+        pairs >= min_pairs,
+        "only {pairs} pairs had a reference level"
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Order `N+1` is never worse than order `N` (chained), and `--order auto` is never worse
+/// than the best order of its sweep by more than its documented tolerance (issue 11,
+/// defect 3), on smooth, jagged, noisy and rising envelopes.
+#[test]
+fn higher_order_never_worse_and_auto_never_worse_than_its_best() {
+    for k in [1, 3, 6, 11] {
+        let (omega, r_min) = envelope(k);
+        let env = Envelope {
+            omega,
+            r_min,
+            a1_limit: None,
+            method: EnvelopeMethod::File,
+        };
+        let set = FitSettings::default();
+        let (fit, rows) = rshape::fit::fit_auto(&env, None, &set, 4)
+            .unwrap_or_else(|e| panic!("envelope {k}: {e}"));
+        assert!(fit.certificate.passed, "envelope {k}");
+        let ok: Vec<_> = rows.iter().filter(|r| r.status == "ok").collect();
+        assert!(ok.len() >= 4, "envelope {k}: {rows:?}");
+        for w in ok.windows(2) {
+            assert!(
+                w[1].max_log10 <= w[0].max_log10 + 1e-9
+                    && w[1].mean_log10 <= w[0].mean_log10 + 1e-9,
+                "envelope {k}: order {} worse than order {}: {rows:?}",
+                w[1].order,
+                w[0].order
+            );
+        }
+        let best = ok.iter().map(|r| r.max_log10).fold(f64::INFINITY, f64::min);
+        assert!(
+            fit.certificate.max_log10_ratio <= best + set.auto_tolerance + 1e-9,
+            "envelope {k}: auto {} vs best {best}",
+            fit.certificate.max_log10_ratio
+        );
+    }
 }

@@ -12,6 +12,7 @@
 //! run goes on with the others.
 
 use super::basis::{reference_poles, GridPoint, PointKind};
+use super::polyfit;
 use super::problem::{
     area_fixed_poles, basis_rows, initial_points, max_slack, SolverEvent, SolverStatus,
 };
@@ -427,8 +428,19 @@ pub(crate) fn fit_order(
         ));
     }
 
-    // 3. Rank: feasible (to the LP accuracy) first; never worse than the previous order.
+    // 3. The global minimax over the full numerator and denominator (quasi-convex, see
+    //    [`super::polyfit`]), searched only below the best level reached so far.
     let ok = |c: &Scored| c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6;
+    let t_known = cands
+        .iter()
+        .filter(|c| ok(c))
+        .map(|c| c.t)
+        .fold(f64::INFINITY, f64::min);
+    if let Some(c) = polyfit::minimax(prep, n, t_known, set, &mut events, &mut lp_solves) {
+        cands.push(c);
+    }
+
+    // 4. Rank: feasible (to the LP accuracy) first; never worse than the previous order.
     let guard = |c: &Scored| match prev {
         Some(p) => c.mean_log <= p.mean_log + 1e-12 && c.max_log <= p.max_log + 1e-12,
         None => true,

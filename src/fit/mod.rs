@@ -23,6 +23,7 @@ pub mod between;
 pub mod certificate;
 pub(crate) mod engine;
 pub mod order;
+pub(crate) mod polyfit;
 pub mod problem;
 pub mod realization;
 pub mod run;
@@ -373,7 +374,7 @@ impl Context<'_> {
         let inp = self.cert_input(set);
         let mut reasons = Vec::new();
         let mut first_failed: Option<FitResult> = None;
-        for cand in ranked.iter().take(4) {
+        let one = |cand: &Scored| -> (FitResult, Scored) {
             let unscaled = cand.zpk.unscale(self.scaling.omega0, self.scaling.rho);
             let (fixed, cert) = certificate::certify_and_repair(&unscaled, &inp);
             let objective_value = match set.objective {
@@ -388,17 +389,39 @@ impl Context<'_> {
                 order,
                 objective: set.objective,
                 objective_value,
-                certificate: cert.clone(),
+                certificate: cert,
                 origin: cand.origin.clone(),
                 solver_events: events.clone(),
                 lp_solves,
                 scaling: self.scaling,
                 floor: self.floor,
             };
+            let mut sc = cand.clone();
+            sc.zpk.gain *= res.certificate.repair_factor;
+            let sc = self.prep.score(sc.zpk, &sc.origin);
+            (res, sc)
+        };
+        for cand in ranked.iter().take(4) {
+            let (res, sc) = one(cand);
+            let cert = res.certificate.clone();
             if cert.passed {
-                let mut sc = cand.clone();
-                sc.zpk.gain *= cert.repair_factor;
-                let sc = self.prep.score(sc.zpk, &sc.origin);
+                // A candidate repaired after its certificate (a dip between grid points)
+                // can end a hair worse than the previous order's r: then that one is kept,
+                // so conservatism never increases with the order.
+                let carried = ranked
+                    .iter()
+                    .find(|c| c.origin.ends_with("carried over") && c.origin != cand.origin);
+                if let Some(c) = carried {
+                    let (cres, csc) = one(c);
+                    let (a, b) = (&res.certificate, &cres.certificate);
+                    if cres.certificate.passed
+                        && (b.max_log10_ratio < a.max_log10_ratio
+                            || b.mean_log10_ratio < a.mean_log10_ratio)
+                        && b.max_log10_ratio <= a.max_log10_ratio + 1e-6
+                    {
+                        return Ok((cres, csc));
+                    }
+                }
                 return Ok((res, sc));
             }
             reasons.push(format!("{}: {}", cand.origin, cert.failures.join(", ")));

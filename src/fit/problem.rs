@@ -194,7 +194,7 @@ pub(crate) fn initial_points(grid: &[GridPoint], target: usize) -> Vec<bool> {
 /// violation along each group, and the worst ones) until none is violated, so the solution
 /// is optimal for the full LP.  With 1000 data the working set stays a few hundred rows.
 #[allow(clippy::too_many_arguments)]
-fn active_set_solve(
+pub(crate) fn active_set_solve(
     n: usize,
     c: &[f64],
     rows: &[(Vec<f64>, f64)],
