@@ -258,31 +258,11 @@ fn attained_min(sq: &SquaredMagnitude, xa: f64, xb: f64, b2: f64) -> (f64, f64, 
     let k = (0..=n)
         .min_by(|i, j| vals[*i].total_cmp(&vals[*j]))
         .unwrap_or(0);
-    let (mut a, mut b) = (xs[k.saturating_sub(1)], xs[(k + 1).min(n)]);
+    let (a, b) = (xs[k.saturating_sub(1)], xs[(k + 1).min(n)]);
     let mut best = (vals[k], xs[k]);
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let f = |x: f64| sq.at(x) / b2;
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..60 {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    for (v, x) in [(fc, c), (fd, d)] {
-        if v < best.0 {
-            best = (v, x);
-        }
+    let (x, v) = crate::system::golden::golden_section_min(|x| sq.at(x) / b2, a, b, 60);
+    if v < best.0 {
+        best = (v, x);
     }
     (best.0, best.1, n + 63)
 }

@@ -88,32 +88,10 @@ pub struct CertInput<'a> {
     pub axis_tol: f64,
 }
 
-fn golden_min(f: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, iters: usize) -> (f64, f64) {
+fn golden_min(f: &dyn Fn(f64) -> f64, a: f64, b: f64, iters: usize) -> (f64, f64) {
     // On ln ω.
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut c = b - g * (b - a);
-    let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (f(c.exp()), f(d.exp()));
-    for _ in 0..iters {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = f(c.exp());
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = f(d.exp());
-        }
-    }
-    if fc < fd {
-        (c.exp(), fc)
-    } else {
-        (d.exp(), fd)
-    }
+    let (x, fx) = crate::system::golden::golden_section_min(|x| f(x.exp()), a, b, iters);
+    (x.exp(), fx)
 }
 
 /// Minimum of `f` over the sorted grid `w`, refined by golden section around every grid

@@ -70,32 +70,9 @@ fn refine_peak(ev: &FreqEvaluator, omega: f64) -> (f64, f64) {
     if !(omega.is_finite() && omega > 0.0) {
         return (sigma_max(ev, omega), omega);
     }
-    let phi = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut a, mut b) = ((omega / 1.001).ln(), (omega * 1.001).ln());
-    let f = |x: f64| sigma_max(ev, x.exp());
-    let mut c = b - phi * (b - a);
-    let mut d = a + phi * (b - a);
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..80 {
-        if fc > fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - phi * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + phi * (b - a);
-            fd = f(d);
-        }
-    }
-    if fc > fd {
-        (fc, c.exp())
-    } else {
-        (fd, d.exp())
-    }
+    let (a, b) = ((omega / 1.001).ln(), (omega * 1.001).ln());
+    let (x, neg) = super::golden::golden_section_min(|x| -sigma_max(ev, x.exp()), a, b, 80);
+    (-neg, x.exp())
 }
 
 fn hamiltonian(ss: &StateSpace, gamma: f64) -> Option<DMatrix<f64>> {

@@ -3,6 +3,7 @@
 pub mod dense_inverse;
 pub mod eig;
 pub mod freq_eval;
+pub mod golden;
 pub mod hinf;
 pub mod interconnect;
 pub mod linalg;
