@@ -206,7 +206,7 @@ fn theorem2_envelope_on_tf_plant_equals_hand_typed_factors() {
 
 #[test]
 fn iss_model_factors_are_normalized_and_exact() {
-    let path = repo("../shared/data/slicot-iss1r/model.json");
+    let path = repo("configs/data/iss1r/model.json");
     if !path.exists() {
         panic!("missing {}", path.display());
     }
