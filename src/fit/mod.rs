@@ -21,6 +21,7 @@
 pub mod basis;
 pub mod between;
 pub mod certificate;
+pub(crate) mod chebseries;
 pub(crate) mod engine;
 pub mod order;
 pub(crate) mod polyfit;

@@ -19,90 +19,40 @@
 //! are optimal to the bisection tolerance and no more LPs are spent.
 
 use super::basis::{GridPoint, PointKind};
+use super::chebseries::{self, cheb};
 use super::engine::{Prepared, Scored};
 use super::problem::{active_set_solve, initial_points, SolverEvent, SolverStatus};
 use super::spectral::Zpk;
 use super::FitSettings;
-use crate::system::Polynomial;
 use num_complex::Complex64;
 
-/// `[T_0(u), …, T_n(u)]`.
-fn cheb(n: usize, u: f64) -> Vec<f64> {
-    let mut t = vec![1.0, u];
-    for k in 2..=n {
-        let v = 2.0 * u * t[k - 1] - t[k - 2];
-        t.push(v);
-    }
-    t.truncate(n + 1);
-    t
-}
-
-/// The disk variable of `x = ω̂²` (`1` at infinity).
-fn disk(x: f64) -> f64 {
+/// The disk variable of `x = ω̂²` centred at `x₀` (`−1` at `ω = 0`, `0` at `x₀`, `1` at
+/// infinity).
+fn disk(x: f64, x0: f64) -> f64 {
     if x.is_infinite() {
         1.0
     } else {
-        (x - 1.0) / (x + 1.0)
+        (x - x0) / (x + x0)
     }
 }
 
-/// Chebyshev coefficients → monomial coefficients in `u`, ascending.
-fn cheb_to_mono(c: &[f64]) -> Vec<f64> {
-    let n = c.len();
-    let mut out = vec![0.0; n];
-    let (mut tkm1, mut tk) = (vec![1.0], vec![0.0, 1.0]);
-    for (k, ck) in c.iter().enumerate() {
-        let tcur: &Vec<f64> = if k == 0 { &tkm1 } else { &tk };
-        for (j, v) in tcur.iter().enumerate() {
-            out[j] += ck * v;
-        }
-        if k >= 1 {
-            let mut next = vec![0.0; tk.len() + 1];
-            for (j, v) in tk.iter().enumerate() {
-                next[j + 1] += 2.0 * v;
-            }
-            for (j, v) in tkm1.iter().enumerate() {
-                next[j] -= v;
-            }
-            tkm1 = std::mem::replace(&mut tk, next);
-        }
-    }
-    out
-}
-
-/// `(1 + x)^n Σ c_k T_k(u)` as a polynomial in `x` (descending powers).
-fn to_x_poly(c: &[f64]) -> Polynomial {
-    let n = c.len() - 1;
-    let mono = cheb_to_mono(c);
-    let xm1 = Polynomial::new(vec![1.0, -1.0]);
-    let xp1 = Polynomial::new(vec![1.0, 1.0]);
-    let mut acc = Polynomial::constant(0.0);
-    for (j, mj) in mono.iter().enumerate() {
-        let mut term = Polynomial::constant(*mj);
-        for _ in 0..j {
-            term = term.mul(&xm1);
-        }
-        for _ in j..n {
-            term = term.mul(&xp1);
-        }
-        acc = acc.add(&term);
-    }
-    acc
-}
-
-/// Stable spectral roots of `(1 + x)^n Σ c_k T_k(u)`, or why not.
-fn spectral_roots(c: &[f64], set: &FitSettings) -> Result<Vec<Complex64>, String> {
-    let p = to_x_poly(c);
-    if p.degree() + 1 < c.len() {
-        return Err("degree drop at infinity".into());
-    }
-    let roots = p.roots_capped(set.root_iter_cap);
-
-    if !roots.converged {
+/// Stable spectral roots `s` of `(x + x₀)^n Σ c_k T_k(u)`, or why not: each root `u` of the
+/// series maps to `x = x₀(1 + u)/(1 − u)` (a dropped degree in `u` to `x = −x₀`), and `x`
+/// to `s = −√(−x)` (see [`super::spectral`]).
+fn spectral_roots(c: &[f64], x0: f64, set: &FitSettings) -> Result<Vec<Complex64>, String> {
+    let Some((us, dropped)) = chebseries::roots(c, set.root_iter_cap) else {
         return Err("root iteration did not converge".into());
+    };
+    let one = Complex64::new(1.0, 0.0);
+    let mut xs: Vec<Complex64> = vec![Complex64::new(-x0, 0.0); dropped];
+    for u in us {
+        if (one - u).norm() == 0.0 {
+            return Err("degree drop at infinity (r not biproper)".into());
+        }
+        xs.push(x0 * (one + u) / (one - u));
     }
-    let mut out = Vec::with_capacity(roots.roots.len());
-    for x in roots.roots {
+    let mut out = Vec::with_capacity(xs.len());
+    for x in xs {
         let s = -(-x).sqrt();
         let s = if x.im == 0.0 {
             Complex64::new(s.re, 0.0)
@@ -120,8 +70,8 @@ fn spectral_roots(c: &[f64], set: &FitSettings) -> Result<Vec<Complex64>, String
     Ok(out)
 }
 
-/// Rows `row·v ≥ rhs` (variables `[a; b; s]`), their groups and grid points; the level rows
-/// (`A ≤ t·upper·B`) are appended by [`level_rows`].
+/// Rows `row·v ≥ rhs` (variables `[a; b]`), their groups and grid points; the level rows
+/// (`A ≤ t·upper·B`) are appended by [`level_rows`], the positivity cuts by [`cut_rows`].
 struct Rows {
     rows: Vec<(Vec<f64>, f64)>,
     group: Vec<u32>,
@@ -138,55 +88,61 @@ fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
     r.point.push(p);
 }
 
-/// Floor on `Σ b_k T_k(u)` (normalized to 1 at `ω̂ = 1`).
+/// Floor on `Σ b_k T_k(u)` at the grid (normalized to 1 at `x = x₀`).
 const B_MIN: f64 = 1e-14;
 
-fn fixed_rows(n: usize, grid: &[GridPoint]) -> Rows {
+/// Floor on `Σ b_k T_k(u)` at a positivity cut: far enough above zero that the LP's own
+/// tolerance (about 1e-8 on normalized rows) cannot hide a sign change there again.
+const B_CUT: f64 = 1e-7;
+
+/// Rounds of positivity cuts per level.
+const CUT_ROUNDS: usize = 8;
+
+/// A row `ca·A(u) + cb·B(u)`.
+fn ab_row(n: usize, u: f64, ca: f64, cb: f64) -> Vec<f64> {
     let k = n + 1;
+    let t = cheb(n, u);
+    let mut v = vec![0.0; 2 * k];
+    for j in 0..k {
+        v[j] = ca * t[j];
+        v[k + j] = cb * t[j];
+    }
+    v
+}
+
+fn fixed_rows(n: usize, grid: &[GridPoint], x0: f64) -> Rows {
     let mut r = Rows {
         rows: Vec::new(),
         group: Vec::new(),
         point: Vec::new(),
     };
     for (i, g) in grid.iter().enumerate() {
-        let t = cheb(n, disk(g.x));
-        let mk = |ca: f64, cb: f64| {
-            let mut v = vec![0.0; 2 * k];
-            for j in 0..k {
-                v[j] = ca * t[j];
-                v[k + j] = cb * t[j];
-            }
-            v
-        };
+        let u = disk(g.x, x0);
         if g.lower > 0.0 {
-            push(&mut r, mk(1.0, -g.lower), 0.0, 0, i);
+            push(&mut r, ab_row(n, u, 1.0, -g.lower), 0.0, 0, i);
         }
         if let Some(a) = g.a1 {
-            push(&mut r, mk(-1.0, a), 0.0, 2, i);
+            push(&mut r, ab_row(n, u, -1.0, a), 0.0, 2, i);
         }
-        push(&mut r, mk(0.0, 1.0), B_MIN, 3, i);
+        push(&mut r, ab_row(n, u, 0.0, 1.0), B_MIN, 3, i);
     }
     r
 }
 
-fn level_rows(n: usize, grid: &[GridPoint], t: f64, base: &Rows) -> Rows {
-    let k = n + 1;
+fn level_rows(n: usize, grid: &[GridPoint], x0: f64, t: f64, base: &Rows, cuts: &Rows) -> Rows {
     let mut r = Rows {
         rows: base.rows.clone(),
         group: base.group.clone(),
         point: base.point.clone(),
     };
     for (i, g) in grid.iter().enumerate() {
-        if let Some(u) = g.upper.filter(|_| g.kind == PointKind::Datum) {
-            let tt = cheb(n, disk(g.x));
-            let mut v = vec![0.0; 2 * k];
-            for j in 0..k {
-                v[j] = -tt[j];
-                v[k + j] = t * u * tt[j];
-            }
-            push(&mut r, v, 0.0, 1, i);
+        if let Some(up) = g.upper.filter(|_| g.kind == PointKind::Datum) {
+            push(&mut r, ab_row(n, disk(g.x, x0), -1.0, t * up), 0.0, 1, i);
         }
     }
+    r.rows.extend(cuts.rows.iter().cloned());
+    r.group.extend(&cuts.group);
+    r.point.extend(&cuts.point);
     // Sort by (group, point) so that neighbours along a group are adjacent for the
     // working-set rule.
     let mut idx: Vec<usize> = (0..r.rows.len()).collect();
@@ -195,6 +151,50 @@ fn level_rows(n: usize, grid: &[GridPoint], t: f64, base: &Rows) -> Rows {
         rows: idx.iter().map(|&i| r.rows[i].clone()).collect(),
         group: idx.iter().map(|&i| r.group[i]).collect(),
         point: idx.iter().map(|&i| r.point[i]).collect(),
+    }
+}
+
+/// Positivity cuts for a solution `(a, b)` of the LP on the grid: `B ≥ B_CUT` and
+/// `A ≥ floor·B` at each point of `[−1, 1]` where they fail between grid points (found
+/// exactly by [`chebseries::below`]).  Both must hold on all of `[−1, 1]` (`x ∈ [0, ∞]`) for
+/// the spectral factors to exist (Youla; Boulet & Francis 1998, §3): the grid alone cannot
+/// see a sign change of `B` far above the band, where the disk form of a rising `|r|` is
+/// tiny.  Returns whether any cut was added.
+fn cut_rows(n: usize, x: &[f64], floor: f64, cap: usize, cuts: &mut Rows) -> bool {
+    let k = n + 1;
+    let (a, b) = (&x[..k], &x[k..2 * k]);
+    let before = cuts.rows.len();
+    for u in chebseries::below(b, 0.1 * B_CUT, cap) {
+        push(cuts, ab_row(n, u, 0.0, 1.0), B_CUT, 4, usize::MAX);
+    }
+    let af: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - floor * q).collect();
+    for u in chebseries::below(&af, 0.0, cap) {
+        push(cuts, ab_row(n, u, 1.0, -floor), 0.0, 5, usize::MAX);
+    }
+    cuts.rows.len() > before
+}
+
+/// Largest violation `rhs − row·x` over normalized rows.
+fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
+    let scale = 1.0 + x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    rows.iter()
+        .map(|(r, h)| h - r.iter().zip(x).map(|(a, b)| a * b).sum::<f64>())
+        .fold(f64::NEG_INFINITY, f64::max)
+        / scale
+}
+
+/// Disk-map centres tried, in scaled `x`: the band centre, then the two quarter points
+/// (`x₀ = ω̂_hi` and `1/ω̂_hi`).  The Chebyshev series of `A` and `B` are well scaled only
+/// near their centre: with all roots at one end of a wide band (a rising envelope: zeros at
+/// its top, poles above it) the centred series are tiny there and the LP's tolerance hides
+/// their sign, so the level it proves is not reachable by a unit; an off-centre map keeps
+/// them of order one (measured on the reference sweep of `tests/fit_reference.rs`).
+fn centres(prep: &Prepared) -> Vec<f64> {
+    let w_hi = prep.band.1.max(1.0 / prep.band.0).max(1.0);
+    if w_hi < 1.5 {
+        vec![1.0]
+    } else {
+        vec![1.0, w_hi, 1.0 / w_hi]
     }
 }
 
@@ -211,49 +211,103 @@ pub(crate) fn minimax(
     if n == 0 {
         return None;
     }
+    let mut best: Option<Scored> = None;
+    let mut t_best = t_known;
+    for x0 in centres(prep) {
+        if let Some(c) = minimax_at(prep, n, x0, t_best, set, events, lp_solves) {
+            if c.t < t_best || !t_best.is_finite() {
+                t_best = c.t;
+                best = Some(c);
+            }
+        }
+    }
+    best
+}
+
+/// [`minimax`] with the disk map centred at `x₀`.
+fn minimax_at(
+    prep: &Prepared,
+    n: usize,
+    x0: f64,
+    t_known: f64,
+    set: &FitSettings,
+    events: &mut Vec<SolverEvent>,
+    lp_solves: &mut usize,
+) -> Option<Scored> {
     let k = n + 1;
     let nv = 2 * k;
-    let base = fixed_rows(n, &prep.grid);
+    let base = fixed_rows(n, &prep.grid, x0);
+    let floor = prep
+        .grid
+        .iter()
+        .filter(|g| g.kind == PointKind::Infinity)
+        .map(|g| g.lower)
+        .fold(0.0, f64::max);
     let init = initial_points(&prep.grid, 40);
     let mut eq = vec![0.0; nv];
     eq[k..2 * k].copy_from_slice(&cheb(n, 0.0));
     let eqs = vec![(eq, 1.0)];
     let cost = vec![0.0; nv];
     let mut mask = Vec::new();
+    // Cuts found at one level stay valid at every level (they are not level rows).
+    let mut cuts = Rows {
+        rows: Vec::new(),
+        group: Vec::new(),
+        point: Vec::new(),
+    };
     let mut try_level = |t: f64, events: &mut Vec<SolverEvent>| -> Option<Vec<f64>> {
-        let r = level_rows(n, &prep.grid, t, &base);
-        if mask.len() != r.rows.len() {
-            mask.clear();
+        for _ in 0..CUT_ROUNDS {
+            let r = level_rows(n, &prep.grid, x0, t, &base, &cuts);
+            if mask.len() != r.rows.len() {
+                mask.clear();
+            }
+            let (out, rounds) = active_set_solve(
+                nv,
+                &cost,
+                &r.rows,
+                &r.group,
+                &r.point,
+                &eqs,
+                &init,
+                &mut mask,
+                set.max_solver_iter,
+            );
+            *lp_solves += rounds;
+            if matches!(
+                out.status,
+                SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
+            ) {
+                return None;
+            }
+            // A reduced-accuracy or capped solve still proves the level when its point
+            // meets every row to the working tolerance: the positivity cuts below and the
+            // coverage check of the candidate are exact, whatever the LP's accuracy.
+            let usable = out.status == SolverStatus::Solved
+                || (out.x.len() == nv
+                    && out.x.iter().all(|v| v.is_finite())
+                    && max_violation(&r.rows, &out.x) <= 1e-8);
+            if !usable {
+                events.push(SolverEvent {
+                    order: n,
+                    stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
+                    status: out.status,
+                    action: "level treated as not feasible (the other candidates stand)".into(),
+                });
+                return None;
+            }
+            if !cut_rows(n, &out.x, floor, set.root_iter_cap, &mut cuts) {
+                return Some(out.x);
+            }
         }
-        let (out, rounds) = active_set_solve(
-            nv,
-            &cost,
-            &r.rows,
-            &r.group,
-            &r.point,
-            &eqs,
-            &init,
-            &mut mask,
-            set.max_solver_iter,
-        );
-        *lp_solves += rounds;
-        if matches!(
-            out.status,
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
-        ) {
-            return None;
-        }
-        if out.status != SolverStatus::Solved {
-            events.push(SolverEvent {
-                order: n,
-                stage: format!("polynomial minimax t={t:.4e}"),
-                status: out.status,
-                action: "level treated as not feasible (the partial-fraction candidates stand)"
-                    .into(),
-            });
-            return None;
-        }
-        Some(out.x)
+        events.push(SolverEvent {
+            order: n,
+            stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
+            status: SolverStatus::Solved,
+            action: format!(
+                "A or B still not positive on [0, inf] after {CUT_ROUNDS} rounds of cuts; level treated as not feasible"
+            ),
+        });
+        None
     };
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
     let mut feasible: Vec<(f64, Vec<f64>)> = Vec::new();
@@ -293,32 +347,31 @@ pub(crate) fn minimax(
             None => lo = mid,
         }
     }
-    // The lowest feasible level first; a solution whose spectral factors fail (B or A
-    // negative between grid points far above the band, where the disk form is small and
-    // the LP tolerance hides the sign) gives way to the next higher feasible level.
+    // The lowest feasible level first; a solution that still fails (the certificate's
+    // exact test is stricter than the grid) gives way to the next higher feasible level.
     let mut found: Vec<(f64, Vec<f64>)> = feasible;
     found.sort_by(|p, q| p.0.total_cmp(&q.0));
     let mut last_err = None;
     for (lev, x) in found.into_iter().take(6) {
         let (a, b) = (&x[..k], &x[k..2 * k]);
-        match (spectral_roots(a, set), spectral_roots(b, set)) {
+        match (spectral_roots(a, x0, set), spectral_roots(b, x0, set)) {
             (Ok(zeros), Ok(poles)) => {
                 let mut z = Zpk {
                     gain: 1.0,
                     zeros,
                     poles,
                 };
-                let ev = |c: &[f64]| cheb(n, 0.0).iter().zip(c).map(|(p, q)| p * q).sum::<f64>();
-                let target = (ev(a) / ev(b)).sqrt();
-                z.gain = target / z.mag(1.0);
+                let target = (chebseries::eval(a, 0.0) / chebseries::eval(b, 0.0)).sqrt();
+                z.gain = target / z.mag(x0.sqrt());
                 if z.gain > 0.0 && z.gain.is_finite() {
                     let c = prep.score(z, &format!("polynomial minimax (t = {:.4e})", lev.exp()));
                     if c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6 {
                         return Some(c);
                     }
                     last_err = Some(format!(
-                        "level {:.4e}: bounds missed on the grid",
-                        lev.exp()
+                        "level {:.4e}: bounds missed on the grid (coverage {:.3e})",
+                        lev.exp(),
+                        c.coverage
                     ));
                 }
             }
@@ -328,7 +381,7 @@ pub(crate) fn minimax(
     if let Some(e) = last_err {
         events.push(SolverEvent {
             order: n,
-            stage: "polynomial minimax spectral factorization".into(),
+            stage: format!("polynomial minimax (x0 = {x0:.3e}) spectral factorization"),
             status: SolverStatus::Solved,
             action: format!("{e}; candidate discarded, others tried"),
         });
@@ -341,15 +394,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn x_polynomial_matches_the_chebyshev_form() {
-        let c = [0.7, -0.2, 0.05, 0.01];
-        let p = to_x_poly(&c);
-        for x in [1e-3, 0.5, 1.0, 7.0, 1e3] {
-            let u = disk(x);
-            let direct =
-                (1.0 + x).powi(3) * cheb(3, u).iter().zip(&c).map(|(a, b)| a * b).sum::<f64>();
-            let via = p.eval(Complex64::new(x, 0.0)).re;
-            assert!((direct - via).abs() <= 1e-12 * direct.abs().max(1.0), "{x}");
+    fn spectral_roots_of_a_known_unit_through_the_disk_map() {
+        // |r|² for r = (s + 3)(s + 200)/((s + 0.5)(s + 1000)) in x, centre x₀ = 50:
+        // A(x) = (x + 9)(x + 4e4); as a series in u, A(x)/(x + x₀)² = Σ a_k T_k(u) with
+        // x = x₀(1+u)/(1−u): fit the three coefficients by interpolation at u = −½, 0, ½.
+        let x0 = 50.0;
+        let set = FitSettings::default();
+        for (roots, want) in [([9.0, 4e4], [-3.0, -200.0]), ([0.25, 1e6], [-0.5, -1000.0])] {
+            let f = |u: f64| {
+                let x = x0 * (1.0 + u) / (1.0 - u);
+                (x + roots[0]) * (x + roots[1]) / ((x + x0) * (x + x0))
+            };
+            // T0 = 1, T1 = u, T2 = 2u² − 1 at u = −½, 0, ½.
+            let m = nalgebra::Matrix3::new(1.0, -0.5, -0.5, 1.0, 0.0, -1.0, 1.0, 0.5, -0.5);
+            let rhs = nalgebra::Vector3::new(f(-0.5), f(0.0), f(0.5));
+            let c = m.lu().solve(&rhs).unwrap();
+            let mut s = spectral_roots(c.as_slice(), x0, &set).unwrap();
+            s.sort_by(|p, q| q.re.total_cmp(&p.re));
+            for (got, w) in s.iter().zip(want) {
+                assert!(
+                    (got.re - w).abs() < 1e-9 * w.abs() && got.im == 0.0,
+                    "{s:?}"
+                );
+            }
         }
     }
 }
