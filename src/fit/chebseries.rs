@@ -131,15 +131,20 @@ pub(crate) fn roots(c: &[f64], cap: usize) -> Option<(Vec<Complex64>, usize)> {
 
 /// Points of `[−1, 1]` where `Σ c_k T_k(u) < floor`, one per interval of violation (its
 /// minimum among the probe points), or an empty list when the series stays above `floor`.
+pub(crate) fn below(c: &[f64], floor: f64, cap: usize) -> Vec<f64> {
+    below_on(c, -1.0, 1.0, floor, cap)
+}
+
+/// [`below`] on `[lo, hi] ⊂ [−1, 1]`.
 ///
 /// Exact up to rounding: the series is a polynomial of degree `n`, so between two
 /// consecutive real critical points (roots of the derivative, computed as roots of the
-/// derivative's own series) it is monotone; its minimum over `[−1, 1]` is attained at an
+/// derivative's own series) it is monotone; its minimum over `[lo, hi]` is attained at an
 /// endpoint or at one of those points.  Evaluating there finds every interval where it
 /// falls below `floor`, however narrow — no sampling.
-pub(crate) fn below(c: &[f64], floor: f64, cap: usize) -> Vec<f64> {
+pub(crate) fn below_on(c: &[f64], lo: f64, hi: f64, floor: f64, cap: usize) -> Vec<f64> {
     let n = c.len().saturating_sub(1);
-    let mut probes = vec![-1.0, 1.0];
+    let mut probes = vec![lo, hi];
     if n >= 2 {
         let d = derivative(c);
         match roots(&d, cap) {
@@ -147,17 +152,18 @@ pub(crate) fn below(c: &[f64], floor: f64, cap: usize) -> Vec<f64> {
                 for z in rs {
                     // A complex pair close to the axis is a near-critical point: probe its
                     // real part too.
-                    if z.im.abs() <= 1e-3 && z.re.abs() < 1.0 {
+                    if z.im.abs() <= 1e-3 && z.re > lo && z.re < hi {
                         probes.push(z.re);
                     }
                 }
             }
             None => {
                 // No convergence: fall back to a dense Chebyshev-node probe (never silent:
-                // the caller's spectral factorization verifies again).
-                probes.extend(
-                    (0..4096).map(|j| (std::f64::consts::PI * (j as f64 + 0.5) / 4096.0).cos()),
-                );
+                // the candidate's certificate verifies again).
+                probes.extend((0..4096).map(|j| {
+                    let v = (std::f64::consts::PI * (j as f64 + 0.5) / 4096.0).cos();
+                    0.5 * (lo + hi) + 0.5 * (hi - lo) * v
+                }));
             }
         }
     }

@@ -10,6 +10,7 @@
 //! * [`spectral`]: spectral factorization, roots on the axis reported as errors;
 //! * [`engine`]: one order — candidates, failures recorded and skipped;
 //! * [`between`]: the no-dip rule between data, proved by interval branch-and-bound;
+//! * [`context`]: input checks, prescaling, and the choice among certified candidates;
 //! * [`certificate`]: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
 //! * [`realization`]: a balanced cascade state-space realization of `r` for the exports;
 //! * [`order`]: the order sweep and the automatic order choice;
@@ -22,6 +23,7 @@ pub mod basis;
 pub mod between;
 pub mod certificate;
 pub(crate) mod chebseries;
+mod context;
 pub(crate) mod engine;
 pub mod order;
 pub(crate) mod polyfit;
@@ -38,8 +40,9 @@ pub use spectral::Zpk;
 
 use crate::consistency::Envelope;
 use crate::system::TransferFunction;
-use basis::{build_grid, GridSpec, Scaling};
-use engine::{fit_order, Prepared, Scored};
+use basis::Scaling;
+use context::{prepare, Context};
+use engine::{fit_order, Scored};
 use num_complex::Complex64;
 use serde::Serialize;
 
@@ -197,255 +200,6 @@ fn fmt_list(v: &[f64]) -> String {
 
 /// The A1 limit `σ_min(M̃(jω))` as a function of ω in rad/s.
 pub type A1Fn<'a> = &'a dyn Fn(f64) -> f64;
-
-/// Checked, scaled inputs.
-pub(crate) struct Context<'a> {
-    pub env: &'a Envelope,
-    pub a1: Option<A1Fn<'a>>,
-    pub scaling: Scaling,
-    pub floor: f64,
-    pub prep: Prepared,
-}
-
-pub(crate) fn prepare<'a>(
-    env: &'a Envelope,
-    a1: Option<A1Fn<'a>>,
-    set: &FitSettings,
-) -> Result<Context<'a>, FitError> {
-    let n = env.omega.len();
-    if n == 0 || env.r_min.len() != n {
-        return Err(FitError::Invalid(format!(
-            "the envelope needs one r_min per frequency and at least one datum (got {} frequencies, {} r_min)",
-            n,
-            env.r_min.len()
-        )));
-    }
-    if let Some(a) = &env.a1_limit {
-        if a.len() != n {
-            return Err(FitError::Invalid(
-                "a1_limit must have one value per datum".into(),
-            ));
-        }
-    }
-    for i in 0..n {
-        let w = env.omega[i];
-        if !(w.is_finite() && w > 0.0) || (i > 0 && !(w > env.omega[i - 1])) {
-            return Err(FitError::Invalid(format!(
-                "frequencies must be finite, positive and strictly increasing (datum {} at {w})",
-                i + 1
-            )));
-        }
-        if env.r_min[i].is_nan() || env.r_min[i] < 0.0 {
-            return Err(FitError::Invalid(format!(
-                "r_min at omega = {w} is {} (must be ≥ 0 or inf)",
-                env.r_min[i]
-            )));
-        }
-    }
-    let ok_margin = set.margin >= 0.0 && set.margin.is_finite();
-    let ok_floor = set.floor_rel > 0.0 && set.floor_rel < 1.0;
-    if !ok_margin || !ok_floor || set.grid_per_decade < 50 || set.cert_per_decade < 50 {
-        return Err(FitError::Invalid(
-            "settings: margin must be ≥ 0, floor_rel in (0, 1), grid densities ≥ 50 per decade"
-                .into(),
-        ));
-    }
-    let inadmissible: Vec<f64> = (0..n)
-        .filter(|i| env.r_min[*i].is_infinite())
-        .map(|i| env.omega[i])
-        .collect();
-    if !inadmissible.is_empty() {
-        return Err(FitError::Inadmissible(inadmissible));
-    }
-    let need = 1.0 + set.margin;
-    let a1_at = |i: usize| -> Option<f64> {
-        match (a1, &env.a1_limit) {
-            (Some(f), _) => Some(f(env.omega[i])),
-            (None, Some(a)) => Some(a[i]),
-            _ => None,
-        }
-    };
-    let beyond: Vec<f64> = (0..n)
-        .filter(|i| a1_at(*i).is_some_and(|a| !(env.r_min[*i] * need < a)))
-        .map(|i| env.omega[i])
-        .collect();
-    if !beyond.is_empty() {
-        return Err(FitError::BeyondA1(beyond));
-    }
-    let min_pos = env
-        .r_min
-        .iter()
-        .copied()
-        .filter(|r| *r > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if !min_pos.is_finite() {
-        return Err(FitError::Invalid(
-            "every r_min is 0: the data are explained within the noise and need no bound; nothing to fit"
-                .into(),
-        ));
-    }
-    let scaling = Scaling::from_data(&env.omega, &env.r_min);
-    let floor = set.floor_rel * min_pos;
-    let w: Vec<f64> = env.omega.iter().map(|x| x / scaling.omega0).collect();
-    let rmin: Vec<f64> = env.r_min.iter().map(|r| r / scaling.rho).collect();
-    let safety = 1.0 + 1e-7;
-    let lower: Vec<f64> = rmin.iter().map(|r| (r * need * safety).powi(2)).collect();
-    // Log-frequency trapezoid weights over the data with a bound.
-    let mut weights = vec![0.0; n];
-    for i in 0..n {
-        if rmin[i] > 0.0 {
-            let a = if i > 0 { (w[i] / w[i - 1]).ln() } else { 0.0 };
-            let b = if i + 1 < n {
-                (w[i + 1] / w[i]).ln()
-            } else {
-                0.0
-            };
-            weights[i] = 0.5 * (a + b);
-        }
-    }
-    let total: f64 = weights.iter().sum();
-    let cnt = rmin.iter().filter(|r| **r > 0.0).count() as f64;
-    for (i, wt) in weights.iter_mut().enumerate() {
-        *wt = if total > 0.0 {
-            *wt / total
-        } else if rmin[i] > 0.0 {
-            1.0 / cnt
-        } else {
-            0.0
-        };
-    }
-    let (o0, rho, back) = (scaling.omega0, scaling.rho, 1.0 - set.a1_backoff);
-    let a1_scaled = a1.map(|f| move |wh: f64| (f(wh * o0) * back / rho).powi(2));
-    let a1_data: Option<Vec<f64>> = env
-        .a1_limit
-        .as_ref()
-        .map(|a| a.iter().map(|v| (v * back / rho).powi(2)).collect());
-    let grid = build_grid(&GridSpec {
-        w: &w,
-        lower: &lower,
-        a1: a1_scaled.as_ref().map(|f| f as &dyn Fn(f64) -> f64),
-        a1_data: a1_data.as_deref(),
-        floor: (floor / rho).powi(2),
-        per_decade: set.grid_per_decade,
-        extend_decades: set.extend_decades,
-        no_dip: set.no_dip,
-    });
-    let band = (w[0], w[n - 1]);
-    Ok(Context {
-        env,
-        a1,
-        scaling,
-        floor,
-        prep: Prepared {
-            w,
-            rmin,
-            weights,
-            grid,
-            band,
-        },
-    })
-}
-
-impl Context<'_> {
-    pub(crate) fn cert_input(&self, set: &FitSettings) -> certificate::CertInput<'_> {
-        certificate::CertInput {
-            omega: &self.env.omega,
-            r_min: &self.env.r_min,
-            a1: self.a1,
-            a1_data: self.env.a1_limit.as_deref(),
-            margin: set.margin,
-            floor: self.floor,
-            per_decade: set.cert_per_decade,
-            extend_decades: set.extend_decades,
-            no_dip: set.no_dip,
-            axis_tol: set.axis_tol,
-        }
-    }
-
-    /// Certifies the ranked candidates of one order, best first; returns the first that
-    /// passes (possibly repaired), or the reasons they all failed.
-    pub(crate) fn certify_ranked(
-        &self,
-        order: usize,
-        ranked: &[Scored],
-        events: Vec<SolverEvent>,
-        lp_solves: usize,
-        set: &FitSettings,
-    ) -> Result<(FitResult, Scored), FitError> {
-        let inp = self.cert_input(set);
-        let mut reasons = Vec::new();
-        let mut first_failed: Option<FitResult> = None;
-        let one = |cand: &Scored| -> (FitResult, Scored) {
-            let unscaled = cand.zpk.unscale(self.scaling.omega0, self.scaling.rho);
-            let (fixed, cert) = certificate::certify_and_repair(&unscaled, &inp);
-            let objective_value = match set.objective {
-                Objective::Minimax => cert.max_log10_ratio,
-                Objective::Area => cand.area * cert.repair_factor.powi(2),
-            };
-            let res = FitResult {
-                r: TransferFunction::from_zpk(&fixed.zeros, &fixed.poles, fixed.gain),
-                zeros: fixed.zeros.clone(),
-                poles: fixed.poles.clone(),
-                gain: fixed.gain,
-                order,
-                objective: set.objective,
-                objective_value,
-                certificate: cert,
-                origin: cand.origin.clone(),
-                solver_events: events.clone(),
-                lp_solves,
-                scaling: self.scaling,
-                floor: self.floor,
-            };
-            let mut sc = cand.clone();
-            sc.zpk.gain *= res.certificate.repair_factor;
-            let sc = self.prep.score(sc.zpk, &sc.origin);
-            (res, sc)
-        };
-        for cand in ranked.iter().take(4) {
-            let (res, sc) = one(cand);
-            let cert = res.certificate.clone();
-            if cert.passed {
-                // A candidate repaired after its certificate (a dip between grid points)
-                // can end a hair worse than the previous order's r: then that one is kept,
-                // so conservatism never increases with the order.
-                let carried = ranked
-                    .iter()
-                    .find(|c| c.origin.ends_with("carried over") && c.origin != cand.origin);
-                if let Some(c) = carried {
-                    let (cres, csc) = one(c);
-                    let (a, b) = (&res.certificate, &cres.certificate);
-                    if cres.certificate.passed
-                        && (b.max_log10_ratio < a.max_log10_ratio
-                            || b.mean_log10_ratio < a.mean_log10_ratio)
-                        && b.max_log10_ratio <= a.max_log10_ratio + 1e-6
-                    {
-                        return Ok((cres, csc));
-                    }
-                }
-                return Ok((res, sc));
-            }
-            reasons.push(format!("{}: {}", cand.origin, cert.failures.join(", ")));
-            if first_failed.is_none() {
-                first_failed = Some(res);
-            }
-        }
-        match first_failed {
-            Some(r) => Err(FitError::Uncertified {
-                result: Box::new(r),
-                reasons,
-            }),
-            None => Err(FitError::NoFeasibleFit {
-                order,
-                reasons: events
-                    .iter()
-                    .map(|e| format!("{}: {:?} ({})", e.stage, e.status, e.action))
-                    .collect(),
-                events,
-            }),
-        }
-    }
-}
 
 /// Fits a unit `r(s)` of order `settings.order` above the envelope (see the module doc).
 ///

@@ -3,8 +3,9 @@
 //! (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest order whose
 //! mean and max are both within `auto_tolerance` of the best in the table.
 
+use super::context::prepare;
 use super::engine::{fit_order, Scored};
-use super::{prepare, A1Fn, FitError, FitResult, FitSettings};
+use super::{A1Fn, FitError, FitResult, FitSettings};
 use crate::consistency::Envelope;
 use serde::Serialize;
 

@@ -160,10 +160,37 @@ fn level_rows(n: usize, grid: &[GridPoint], x0: f64, t: f64, base: &Rows, cuts: 
 /// the spectral factors to exist (Youla; Boulet & Francis 1998, §3): the grid alone cannot
 /// see a sign change of `B` far above the band, where the disk form of a rising `|r|` is
 /// tiny.  Returns whether any cut was added.
-fn cut_rows(n: usize, x: &[f64], floor: f64, cap: usize, cuts: &mut Rows) -> bool {
+fn cut_rows(
+    n: usize,
+    x: &[f64],
+    floor: f64,
+    data: &[(f64, f64)],
+    cap: usize,
+    cuts: &mut Rows,
+) -> bool {
     let k = n + 1;
     let (a, b) = (&x[..k], &x[k..2 * k]);
     let before = cuts.rows.len();
+    // No dip between data: `A ≥ min(l_i, l_{i+1})·B` on each interval.  A dip narrower than
+    // the grid spacing sits at a zero pair of `A` close to the axis, so only the intervals
+    // holding the real part of such a root are tested (exactly, on the interval).
+    if let Some((za, _)) = chebseries::roots(a, cap) {
+        for z in za {
+            if z.im.abs() > 0.05 || !(z.re > -1.0 && z.re < 1.0) {
+                continue;
+            }
+            let j = data.partition_point(|(u, _)| *u <= z.re);
+            if j == 0 || j == data.len() {
+                continue;
+            }
+            let ((lo, l0), (hi, l1)) = (data[j - 1], data[j]);
+            let l = l0.min(l1);
+            let c: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - l * q).collect();
+            for u in chebseries::below_on(&c, lo, hi, 0.0, cap) {
+                push(cuts, ab_row(n, u, 1.0, -l), 0.0, 6, usize::MAX);
+            }
+        }
+    }
     for u in chebseries::below(b, 0.1 * B_CUT, cap) {
         push(cuts, ab_row(n, u, 0.0, 1.0), B_CUT, 4, usize::MAX);
     }
@@ -183,8 +210,8 @@ fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
         / scale
 }
 
-/// Disk-map centres tried, in scaled `x`: the band centre, then the two quarter points
-/// (`x₀ = ω̂_hi` and `1/ω̂_hi`).  The Chebyshev series of `A` and `B` are well scaled only
+/// Disk-map centres tried, in scaled `x`: the band centre, then — only when the search at
+/// the previous centre had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`).  The Chebyshev series of `A` and `B` are well scaled only
 /// near their centre: with all roots at one end of a wide band (a rising envelope: zeros at
 /// its top, poles above it) the centred series are tiny there and the LP's tolerance hides
 /// their sign, so the level it proves is not reachable by a unit; an off-centre map keeps
@@ -214,11 +241,18 @@ pub(crate) fn minimax(
     let mut best: Option<Scored> = None;
     let mut t_best = t_known;
     for x0 in centres(prep) {
+        let before = events.len();
         if let Some(c) = minimax_at(prep, n, x0, t_best, set, events, lp_solves) {
             if c.t < t_best || !t_best.is_finite() {
                 t_best = c.t;
                 best = Some(c);
             }
+        }
+        // Every doubt (a solve short of `Solved`, cuts that did not converge, a failed
+        // factorization) is an event; a search without one decided every level exactly
+        // at this centre, and the other centres are not needed.
+        if events.len() == before {
+            break;
         }
     }
     best
@@ -243,6 +277,16 @@ fn minimax_at(
         .filter(|g| g.kind == PointKind::Infinity)
         .map(|g| g.lower)
         .fold(0.0, f64::max);
+    // The data as (u, lower bound on |r̂|²), increasing in u, for the no-dip cuts.
+    let data: Vec<(f64, f64)> = if set.no_dip {
+        prep.grid
+            .iter()
+            .filter(|g| g.kind == PointKind::Datum)
+            .map(|g| (disk(g.x, x0), g.lower))
+            .collect()
+    } else {
+        Vec::new()
+    };
     let init = initial_points(&prep.grid, 40);
     let mut eq = vec![0.0; nv];
     eq[k..2 * k].copy_from_slice(&cheb(n, 0.0));
@@ -295,7 +339,7 @@ fn minimax_at(
                 });
                 return None;
             }
-            if !cut_rows(n, &out.x, floor, set.root_iter_cap, &mut cuts) {
+            if !cut_rows(n, &out.x, floor, &data, set.root_iter_cap, &mut cuts) {
                 return Some(out.x);
             }
         }
