@@ -235,8 +235,46 @@ pub fn fit_unit(
                 r
             })
         }
+        Ok(alone) if !settings.chain && settings.order > 0 && doubtful(&alone) => {
+            // The order alone ended on the constant fallback or after a level search that
+            // failed numerically (GitHub issue 11, defect 5: a steep rise made the order-3
+            // fit fall back to a constant 6 decades above the data while order 2 reached
+            // 0.03 decade).  The chained fit carries the lower orders forward; the better
+            // certified of the two is returned.
+            let chained = FitSettings {
+                chain: true,
+                ..settings.clone()
+            };
+            match fit_with(&ctx, &chained) {
+                Ok(mut c) if c.objective_value < alone.objective_value => {
+                    c.solver_events.insert(
+                        0,
+                        SolverEvent {
+                            order: settings.order,
+                            stage: "order alone".into(),
+                            status: SolverStatus::NoCandidate,
+                            action: format!(
+                                "level search failed numerically (best alone: {} at {:.4}); refitted with the lower orders carried forward",
+                                alone.origin, alone.objective_value
+                            ),
+                        },
+                    );
+                    Ok(c)
+                }
+                _ => Ok(alone),
+            }
+        }
         other => other,
     }
+}
+
+/// True when a fit of one order alone may have missed its optimum for numerical reasons:
+/// it ended on the constant fallback, or its level search found no feasible level at all.
+fn doubtful(r: &FitResult) -> bool {
+    r.origin.starts_with("constant")
+        || r.solver_events
+            .iter()
+            .any(|e| e.order == r.order && e.action.starts_with("no feasible level"))
 }
 
 fn fit_with(ctx: &Context<'_>, settings: &FitSettings) -> Result<FitResult, FitError> {
