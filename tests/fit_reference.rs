@@ -152,10 +152,21 @@ fn reference_level_at(
     }
     for i in 1..omega.len() {
         let m = l[i - 1].min(l[i]);
-        for w in logspace(omega[i - 1], omega[i], 6).iter().skip(1).take(4) {
-            points.push(u(x(*w)));
+        for (j, w) in logspace(omega[i - 1], omega[i], 42)
+            .iter()
+            .enumerate()
+            .skip(1)
+            .take(40)
+        {
+            // Four points between data are LP rows; all forty are checked afterwards (a
+            // unit that dips between the rows does not count, as in rshape's certificate).
+            if j % 8 == 4 {
+                points.push(u(x(*w)));
+                if m > 0.0 {
+                    fixed.push(row(u(x(*w)), 1.0, m, 0.0));
+                }
+            }
             if m > 0.0 {
-                fixed.push(row(u(x(*w)), 1.0, m, 0.0));
                 bounds.push((u(x(*w)), m));
             }
         }
@@ -430,4 +441,19 @@ fn steep_rise_is_fitted_near_the_reference_at_orders_1_to_3() {
             assert!(ours < 0.05, "order {order}: {ours}");
         }
     }
+}
+
+/// A chosen list of pairs (`PAIRS=3:4,14:6`), for investigating the sweep.
+#[test]
+#[ignore = "manual: PAIRS=k:n,... cargo test --release --test fit_reference pairs -- --ignored"]
+fn pairs_from_the_environment() {
+    let list: Vec<(usize, usize)> = std::env::var("PAIRS")
+        .unwrap_or_default()
+        .split(',')
+        .filter_map(|p| {
+            let (k, n) = p.split_once(':')?;
+            Some((k.parse().ok()?, n.parse().ok()?))
+        })
+        .collect();
+    sweep(&list, 0);
 }

@@ -243,8 +243,10 @@ pub(crate) fn minimax(
     for x0 in centres(prep) {
         let before = events.len();
         if let Some(c) = minimax_at(prep, n, x0, t_best, set, events, lp_solves) {
-            if c.t < t_best || !t_best.is_finite() {
-                t_best = c.t;
+            // A candidate at (or a hair above) the level already known is kept too: it
+            // is exact between the data where the known one may need repair.
+            if best.as_ref().is_none_or(|b: &Scored| c.t < b.t) {
+                t_best = t_best.min(c.t);
                 best = Some(c);
             }
         }
@@ -317,10 +319,9 @@ fn minimax_at(
                 set.max_solver_iter,
             );
             *lp_solves += rounds;
-            if matches!(
-                out.status,
-                SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
-            ) {
+            // Only a full-accuracy certificate of infeasibility decides the level; a
+            // reduced-accuracy one is a doubt like any other status below.
+            if out.status == SolverStatus::PrimalInfeasible {
                 return None;
             }
             // A reduced-accuracy or capped solve still proves the level when its point
@@ -358,9 +359,37 @@ fn minimax_at(
     let (mut lo, mut hi);
     if t_known.is_finite() && t_known >= 1.0 {
         let probe = (t_known.ln() - tol).max(0.0);
-        feasible.push((probe, try_level(probe.exp(), events)?));
-        hi = probe;
-        lo = 0.0;
+        match try_level(probe.exp(), events) {
+            Some(x) => {
+                feasible.push((probe, x));
+                hi = probe;
+                lo = 0.0;
+            }
+            None => {
+                // No better level exists on the grid, but the candidate that reached
+                // `t_known` may dip between grid points and lose up to 0.03 decade to the
+                // certificate's repair; this fitter's solution at that level has its no-dip
+                // cuts checked exactly, so it is offered too.
+                // When that candidate does dip, the exact optimum lies above `t_known`:
+                // steps of 0.25, 2, 8, 32 tolerances (up to 0.06 decade), then bisection.
+                lo = t_known.ln();
+                hi = f64::NAN;
+                for step in [0.25, 2.0, 8.0, 32.0] {
+                    let at = t_known.ln() + step * tol;
+                    match try_level(at.exp(), events) {
+                        Some(x) => {
+                            feasible.push((at, x));
+                            hi = at;
+                            break;
+                        }
+                        None => lo = at,
+                    }
+                }
+                if hi.is_nan() {
+                    return None;
+                }
+            }
+        }
     } else {
         let mut t = 10.0f64;
         lo = 0.0;
