@@ -74,7 +74,10 @@ fn channels(cfg: &str, extra: &[&str]) -> Vec<Option<String>> {
     }
     let err = text(&out.stderr);
     let (o, i) = dims(&err).unwrap_or_else(|| panic!("{cfg}: {err}"));
-    assert!(err.contains("--channel OUT,IN") && err.lines().count() == 1, "{err}");
+    assert!(
+        err.contains("--channel OUT,IN") && err.lines().count() == 1,
+        "{err}"
+    );
     (1..=o)
         .flat_map(|a| (1..=i).map(move |b| Some(format!("{a},{b}"))))
         .collect()
@@ -101,11 +104,7 @@ fn compare_runs_on_every_config_and_every_channel() {
                 args.extend(["--channel", c]);
             }
             let out = rshape(&args);
-            assert!(
-                out.status.success(),
-                "{cfg} {ch:?}: {}",
-                text(&out.stderr)
-            );
+            assert!(out.status.success(), "{cfg} {ch:?}: {}", text(&out.stderr));
             let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
             let rms = v["misfit_rms"].as_f64().unwrap();
             assert!(rms.is_finite() && rms >= 0.0, "{cfg} {ch:?}: {rms}");
