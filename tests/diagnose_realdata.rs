@@ -208,8 +208,8 @@ fn factor_form_configs_compare_and_diagnose() {
         err.contains("cannot be converted") && err.lines().count() == 1,
         "{err}"
     );
-    // Closed-loop configs reach diagnose through the open-loop equivalent (here a standard
-    // factorization, which diagnose cannot extend: the same one-line reason).
+    // Closed-loop configs reach diagnose through the open-loop equivalent; their nominal
+    // N̂·D̂⁻¹ = 1/s² is converted to a [physical] rigid body.
     let out = Command::new(exe)
         .args([
             "diagnose",
@@ -219,10 +219,23 @@ fn factor_form_configs_compare_and_diagnose() {
         ])
         .output()
         .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines().next().unwrap().contains(
+            "the [closed_loop] nominal plant is a sum of physical terms: converted to [physical] (1 rigid body)"
+        ),
+        "{text}"
+    );
+    // A state-space [plant] is not converted: the one-line reason, exit 2.
+    let out = Command::new(exe)
+        .args(["diagnose", "configs/iss1r_reduced.toml", "--channel", "1,1"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("standard factorization") && err.lines().count() == 1,
+        err.contains("a state-space [plant] is not converted") && err.lines().count() == 1,
         "{err}"
     );
 }
