@@ -3,9 +3,10 @@
 //! Let `O = diag(O_1 … O_p)` be the output-path effects, `O_i(s)` the product of the effects
 //! on output `i`. Then `O·G = Σ_k O·C_{:,k}·M̃_kk⁻¹·Ñ_k·J`.
 //!
-//! * When every output carries the same chain `O_0`, `O = O_0·I` commutes with the plant and
-//!   goes into every entry of `J` (the SISO case is this one).
-//! * Otherwise the outputs are grouped by their chain, `P_g` the projection on group `g`, and
+//! * A constant effect (gain, sign) on output `i` scales row `i` of `C`.
+//! * When every output carries the same dynamic chain `O_0`, `O = O_0·I` commutes with the
+//!   plant and goes into every entry of `J` (the SISO case is this one).
+//! * Otherwise the outputs are grouped by their dynamic chain, `P_g` the projection on group `g`, and
 //!   `O·C_{:,k} = Σ_g P_g C_{:,k} O_g`: modal row `k` becomes one row per group `g` that sees
 //!   it, with the same `M̃_kk`, the row `O_g·Ñ_k` and the column `P_g C_{:,k}` of `C`. `C`
 //!   stays constant, and its rank is still `p` (its rows of group `g` use only that group's
@@ -14,7 +15,7 @@
 //!   all-pass) is stable with no zero where `M̃_kk` vanishes (`s = 0` for a rigid body).
 //!   A sensor lag on output 2 of a 1×2 modal model with `n` modes thus gives `2n` rows.
 
-use super::{EffectPath, PhysicalModel};
+use super::{EffectKind, EffectPath, PhysicalModel};
 use crate::system::TransferFunction;
 
 /// The rows of a special factorization being built: the diagonal of `M̃`, the rows of `Ñ`
@@ -25,47 +26,65 @@ pub(super) struct Rows {
     pub c: Vec<Vec<f64>>,
 }
 
+/// The output-path effects on one output: the indices of the dynamic ones and their
+/// product, and the product of the constant ones (gain, sign).
+pub(super) struct Chain {
+    idx: Vec<usize>,
+    tf: TransferFunction,
+    gain: f64,
+}
+
 impl PhysicalModel {
-    /// Per output: the indices of the output-path effects acting on it and their product
-    /// (Padé of order `order` for delays and holds).
-    pub(super) fn output_chains(&self, order: usize) -> Vec<(Vec<usize>, TransferFunction)> {
+    /// Per output: its output-path effects (Padé of order `order` for delays and holds).
+    pub(super) fn output_chains(&self, order: usize) -> Vec<Chain> {
         (0..self.n_outputs())
             .map(|i| {
-                let mut idx = Vec::new();
-                let mut tf = TransferFunction::gain(1.0);
+                let mut ch = Chain {
+                    idx: Vec::new(),
+                    tf: TransferFunction::gain(1.0),
+                    gain: 1.0,
+                };
                 for (k, e) in self.effect.iter().enumerate() {
                     if e.path == EffectPath::Output && e.channel.is_none_or(|c| c == i + 1) {
-                        idx.push(k);
-                        tf = tf.mul(&e.to_tf(order));
+                        match e.kind {
+                            EffectKind::Gain => ch.gain *= e.k.unwrap_or(1.0),
+                            EffectKind::Sign => ch.gain = -ch.gain,
+                            _ => {
+                                ch.idx.push(k);
+                                ch.tf = ch.tf.mul(&e.to_tf(order));
+                            }
+                        }
                     }
                 }
-                (idx, tf)
+                ch
             })
             .collect()
     }
 }
 
-/// Puts the output chains into the factorization (see the module docs): into `j` when all
-/// outputs share one chain, else by splitting each modal row per group of outputs.
-pub(super) fn split_rows(
-    chains: Vec<(Vec<usize>, TransferFunction)>,
-    rows: Rows,
-    j: &mut [TransferFunction],
-) -> Rows {
-    if chains.iter().all(|c| c.0 == chains[0].0) {
-        if !chains[0].0.is_empty() {
+/// Puts the output chains into the factorization (see the module docs): constant gains into
+/// the rows of `C`; dynamic effects into `j` when all outputs share them, else by splitting
+/// each modal row per group of outputs.
+pub(super) fn split_rows(chains: Vec<Chain>, mut rows: Rows, j: &mut [TransferFunction]) -> Rows {
+    for ck in rows.c.iter_mut() {
+        for (i, x) in ck.iter_mut().enumerate() {
+            *x *= chains[i].gain;
+        }
+    }
+    if chains.iter().all(|c| c.idx == chains[0].idx) {
+        if !chains[0].idx.is_empty() {
             for jk in j.iter_mut() {
-                *jk = jk.mul(&chains[0].1);
+                *jk = jk.mul(&chains[0].tf);
             }
         }
         return rows;
     }
-    // Groups of outputs with the same chain, in order of their first output.
+    // Groups of outputs with the same dynamic effects, in order of their first output.
     let mut groups: Vec<(Vec<usize>, &TransferFunction)> = Vec::new();
-    for (i, (key, tf)) in chains.iter().enumerate() {
-        match groups.iter_mut().find(|g| chains[g.0[0]].0 == *key) {
+    for (i, ch) in chains.iter().enumerate() {
+        match groups.iter_mut().find(|g| chains[g.0[0]].idx == ch.idx) {
             Some(g) => g.0.push(i),
-            None => groups.push((vec![i], tf)),
+            None => groups.push((vec![i], &ch.tf)),
         }
     }
     let mut out = Rows {
@@ -160,6 +179,44 @@ mod tests {
         let want = -w * 1.5e-4 - (w / 3000.0f64).atan();
         assert!((extra - want).abs() < 1e-9, "{extra} vs {want}");
         assert!(((g[(0, 0)] / g0[(0, 0)]) - 0.9).norm() < 1e-12);
+    }
+
+    /// A gain on one output scales its row of `C`: no row is split.
+    #[test]
+    fn a_gain_on_one_output_scales_its_row_of_c() {
+        let ph: PhysicalModel = toml::from_str(
+            r#"
+            [[rigid_body]]
+            output_gain = [100.0, 100.0]
+            [[mode]]
+            omega_n = 480.0
+            zeta = 0.02
+            output_gain = [100.0, -100.0]
+            [[effect]]
+            kind = "gain"
+            path = "output"
+            channel = 2
+            k = 0.8
+            [[effect]]
+            kind = "sign"
+            path = "output"
+            channel = 1
+            "#,
+        )
+        .unwrap();
+        let f = ph.to_factorization().unwrap();
+        assert_eq!(f.c.ncols(), 2);
+        // Columns: the mode, then the rigid body.
+        assert_eq!(
+            (f.c[(0, 0)], f.c[(1, 0)], f.c[(1, 1)]),
+            (-100.0, -80.0, 80.0)
+        );
+        for w in [1.0, 480.0, 5000.0] {
+            let (a, b) = (f.plant(w).unwrap(), ph.eval(w));
+            for i in 0..2 {
+                assert!((a[(i, 0)] - b[(i, 0)]).norm() <= 1e-12 * b[(i, 0)].norm());
+            }
+        }
     }
 
     /// The same effects on every output go into `J`: no row is split.
