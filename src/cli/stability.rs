@@ -6,7 +6,7 @@
 use super::common::InputArgs;
 use crate::fit::{run_fit, FitSettings, OrderChoice};
 use crate::model::controller::Controller;
-use crate::model::Config;
+use crate::model::{Config, FactorizationKind};
 use crate::plot::stability::{stability_svg, StabilityInput};
 use crate::report::fmt::fmt_g;
 use crate::stability::analyze;
@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 /// Arguments of `rshape stability`.
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
-    /// The TOML config (a standard [model] or a [plant]; its [r] is the configured bound).
+    /// The TOML config (any factorization: [model] standard or special, [physical], [plant];
+    /// its [r] is the configured bound).
     pub config: PathBuf,
     /// The controller file (a [controller] table).
     #[arg(long)]
@@ -174,12 +175,16 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         return Ok(1);
     }
     outln!(
-        "internally stable: {n} closed-loop poles, largest real part {}",
+        "internally stable: {n} closed-loop poles (the loop's and the factors' own), largest real part {}",
         fmt_g(rep.abscissa)
     );
     if let Some(t) = &rep.t_norm {
+        let form = match config.factorization.kind {
+            FactorizationKind::Standard => "T = [K; I](I+GK)^-1 M~^-1",
+            FactorizationKind::Special => "T = [JKC; I](M~ + N~JKC)^-1, special factorization",
+        };
         outln!(
-            "||T||_inf = {} at omega = {} rad/s (T = [K; I](I+GK)^-1 M~^-1)",
+            "||T||_inf = {} at omega = {} rad/s ({form})",
             fmt_g(t.gamma),
             fmt_g(t.omega)
         );
