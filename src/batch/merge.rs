@@ -101,6 +101,7 @@ pub fn merge(
             factorization: config
                 .as_ref()
                 .and_then(crate::pipeline::closed_loop::a1_factorization),
+            closed_loop: first.closed_loop,
         },
     )?;
     Ok(MergeOutcome {
