@@ -102,21 +102,46 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     if let Some(p) = &a.r_json {
         rs.push(("fitted".into(), read_r_json(p)?));
     }
-    if a.fit {
-        let out = a
-            .out
-            .as_ref()
-            .ok_or_else(|| anyhow!("--fit writes r.json and its exports: give --out DIR"))?;
+    // Grid from the data range, else from the plant's poles (via a first pass, which also
+    // checks the controller's size before anything is written).
+    let probe = analyze(&config.factorization, &controller, &[], &[1.0])?;
+    // With --fit, the data are read and the envelope computed before the folder is touched.
+    let fit_input = if a.fit {
+        if a.out.is_none() {
+            return Err(anyhow!(
+                "--fit writes r.json and its exports: give --out DIR"
+            ));
+        }
         let input = InputArgs {
             config: a.config.clone(),
             data: a.data.clone(),
             noise_radius: None,
         };
-        let (inputs, env) = input.envelope()?;
+        Some(input.envelope()?)
+    } else {
+        None
+    };
+    // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
+    // input's folder; the previous run's listed files are cleared.
+    let inputs: Vec<&Path> = [
+        Some(a.config.as_path()),
+        Some(a.controller.as_path()),
+        a.r_json.as_deref(),
+        a.data.as_deref(),
+        config.data.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let _manifest = match &a.out {
+        Some(out) => Some(super::common::prepare_out(out, &inputs)?),
+        None => None,
+    };
+    if let (Some((inputs, env)), Some(out)) = (&fit_input, &a.out) {
         let f = &inputs.config.factorization;
         let a1 = |w: f64| f.a1_limit(w);
         let outcome = run_fit(
-            &env,
+            env,
             Some(&a1),
             &FitSettings::default(),
             OrderChoice::Auto { max: 8 },
@@ -125,13 +150,10 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         fit_text = outcome.text;
         rs.push(("fitted".into(), outcome.result.r.clone()));
     }
-    // Grid from the data range, else from the plant's poles (via a first pass).
-    let probe = analyze(&config.factorization, &controller, &[], &[1.0])?;
     let grid = grid_for(&config, &probe.0.closed_loop_poles);
     let (rep, curve) = analyze(&config.factorization, &controller, &rs, &grid)?;
     let robust = rep.internally_stable && rep.margins.iter().all(|m| m.robust);
     if let Some(out) = &a.out {
-        std::fs::create_dir_all(out).with_context(|| format!("{}", out.display()))?;
         let labelled: Vec<(String, Vec<f64>)> = rs
             .iter()
             .map(|(l, _)| l.clone())
