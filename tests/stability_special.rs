@@ -367,3 +367,47 @@ fn robot_with_a_destabilizing_gain_exits_1_and_lists_the_unstable_poles() {
     assert!(text.contains("NOT internally stable"), "{text}");
     assert!(text.contains("4.53"), "{text}");
 }
+
+#[test]
+fn closed_loop_config_uses_its_factors_but_not_its_weight_v_as_r() {
+    // configs/closed_loop_same.toml: nominal 1/s² with factors N̂ = 1/(s+2)², D̂ = s²/(s+2)²,
+    // [v] = (0.015 s + 0.035)/(s + 1) weights the dual-Youla perturbation, not the factors.
+    let dir = tempfile::tempdir().unwrap();
+    let k = dir.path().join("k.toml");
+    std::fs::write(
+        &k,
+        "[controller]\ntf = [[{ num = [20, 20], den = [1, 10] }]]\n",
+    )
+    .unwrap();
+    let cfg = repo("configs/closed_loop_same.toml");
+    let out = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        k.to_str().unwrap(),
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let rep: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert!(margins(&rep).is_empty(), "{rep}");
+    // Poles of the loop 1/s² with 20(s+1)/(s+10): s³ + 10s² + 20s + 20 = 0, largest real
+    // part −1.12344 (numpy.roots); the factors' own poles (−2, double) lie further left.
+    let abscissa = rep["abscissa"].as_f64().unwrap();
+    assert!((abscissa + 1.123_445).abs() < 1e-5, "{abscissa}");
+    let out = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        k.to_str().unwrap(),
+        "--fit",
+        "--out",
+        dir.path().join("o").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let e = stderr(&out);
+    assert!(
+        e.contains("--r-json") && e.trim_end().lines().count() == 1,
+        "{e}"
+    );
+    assert!(!dir.path().join("o").exists());
+}

@@ -95,7 +95,17 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     let config = Config::load(&a.config)?;
     let controller = Controller::load(&a.controller)?;
     let mut rs: Vec<(String, TransferFunction)> = Vec::new();
-    if let Some(r) = &config.r {
+    // A [closed_loop] config holds the weight V of Crowder & de Callafon in `config.r`: it
+    // bounds the dual-Youla perturbation, not the factor perturbation of Theorem 1, so it is
+    // not a configured r here (its nominal factors are, with an r from --r-json).
+    let closed_loop = config.closed_loop.is_some();
+    if closed_loop && a.fit {
+        return Err(anyhow!(
+            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
+            a.config.display()
+        ));
+    }
+    if let Some(r) = config.r.as_ref().filter(|_| !closed_loop) {
         rs.push(("configured".into(), r.clone()));
     }
     let mut fit_text = String::new();
@@ -227,7 +237,9 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
             }
         }
     }
-    if rep.margins.is_empty() {
+    if rep.margins.is_empty() && closed_loop {
+        outln!("no r given: the [v] of a [closed_loop] config is not a factor bound; give --r-json for the Theorem 1 margin");
+    } else if rep.margins.is_empty() {
         outln!("no r given: add [r] to the config, --r-json or --fit for the Theorem 1 margin");
     } else {
         outln!(
