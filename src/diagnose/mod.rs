@@ -17,6 +17,7 @@ pub mod channels;
 pub mod engine;
 pub mod factor_form;
 pub mod fit;
+pub mod plant_form;
 pub mod problem;
 pub mod rank;
 pub mod report;
