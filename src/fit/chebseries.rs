@@ -180,6 +180,45 @@ pub(crate) fn below_on(c: &[f64], lo: f64, hi: f64, floor: f64, cap: usize) -> V
     out
 }
 
+/// Stable spectral roots `s` of `(x + x₀)^n Σ c_k T_k(u)`, or why not: each root `u` of the
+/// series maps to `x = x₀(1 + u)/(1 − u)` (a dropped degree in `u` to `x = −x₀`), and `x`
+/// to `s = −√(−x)` (see [`super::spectral`], whose positivity argument applies).
+pub(crate) fn spectral_roots(
+    c: &[f64],
+    x0: f64,
+    axis_tol: f64,
+    cap: usize,
+) -> Result<Vec<Complex64>, String> {
+    let Some((us, dropped)) = roots(c, cap) else {
+        return Err("root iteration did not converge".into());
+    };
+    let one = Complex64::new(1.0, 0.0);
+    let mut xs: Vec<Complex64> = vec![Complex64::new(-x0, 0.0); dropped];
+    for u in us {
+        if (one - u).norm() == 0.0 {
+            return Err("degree drop at infinity (r not biproper)".into());
+        }
+        xs.push(x0 * (one + u) / (one - u));
+    }
+    let mut out = Vec::with_capacity(xs.len());
+    for x in xs {
+        let s = -(-x).sqrt();
+        let s = if x.im == 0.0 {
+            Complex64::new(s.re, 0.0)
+        } else {
+            s
+        };
+        if !(s.re < -axis_tol * s.norm()) || s.norm() == 0.0 {
+            return Err(format!(
+                "root on the jω-axis at scaled ω = {:.4e}",
+                s.im.abs()
+            ));
+        }
+        out.push(s);
+    }
+    Ok(out)
+}
+
 /// Chebyshev coefficients of the derivative (`c'_{k−1} = c'_{k+1} + 2k·c_k`).
 fn derivative(c: &[f64]) -> Vec<f64> {
     let n = c.len() - 1;

@@ -24,7 +24,6 @@ use super::engine::{Prepared, Scored};
 use super::problem::{active_set_solve, initial_points, SolverEvent, SolverStatus};
 use super::spectral::Zpk;
 use super::FitSettings;
-use num_complex::Complex64;
 
 /// The disk variable of `x = ω̂²` centred at `x₀` (`−1` at `ω = 0`, `0` at `x₀`, `1` at
 /// infinity).
@@ -34,40 +33,6 @@ fn disk(x: f64, x0: f64) -> f64 {
     } else {
         (x - x0) / (x + x0)
     }
-}
-
-/// Stable spectral roots `s` of `(x + x₀)^n Σ c_k T_k(u)`, or why not: each root `u` of the
-/// series maps to `x = x₀(1 + u)/(1 − u)` (a dropped degree in `u` to `x = −x₀`), and `x`
-/// to `s = −√(−x)` (see [`super::spectral`]).
-fn spectral_roots(c: &[f64], x0: f64, set: &FitSettings) -> Result<Vec<Complex64>, String> {
-    let Some((us, dropped)) = chebseries::roots(c, set.root_iter_cap) else {
-        return Err("root iteration did not converge".into());
-    };
-    let one = Complex64::new(1.0, 0.0);
-    let mut xs: Vec<Complex64> = vec![Complex64::new(-x0, 0.0); dropped];
-    for u in us {
-        if (one - u).norm() == 0.0 {
-            return Err("degree drop at infinity (r not biproper)".into());
-        }
-        xs.push(x0 * (one + u) / (one - u));
-    }
-    let mut out = Vec::with_capacity(xs.len());
-    for x in xs {
-        let s = -(-x).sqrt();
-        let s = if x.im == 0.0 {
-            Complex64::new(s.re, 0.0)
-        } else {
-            s
-        };
-        if !(s.re < -set.axis_tol * s.norm()) || s.norm() == 0.0 {
-            return Err(format!(
-                "root on the jω-axis at scaled ω = {:.4e}",
-                s.im.abs()
-            ));
-        }
-        out.push(s);
-    }
-    Ok(out)
 }
 
 /// Rows `row·v ≥ rhs` (variables `[a; b]`), their groups and grid points; the level rows
@@ -439,7 +404,10 @@ fn minimax_at(
     let mut last_err = None;
     for (lev, x) in found.into_iter().take(6) {
         let (a, b) = (&x[..k], &x[k..2 * k]);
-        match (spectral_roots(a, x0, set), spectral_roots(b, x0, set)) {
+        match (
+            chebseries::spectral_roots(a, x0, set.axis_tol, set.root_iter_cap),
+            chebseries::spectral_roots(b, x0, set.axis_tol, set.root_iter_cap),
+        ) {
             (Ok(zeros), Ok(poles)) => {
                 let mut z = Zpk {
                     gain: 1.0,
@@ -494,7 +462,9 @@ mod tests {
             let m = nalgebra::Matrix3::new(1.0, -0.5, -0.5, 1.0, 0.0, -1.0, 1.0, 0.5, -0.5);
             let rhs = nalgebra::Vector3::new(f(-0.5), f(0.0), f(0.5));
             let c = m.lu().solve(&rhs).unwrap();
-            let mut s = spectral_roots(c.as_slice(), x0, &set).unwrap();
+            let mut s =
+                chebseries::spectral_roots(c.as_slice(), x0, set.axis_tol, set.root_iter_cap)
+                    .unwrap();
             s.sort_by(|p, q| q.re.total_cmp(&p.re));
             for (got, w) in s.iter().zip(want) {
                 assert!(
