@@ -275,7 +275,7 @@ fn envelope(k: usize) -> (Vec<f64>, Vec<f64>) {
 /// `N + 1` (fitted alone, not chained) is never worse than order `N`.  Run with
 /// `cargo test --release --test fit_reference -- --ignored --nocapture` to see the table.
 #[test]
-#[ignore = "the full sweep takes minutes; the CI subset below covers its hard cases"]
+#[ignore = "3-6 min in release; issue 11 defect 3 partly open: a few of 240 pairs above the reference by more than 0.01 decade and fixed orders alone not always monotone (figures in README)"]
 fn rshape_reaches_the_reference_optimum_at_every_order() {
     let pairs: Vec<(usize, usize)> = (0..30).flat_map(|k| (1..=8).map(move |n| (k, n))).collect();
     sweep(&pairs, 200);
