@@ -21,6 +21,7 @@ use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Siso};
 pub use super::problem::Measures as ErrorMeasures;
+use super::polish::settle;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
 use super::rank::{
@@ -380,16 +381,18 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         dropped = failing.iter().map(|i| node.effects[*i].0.label()).collect();
         let model = assemble(base, &keep, data, None);
         node.measures = measures(&model, data)?;
+        node.v_fit = node.measures.v;
         node.model = model;
         node.steps.retain(|st| !dropped.contains(&st.effect));
         node.effects = keep;
     }
-    // A last joint refit of the chosen model.
-    let polished = retune(&node.model, data, None, false);
-    if polished.v_after < node.measures.v {
-        node.measures = measures(&polished.model, data)?;
-        node.model = polished.model;
+    // A last joint refit of the chosen model, and its consistency polish.
+    let refit = retune(&node.model, data, None, false);
+    if refit.v_after < node.v_fit {
+        node.v_fit = refit.v_after;
+        node.model = refit.model;
     }
+    (node.model, node.measures) = settle(node.model, data)?;
     let chosen_bic = res.nodes[res.chosen].bic;
     let mut runner_up: Vec<EffectSet> = res
         .nodes

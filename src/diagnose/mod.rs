@@ -17,11 +17,13 @@ pub mod channels;
 pub mod engine;
 pub mod factor_form;
 pub mod fit;
+pub mod polish;
 pub mod problem;
 pub mod rank;
 pub mod report;
 pub mod retune;
 pub mod search;
+mod slots;
 mod starts;
 
 pub use channels::{misfit_channels, Channels};
