@@ -20,8 +20,8 @@
 use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Siso};
-pub use super::problem::Measures as ErrorMeasures;
 use super::polish::settle;
+pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
 use super::rank::{

@@ -20,7 +20,7 @@
 //! least-squares fit; the polish decides only whether the model is consistent.
 
 use super::channels::Channels;
-use super::compare::MAX_MISFIT_RMS;
+use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
 use super::fit::lm_box;
 use super::problem::{Measures, Problem};
 use super::slots::{bounds, design, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl};
@@ -35,7 +35,8 @@ const MU: [f64; 4] = [2.0, 6.0, 20.0, 60.0];
 const ITER: usize = 60;
 
 /// Upper `p`-quantile of χ² with `nu` degrees of freedom (Wilson & Hilferty 1931: the cube
-/// root of `χ²/ν` is nearly normal; within 0.5 % of the exact quantile for ν ≥ 3 at p = 0.95).
+/// root of `χ²/ν` is nearly normal): at p = 0.95 it is 2.5 % low for ν = 1, 0.51 % for ν = 3
+/// and below 0.1 % for ν ≥ 10, where `diagnose` uses it.
 pub fn chi2_quantile(nu: f64, z_p: f64) -> f64 {
     let a = 2.0 / (9.0 * nu);
     nu * (1.0 - a + z_p * a.sqrt()).powi(3)
@@ -116,6 +117,7 @@ pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
         return None;
     }
     let budget = v0 + 0.5 * chi2_quantile(n as f64, Z95);
+    let n_data = (data.len() * data.n_ch()) as f64;
     let mut best: Option<(usize, f64, Vec<f64>)> = None;
     for mu in MU {
         let f = |th: &[f64], out: &mut Vec<f64>| {
@@ -135,6 +137,12 @@ pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
         if out < out0 && best.as_ref().is_none_or(|b| (out, v) < (b.0, b.1)) {
             best = Some((out, v, res.theta.clone()));
         }
+        // The smallest move that brings the model within the noise is enough.
+        if (out as f64) <= MAX_INVALID_FRACTION * n_data
+            && v <= MAX_MISFIT_RMS.powi(2) * 2.0 * n_data
+        {
+            break;
+        }
         theta = res.theta;
     }
     best.map(|(_, _, th)| par.model(m, &th))
@@ -143,7 +151,10 @@ pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
 /// The model to judge consistency by: `m` itself when it is consistent or its `misfit_rms`
 /// exceeds 1 (no polish can help inside the confidence region), else its polish when that
 /// is consistent.  Returns the model and its measures.
-pub fn settle(m: PhysicalModel, data: &Channels) -> crate::error::Result<(PhysicalModel, Measures)> {
+pub fn settle(
+    m: PhysicalModel,
+    data: &Channels,
+) -> crate::error::Result<(PhysicalModel, Measures)> {
     let m0 = Problem::new(&m, data)?.measures(&Default::default());
     if m0.consistent() || m0.misfit_rms > MAX_MISFIT_RMS {
         return Ok((m, m0));
@@ -172,7 +183,8 @@ mod tests {
             (100.0, 124.342113),
         ] {
             let got = chi2_quantile(nu, Z95);
-            assert!(((got - q) / q).abs() < 5e-3, "ν = {nu}: {got} vs {q}");
+            let tol = if nu < 10.0 { 6e-3 } else { 1e-3 };
+            assert!(((got - q) / q).abs() < tol, "ν = {nu}: {got} vs {q}");
         }
     }
 }

@@ -241,7 +241,7 @@ pub fn refit_nominal(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::physical::{ModeSpec, PoleAtZeroSpec};
+    use crate::model::physical::{EffectKind, Gains, ModeSpec, PoleAtZeroSpec};
 
     fn two_mass(k: f64, w: f64, z: f64, rho: f64, tau: f64) -> PhysicalModel {
         let mut e = crate::model::physical::EffectSpec::new(EffectKind::Delay);

@@ -267,7 +267,10 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
         .min_by(|a, b| {
             let key = |i: usize| {
                 let n = &nodes[i];
-                (n.n_params, n.effects.iter().map(|e| prior(&e.0)).sum::<usize>())
+                (
+                    n.n_params,
+                    n.effects.iter().map(|e| prior(&e.0)).sum::<usize>(),
+                )
             };
             key(*a)
                 .cmp(&key(*b))

@@ -223,7 +223,6 @@ pub(super) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) 
     }
 }
 
-
 /// The weighted design matrix of the linear slots `lin` of `m` (nonlinear ones fixed) on the
 /// data at `mask`, and the weighted data: rows are `(Re, Im)` of `√2/r · (·)` per channel and
 /// datum, so `‖y − A x‖²` is the cost `V` with the linear parameters `x`.
