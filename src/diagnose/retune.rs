@@ -78,7 +78,9 @@ fn solve_linear_res(
     } else {
         let qr = a.clone().qr();
         let r = qr.r();
-        let qty = qr.q().transpose() * &y;
+        // Qᵀy by the Householder reflections (no explicit Q).
+        let mut qty = y.clone();
+        qr.q_tr_mul(&mut qty);
         let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
         let mut x = DVector::<f64>::zeros(n);
         for i in (0..n).rev() {

@@ -237,33 +237,49 @@ pub(super) fn design(
     let n = lin.len();
     let mut a = DMatrix::<f64>::zeros(rows, n);
     let mut y = DVector::<f64>::zeros(rows);
+    // The denominator of each column's term `(d₂ s² + d₁ s + d₀)` with `d₂ = 0` for an
+    // integrator, `None` for a feedthrough; its input gains over its mass.
+    let zero = Complex64::new(0.0, 0.0);
+    let cols: Vec<(Option<[f64; 3]>, Vec<f64>)> = lin
+        .iter()
+        .map(|l| match l {
+            Lin::Out(t, _) => {
+                let (_, b, mass) = gains_of(m, *t);
+                let den = match t {
+                    Term::Rigid(i) => [1.0, m.rigid_body[*i].friction_pole.unwrap_or(0.0), 0.0],
+                    Term::Int(_) => [0.0, 1.0, 0.0],
+                    Term::Mode(i) => {
+                        let md = &m.mode[*i];
+                        [1.0, 2.0 * md.zeta * md.omega_n, md.omega_n * md.omega_n]
+                    }
+                };
+                (Some(den), b.to_vec(n_in).iter().map(|x| x / mass).collect())
+            }
+            Lin::Feed(..) => (None, vec![]),
+        })
+        .collect();
     let mut row = 0;
     for (ch, e) in data.entries.iter().enumerate() {
+        // Which columns act on this channel, with their gain.
+        let on: Vec<Option<f64>> = lin
+            .iter()
+            .zip(&cols)
+            .map(|(l, (_, b))| match l {
+                Lin::Out(_, o) if *o == e.0 => Some(b[e.1]),
+                Lin::Feed(o, i) if (*o, *i) == *e => Some(1.0),
+                _ => None,
+            })
+            .collect();
         for &k in mask {
             let w = data.omega[k];
             let s = Complex64::new(0.0, w);
             let wt = std::f64::consts::SQRT_2 / data.radius[ch][k];
             let path = path_at(m, w, *e);
-            for (j, l) in lin.iter().enumerate() {
-                let v = match l {
-                    Lin::Out(t, o) if *o == e.0 => {
-                        let (_, b, mass) = gains_of(m, *t);
-                        let shape = match t {
-                            Term::Rigid(i) => {
-                                let pf = m.rigid_body[*i].friction_pole.unwrap_or(0.0);
-                                (s * (s + pf)).inv()
-                            }
-                            Term::Int(_) => s.inv(),
-                            Term::Mode(i) => {
-                                let md = &m.mode[*i];
-                                (s * s + 2.0 * md.zeta * md.omega_n * s + md.omega_n * md.omega_n)
-                                    .inv()
-                            }
-                        };
-                        path * shape * (b.to_vec(n_in)[e.1] / mass)
-                    }
-                    Lin::Feed(o, i) if (*o, *i) == *e => path,
-                    _ => Complex64::new(0.0, 0.0),
+            for (j, (gain, (den, _))) in on.iter().zip(&cols).enumerate() {
+                let v = match (gain, den) {
+                    (Some(g), Some([d2, d1, d0])) => path * (s * (s * *d2 + *d1) + *d0).inv() * *g,
+                    (Some(g), None) => path * *g,
+                    _ => zero,
                 };
                 a[(row, j)] = v.re * wt;
                 a[(row + 1, j)] = v.im * wt;
