@@ -5,8 +5,8 @@ use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::factor_form::physical_from_factors;
 use crate::diagnose::{
-    apply_candidate, diagnose_channels, misfit_channels, prepare, retune, Channels, Diagnosis,
-    Settings,
+    apply_candidate, diagnose_channels, misfit_channels, prepare, retune_within, Channels,
+    Diagnosis, Settings,
 };
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
@@ -146,7 +146,7 @@ fn write_revision(
 ) -> Result<()> {
     // The candidate (already refit jointly when the search got to it), refit once more.
     let applied = apply_candidate(base, d, k)?;
-    let revised = retune(&applied, data, None, false).model;
+    let revised = retune_within(&applied, base, data, None, false).model;
     let (rms_refit, inv_refit) = misfit_channels(&revised, data);
     // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
     let mut raw = raw.clone();

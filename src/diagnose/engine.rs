@@ -24,14 +24,13 @@ use super::polish::settle;
 pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
-use super::rank::{
-    disambiguate, prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC,
-};
+use super::rank::{prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC};
 pub use super::report::{
     CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
 };
-use super::retune::{cost, retune, ADDED_NOTE};
+use super::retune::{cost, retune_within, ADDED_NOTE};
 use super::search::{add_effect, roots, search, Node, Settings};
+use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use crate::report::fmt::fmt_pct;
@@ -67,7 +66,7 @@ fn assemble(
     for (c, th) in effects {
         m = add_effect(&m, c, th, data);
     }
-    retune(&m, data, mask, true).model
+    retune_within(&m, root, data, mask, true).model
 }
 
 /// Final-set holdout of every effect of `node` (see the module docs).
@@ -84,7 +83,11 @@ fn holdouts(root: &PhysicalModel, node: &Node, data: &Channels) -> Vec<Holdout> 
     // Each model is fitted on all data first, then refit (LM from there) on the part: an
     // effect the part does not see keeps its all-data value instead of drifting.
     let part = |m: &PhysicalModel, mask: &[usize], test: &[usize]| {
-        cost(&retune(m, data, Some(mask), false).model, data, test)
+        cost(
+            &retune_within(m, root, data, Some(mask), false).model,
+            data,
+            test,
+        )
     };
     let full = assemble(root, &node.effects, data, None);
     let full_ho = part(&full, &fit, &ho);
@@ -342,20 +345,6 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     for (k, c) in candidates.iter_mut().enumerate() {
         c.rank = k + 1;
     }
-    let mut ties = Vec::new();
-    if let Some(best) = candidates.first().cloned() {
-        for c in candidates.iter_mut().skip(1) {
-            c.tie_with_best =
-                c.passes && best.passes && (best.delta_bic - c.delta_bic).abs() < TIE_BIC;
-            if c.tie_with_best {
-                ties.push(Tie {
-                    effects: [best.effect.clone(), c.effect.clone()],
-                    bic_gap: (best.delta_bic - c.delta_bic).abs(),
-                    disambiguation: disambiguate(&best.model, &c.model, data),
-                });
-            }
-        }
-    }
     // The chosen set, its final holdout, runner-ups and ties.
     let mut node = res.nodes[res.chosen].clone();
     let holdout = holdouts(base, &node, data);
@@ -387,12 +376,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         node.effects = keep;
     }
     // A last joint refit of the chosen model, and its consistency polish.
-    let refit = retune(&node.model, data, None, false);
+    let refit = retune_within(&node.model, base, data, None, false);
     if refit.v_after < node.v_fit {
         node.v_fit = refit.v_after;
         node.model = refit.model;
     }
-    (node.model, node.measures) = settle(node.model, data)?;
+    (node.model, node.measures) = settle(node.model, base, data)?;
     let chosen_bic = res.nodes[res.chosen].bic;
     let mut runner_up: Vec<EffectSet> = res
         .nodes
@@ -411,20 +400,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     runner_up.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     runner_up.truncate(4);
     let chosen_labels = node.labels();
-    for (i, nd) in res.nodes.iter().enumerate() {
-        let gap = (nd.bic - chosen_bic).abs();
-        if i != res.chosen
-            && gap < TIE_BIC
-            && nd.effects.len() == res.nodes[res.chosen].effects.len()
-            && !nd.effects.is_empty()
-        {
-            ties.push(Tie {
-                effects: [chosen_labels.join(" + "), nd.labels().join(" + ")],
-                bic_gap: gap,
-                disambiguation: disambiguate(&node.model, &nd.model, data),
-            });
-        }
-    }
+    let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
+    ties.extend(candidate_ties(&mut candidates, &ties, data));
     let after = node.measures;
     let verdict = if !node.effects.is_empty() {
         "effects_found"

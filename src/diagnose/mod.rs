@@ -25,8 +25,9 @@ pub mod retune;
 pub mod search;
 mod slots;
 mod starts;
+pub mod ties;
 
 pub use channels::{misfit_channels, Channels};
 pub use engine::{apply_candidate, diagnose, diagnose_channels, Diagnosis};
-pub use retune::{refit_nominal, retune, NominalRefit};
+pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
 pub use search::Settings;

@@ -23,7 +23,9 @@ use super::channels::Channels;
 use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
 use super::fit::lm_box;
 use super::problem::{Measures, Problem};
-use super::slots::{bounds, design, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl};
+use super::slots::{
+    anchor_value, bounds, design, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl,
+};
 use crate::model::physical::PhysicalModel;
 
 /// Hinge threshold `t` on `|e|/r` (a margin below the disk edge, so a datum pushed onto the
@@ -86,10 +88,11 @@ fn score(e: &[f64]) -> (f64, usize) {
     (if v.is_finite() { v } else { f64::INFINITY }, out)
 }
 
-/// The polish of `m` (a least-squares fit on every datum of `data`): a model inside the 95 %
-/// confidence region of `m` with fewer data outside their disks, or `None` when there is none
-/// (see the module documentation).
-pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
+/// The polish of `m` (a least-squares fit on every datum of `data`, built from the configured
+/// model `anchor`, whose boxes it keeps): a model inside the 95 % confidence region of `m`
+/// with fewer data outside their disks, or `None` when there is none (see the module
+/// documentation).
+pub fn polish(m: &PhysicalModel, anchor: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
     let (lin, nl) = slots(m, data);
     let par = Param { lin, nl };
     let all: Vec<usize> = (0..data.len()).collect();
@@ -102,7 +105,7 @@ pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
     }
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
     for (s, x) in par.nl.iter().zip(&theta) {
-        let (a, b, t) = bounds(m, *s, *x, w_min, w_max);
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
         lo.push(a.min(*x));
         hi.push(b.max(*x));
         typ.push(t);
@@ -153,13 +156,14 @@ pub fn polish(m: &PhysicalModel, data: &Channels) -> Option<PhysicalModel> {
 /// is consistent.  Returns the model and its measures.
 pub fn settle(
     m: PhysicalModel,
+    anchor: &PhysicalModel,
     data: &Channels,
 ) -> crate::error::Result<(PhysicalModel, Measures)> {
     let m0 = Problem::new(&m, data)?.measures(&Default::default());
     if m0.consistent() || m0.misfit_rms > MAX_MISFIT_RMS {
         return Ok((m, m0));
     }
-    if let Some(p) = polish(&m, data) {
+    if let Some(p) = polish(&m, anchor, data) {
         let m1 = Problem::new(&p, data)?.measures(&Default::default());
         if m1.consistent() {
             return Ok((p, m1));

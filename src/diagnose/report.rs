@@ -72,6 +72,11 @@ pub struct Tie {
     pub bic_gap: f64,
     /// Which measurement tells them apart.
     pub disambiguation: String,
+    /// The nearest frequency above the band (rad/s) where the two fitted models differ by
+    /// more than the noise (`None`: not within two decades).
+    pub separates_above: Option<f64>,
+    /// The same below the band.
+    pub separates_below: Option<f64>,
 }
 
 /// One step of the chosen path.

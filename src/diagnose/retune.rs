@@ -10,7 +10,7 @@
 //!
 //! | term | nonlinear parameters | box |
 //! |---|---|---|
-//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.25 … 1.25ω_n₀` (inside the band for a mode `diagnose` added), `ζ ∈ [1e-4, 0.7]` |
+//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.3 … 1.3ω_n₀` (inside the band for a mode `diagnose` added), `ζ ∈ [1e-4, 0.7]` |
 //! | rigid body with friction | `ln p` | a decade either side |
 //! | input gains (several inputs) | `b_i`, `i ≥ 2` | two decades, sign kept |
 //! | delay | `τ` | `[0, 10 τ₀ + 1/ω_max]` |
@@ -19,12 +19,14 @@
 //! Output gains (residues) and feedthrough are free (least squares): a gain error of any
 //! size, or a sign error, is absorbed in them, so a `gain` or `sign` path effect is kept as
 //! it is.  From a rough start (`rough = true`) each mode is first placed by a grid over
-//! `ω_n₀/1.25 … 1.25ω_n₀` and five damping values, the residues solved at every point.  The
+//! `ω_n₀/1.3 … 1.3ω_n₀` and five damping values, the residues solved at every point.  The
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use super::channels::Channels;
 use super::fit::lm_box;
-use super::slots::{bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl};
+use super::slots::{
+    anchor_value, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
+};
 use crate::model::physical::PhysicalModel;
 use nalgebra::DVector;
 use num_complex::Complex64;
@@ -120,9 +122,24 @@ pub fn cost(m: &PhysicalModel, data: &Channels, mask: &[usize]) -> f64 {
 }
 
 /// Refits every parameter of `m` jointly on the data at `mask` (all data when `None`); with
-/// `rough`, each mode is first placed by a grid (see the module documentation).
+/// `rough`, each mode is first placed by a grid (see the module documentation).  The boxes
+/// are around the values of `m` itself: [`retune_within`] with `m` as its own anchor.
 pub fn retune(
     m: &PhysicalModel,
+    data: &Channels,
+    mask: Option<&[usize]>,
+    rough: bool,
+) -> NominalRefit {
+    retune_within(m, m, data, mask, rough)
+}
+
+/// [`retune`] with the boxes of the configured parameters around their values in `anchor`,
+/// the configured model `m` was built from (effects added to it keep boxes around their
+/// current values).  A chain of refits (every node of the search, the holdouts) then cannot
+/// walk a configured mode, box by box, away from where the user put it.
+pub fn retune_within(
+    m: &PhysicalModel,
+    anchor: &PhysicalModel,
     data: &Channels,
     mask: Option<&[usize]>,
     rough: bool,
@@ -154,7 +171,7 @@ pub fn retune(
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
             for j in 0..33 {
-                let w = w0 * 1.25f64.powf(-1.0 + j as f64 / 16.0);
+                let w = w0 * MODE_BOX.powf(-1.0 + j as f64 / 16.0);
                 for z in [z0, 0.003, 0.01, 0.03, 0.1] {
                     let mut t = start.clone();
                     t.mode[i].omega_n = w;
@@ -172,10 +189,9 @@ pub fn retune(
     }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
-    for (s, x) in nl.iter().zip(&theta0) {
+    for s in &nl {
         // Bounds around the configured value, so a rough start may not wander further.
-        let (a, b, t) = bounds(m, *s, get_nl(m, *s), w_min, w_max);
-        let _ = x;
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
         lo.push(a);
         hi.push(b);
         typ.push(t);
@@ -293,7 +309,7 @@ mod tests {
 
     #[test]
     fn bounds_hold_and_the_cost_never_rises() {
-        // The true mode is 3× the start: ω_n may move only to 1.25×.
+        // The true mode is 3× the start: ω_n may move only to 1.3×.
         let truth = two_mass(100.0, 1440.0, 0.02, 100.0, 1.0e-4);
         let start = two_mass(100.0, 480.0, 0.02, 100.0, 1.0e-4);
         let omega: Vec<f64> = (11..=250)
@@ -303,7 +319,7 @@ mod tests {
         let radius: Vec<f64> = g.iter().map(|x| 0.01 * x.norm()).collect();
         let r = refit_nominal(&start, &omega, &g, &radius);
         assert!(r.v_after <= r.v_before);
-        assert!(r.model.mode[0].omega_n <= 480.0 * 1.25 * (1.0 + 1e-12));
+        assert!(r.model.mode[0].omega_n <= 480.0 * MODE_BOX * (1.0 + 1e-12));
         assert!(r.model.mode[0].zeta >= 1e-4 && r.model.mode[0].zeta <= 0.7);
     }
 }

@@ -28,7 +28,7 @@ use super::polish::settle;
 use super::problem::{Measures, Problem};
 use super::rank::{candidate_list, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC};
 use super::report::Step;
-use super::retune::{retune, ADDED_NOTE};
+use super::retune::{retune, retune_within, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 
@@ -120,7 +120,7 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     let r = retune(base, data, None, true);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
     let v_fit = r.v_after;
-    let (model, measures) = settle(r.model, data)?;
+    let (model, measures) = settle(r.model, base, data)?;
     Ok([
         Node {
             effects: vec![],
@@ -149,6 +149,8 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
 pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchResult> {
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut level: Vec<usize> = (0..roots.len()).collect();
+    // The configured model: the anchor of every refit's boxes.
+    let anchor = roots[0].model.clone();
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let (mut expanded, mut joint_refits) = (0, 0);
@@ -175,10 +177,10 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
                 if promising && tried <= s.beam {
                     tried += 1;
                     let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                    let r = retune(&added, data, None, node.configured);
+                    let r = retune_within(&added, &anchor, data, None, node.configured);
                     joint_refits += 1;
                     let v_fit = r.v_after;
-                    let (model, m) = settle(r.model, data)?;
+                    let (model, m) = settle(r.model, &anchor, data)?;
                     let n_new = sc.cand.n_params(data.n_ch());
                     // Against the best of the node and (for the configured model) its retune.
                     let ref_v = if node.configured {

@@ -198,11 +198,38 @@ pub(super) fn set_lin(m: &mut PhysicalModel, s: Lin, x: f64) {
     }
 }
 
-/// `(lo, hi, typ)` of a nonlinear slot at its start value `x0`.
+/// A configured mode's ω_n may move by this factor either way from its configured value (a
+/// rough start 20 % off either way, `1/0.8 = 1.25`, with a margin).
+pub const MODE_BOX: f64 = 1.3;
+
+/// The value a nonlinear slot of `m` is bounded around: its value in `anchor` (the
+/// configured model `m` was built from: configured terms and effects come first in every
+/// list) when the slot is a configured one, else its value in `m` (an added effect).
+pub(super) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> f64 {
+    let configured = match s {
+        Nl::ModeW(i) | Nl::ModeZ(i) => i < anchor.mode.len(),
+        Nl::RigidPole(i) => anchor
+            .rigid_body
+            .get(i)
+            .is_some_and(|r| r.friction_pole.is_some_and(|p| p > 0.0)),
+        Nl::In(t, _) => match t {
+            Term::Rigid(i) => i < anchor.rigid_body.len(),
+            Term::Int(i) => i < anchor.integrator.len(),
+            Term::Mode(i) => i < anchor.mode.len(),
+        },
+        Nl::Delay(i) | Nl::LogEffect(i) => anchor
+            .effect
+            .get(i)
+            .is_some_and(|e| e.kind == m.effect[i].kind && get_nl(anchor, s).is_finite()),
+    };
+    get_nl(if configured { anchor } else { m }, s)
+}
+
+/// `(lo, hi, typ)` of a nonlinear slot bounded around `x0` (see [`anchor_value`]).
 pub(super) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) -> (f64, f64, f64) {
     match s {
         Nl::ModeW(i) => {
-            let (mut lo, mut hi) = (x0 - 1.25f64.ln(), x0 + 1.25f64.ln());
+            let (mut lo, mut hi) = (x0 - MODE_BOX.ln(), x0 + MODE_BOX.ln());
             let added = m.mode[i]
                 .name
                 .as_deref()
