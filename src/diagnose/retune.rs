@@ -25,10 +25,10 @@
 use super::channels::Channels;
 use super::fit::lm_box;
 use super::slots::{
-    anchor_value, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
+    anchor_value, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
 };
 use crate::model::physical::PhysicalModel;
-use nalgebra::DVector;
+use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
 /// Names of modes and terms `diagnose` adds start with this.
@@ -65,44 +65,65 @@ fn solve_linear_res(
     data: &Channels,
     mask: &[usize],
 ) -> DVector<f64> {
-    let (mut a, y) = design(m, lin, data, mask);
+    let (a, y) = design(m, lin, data, mask);
     let n = lin.len();
-    // Column scaling, then Householder QR; a column with a negligible pivot is dropped (its
-    // parameter set to 0), so a rank-deficient basis cannot blow up.
+    let rows_per_ch = 2 * mask.len();
+    let mut x = DVector::<f64>::zeros(n);
+    for (chs, cols) in blocks(lin, data) {
+        if cols.is_empty() {
+            continue;
+        }
+        let rows: Vec<usize> = chs
+            .iter()
+            .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
+            .collect();
+        let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+        let yb = DVector::from_fn(rows.len(), |i, _| y[rows[i]]);
+        for (j, xj) in cols.iter().zip(qr_solve(ab, yb).iter()) {
+            x[*j] = *xj;
+        }
+    }
+    for (j, l) in lin.iter().enumerate() {
+        if !x[j].is_finite() {
+            x[j] = 0.0;
+        }
+        set_lin(m, *l, x[j]);
+    }
+    &y - &a * &x
+}
+
+/// Least squares `min ‖y − A x‖`: column scaling, then Householder QR; a column with a
+/// negligible pivot is dropped (its parameter set to 0), so a rank-deficient basis cannot
+/// blow up.
+fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
+    let n = a.ncols();
     let scale: Vec<f64> = (0..n)
         .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
         .collect();
     for (j, s) in scale.iter().enumerate() {
         a.column_mut(j).scale_mut(1.0 / s);
     }
-    let x = if n == 0 {
-        DVector::zeros(0)
-    } else {
-        let qr = a.clone().qr();
-        let r = qr.r();
-        // Qᵀy by the Householder reflections (no explicit Q).
-        let mut qty = y.clone();
-        qr.q_tr_mul(&mut qty);
-        let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
-        let mut x = DVector::<f64>::zeros(n);
-        for i in (0..n).rev() {
-            if r[(i, i)].abs() <= 1e-12 * rmax {
-                continue;
-            }
-            let mut acc = qty[i];
-            for j in i + 1..n {
-                acc -= r[(i, j)] * x[j];
-            }
-            x[i] = acc / r[(i, i)];
+    let qr = a.qr();
+    let r = qr.r();
+    // Qᵀy by the Householder reflections (no explicit Q).
+    let mut qty = y;
+    qr.q_tr_mul(&mut qty);
+    let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    let mut x = DVector::<f64>::zeros(n);
+    for i in (0..n).rev() {
+        if r[(i, i)].abs() <= 1e-12 * rmax {
+            continue;
         }
-        x
-    };
-    let res = &y - &a * &x;
-    for (j, l) in lin.iter().enumerate() {
-        let v = x[j] / scale[j];
-        set_lin(m, *l, if v.is_finite() { v } else { 0.0 });
+        let mut acc = qty[i];
+        for j in i + 1..n {
+            acc -= r[(i, j)] * x[j];
+        }
+        x[i] = acc / r[(i, i)];
     }
-    res
+    for (xi, s) in x.iter_mut().zip(&scale) {
+        *xi /= s;
+    }
+    x
 }
 
 /// Cost `V` of `m` on the data at `mask`.

@@ -332,3 +332,51 @@ pub(super) fn get_lin(m: &PhysicalModel, s: Lin) -> f64 {
         },
     }
 }
+
+/// The independent blocks of the linear least squares: groups of channels that share no
+/// linear slot with the other groups (an output gain acts on the channels of its output, a
+/// feedthrough on one channel), each with the slots acting on it.  With one input every
+/// output is its own block, so the QR factors a few small matrices instead of one large.
+pub(super) fn blocks(lin: &[Lin], data: &Channels) -> Vec<(Vec<usize>, Vec<usize>)> {
+    let n_ch = data.n_ch();
+    let acts = |l: &Lin, ch: usize| {
+        let e = data.entries[ch];
+        match l {
+            Lin::Out(_, o) => *o == e.0,
+            Lin::Feed(o, i) => (*o, *i) == e,
+        }
+    };
+    // Union-find over the channels, joined through the slots they share.
+    let mut parent: Vec<usize> = (0..n_ch).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for l in lin {
+        let chs: Vec<usize> = (0..n_ch).filter(|ch| acts(l, *ch)).collect();
+        for w in chs.windows(2) {
+            let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+            parent[a] = b;
+        }
+    }
+    let mut groups: Vec<(usize, Vec<usize>)> = Vec::new();
+    for ch in 0..n_ch {
+        let r = root(&mut parent, ch);
+        match groups.iter_mut().find(|g| g.0 == r) {
+            Some(g) => g.1.push(ch),
+            None => groups.push((r, vec![ch])),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|(_, chs)| {
+            let cols = (0..lin.len())
+                .filter(|j| chs.iter().any(|ch| acts(&lin[*j], *ch)))
+                .collect();
+            (chs, cols)
+        })
+        .collect()
+}
