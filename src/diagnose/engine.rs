@@ -7,29 +7,32 @@
 //! * [`super::retune`]: the configured parameters, refit with wide bounds (residues by
 //!   least squares, modes placed by a grid from a rough start): the `retune` candidate.
 //! * [`super::search`]: beam search over effect sequences with a joint refit at every node.
-//! * Final holdout, per effect of the chosen set: fitted on 3 of every 4 data, the held-out
-//!   quarter's `V` must be lower with the effect than without it; for a multiplicative
-//!   effect, also fitted below 70 % of the band (log frequency), the top 30 % must be
-//!   predicted better. Both models are fitted on all data first and refit on the part from
-//!   there (so an effect the part does not see keeps its value). An effect that fails is
-//!   dropped and the rest refit. The extrapolation test decides only for a set of
-//!   multiplicative effects (a fit below the split cannot place a mode or a feedthrough that
-//!   acts above it); otherwise it is reported.
-//! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
+//! * Final holdout ([`super::holdout`]), per effect of the chosen set: fitted on 3 of every
+//!   4 data, the held-out quarter's `V` must be lower with the effect than without it; for a
+//!   multiplicative effect, also fitted below 70 % of the band (log frequency), the top 30 %
+//!   must be predicted better. An effect that fails is dropped and the rest refit. The
+//!   extrapolation test decides only for a set of multiplicative effects (a fit below the
+//!   split cannot place a mode or a feedthrough that acts above it); otherwise it is
+//!   reported.
+//! * Ties ([`super::ties`]): sets within 6 of the chosen set's BIC, with where to measure to
+//!   tell them apart.
+//! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`, judged on the model's
+//!   consistency polish ([`super::polish`]).
 
 use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Siso};
+use super::holdout::{holdouts, model_of};
 use super::polish::settle;
 pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
-use super::rank::{prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC};
+use super::rank::{prior, si_map, MIN_DELTA_BIC, TIE_BIC};
 pub use super::report::{
     CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
 };
-use super::retune::{cost, retune_within, ADDED_NOTE};
-use super::search::{add_effect, roots, search, Node, Settings};
+use super::retune::{retune_within, ADDED_NOTE};
+use super::search::{add_effect, roots, search, Settings};
 use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectKind, PhysicalModel};
@@ -52,67 +55,6 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
 
 fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
     Ok(Problem::new(m, data)?.measures(&Default::default()))
-}
-
-/// The model made of `root` (the configured model) and the effects `effects` (parameters as
-/// fitted when added), jointly refit on `mask` from a rough start.
-fn assemble(
-    root: &PhysicalModel,
-    effects: &[(super::candidates::Cand, Vec<f64>)],
-    data: &Channels,
-    mask: Option<&[usize]>,
-) -> PhysicalModel {
-    let mut m = root.clone();
-    for (c, th) in effects {
-        m = add_effect(&m, c, th, data);
-    }
-    retune_within(&m, root, data, mask, true).model
-}
-
-/// Final-set holdout of every effect of `node` (see the module docs).
-fn holdouts(root: &PhysicalModel, node: &Node, data: &Channels) -> Vec<Holdout> {
-    let f = data.len();
-    let fit: Vec<usize> = (0..f).filter(|k| k % 4 != 3).collect();
-    let ho: Vec<usize> = (0..f).filter(|k| k % 4 == 3).collect();
-    let cut = {
-        let (lo, hi) = (data.omega[0].ln(), data.omega[f - 1].ln());
-        (lo + EXTRAPOLATION_SPLIT * (hi - lo)).exp()
-    };
-    let (low, high): (Vec<usize>, Vec<usize>) = (0..f).partition(|k| data.omega[*k] < cut);
-    let extrap = low.len() >= MIN_SPLIT_DATA && high.len() >= MIN_SPLIT_DATA;
-    // Each model is fitted on all data first, then refit (LM from there) on the part: an
-    // effect the part does not see keeps its all-data value instead of drifting.
-    let part = |m: &PhysicalModel, mask: &[usize], test: &[usize]| {
-        cost(
-            &retune_within(m, root, data, Some(mask), false).model,
-            data,
-            test,
-        )
-    };
-    let full = assemble(root, &node.effects, data, None);
-    let full_ho = part(&full, &fit, &ho);
-    let full_hi = extrap.then(|| part(&full, &low, &high));
-    (0..node.effects.len())
-        .map(|j| {
-            let others: Vec<_> = node
-                .effects
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| *i != j)
-                .map(|(_, e)| e.clone())
-                .collect();
-            let c = node.effects[j].0;
-            let wo = assemble(root, &others, data, None);
-            let wo_ho = part(&wo, &fit, &ho);
-            let extrapolation_ok = (extrap && c.multiplicative())
-                .then(|| full_hi.unwrap_or(f64::INFINITY) < part(&wo, &low, &high));
-            Holdout {
-                effect: c.label(),
-                interleaved_ok: full_ho < wo_ho,
-                extrapolation_ok,
-            }
-        })
-        .collect()
 }
 
 /// The effects `diagnose` added to `m`, with their current parameters.
@@ -347,7 +289,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     }
     // The chosen set, its final holdout, runner-ups and ties.
     let mut node = res.nodes[res.chosen].clone();
-    let holdout = holdouts(base, &node, data);
+    let holdout = holdouts(base, &node, &res.nodes, data);
     // A fit below 70 % of the band cannot place an additive effect (a mode, a feedthrough)
     // that acts above it, so the extrapolation test decides only for sets of multiplicative
     // effects; otherwise it is reported.
@@ -368,7 +310,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             .map(|(_, e)| e.clone())
             .collect();
         dropped = failing.iter().map(|i| node.effects[*i].0.label()).collect();
-        let model = assemble(base, &keep, data, None);
+        let model = model_of(base, &keep, &res.nodes, data);
         node.measures = measures(&model, data)?;
         node.v_fit = node.measures.v;
         node.model = model;

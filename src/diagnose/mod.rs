@@ -17,6 +17,7 @@ pub mod channels;
 pub mod engine;
 pub mod factor_form;
 pub mod fit;
+pub mod holdout;
 pub mod polish;
 pub mod problem;
 pub mod rank;
