@@ -310,12 +310,14 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         println!("\nrunner-up sets (BIC gap to the chosen set):");
         for r in &d.runner_up {
             println!(
-                "  {:<40} +{}  misfit_rms {}, invalid {}{}",
+                "  {:<40} {}{}  misfit_rms {}, invalid {}{}",
                 if r.effects.is_empty() {
                     "(retune only)".to_string()
                 } else {
                     r.effects.join(" + ")
                 },
+                // A runner-up in a tie may have the lower BIC (the prior order chose).
+                if r.bic_gap >= 0.0 { "+" } else { "" },
                 sig(r.bic_gap),
                 sig(r.misfit_rms),
                 fmt_pct(r.invalid_fraction),
