@@ -72,6 +72,7 @@ fn batch_1000(bencher: divan::Bencher) {
                     timings_ms: Default::default(),
                     order: rshape::fit::OrderChoice::Auto { max: 8 },
                     factorization: Some(&config.factorization),
+                    closed_loop: false,
                 },
             )
             .unwrap();

@@ -606,6 +606,31 @@ fn cli_kinds() -> Vec<Kind> {
             &["e.csv:3", "r_min `-1`"],
         )
         .file("e.csv", "omega_rad_s,r_min\n1,0.5\n2,-1\n"),
+        paper(
+            "CLI: stability --out is the input folder",
+            2,
+            "stability {dir}/model.toml --controller {dir}/k.toml --out {dir}",
+            &["--out", "input"],
+        )
+        .file("k.toml", "[controller]\nd = [[1, 0], [0, 1], [0, 0]]\n"),
+        paper(
+            "CLI: compare --svg is the config",
+            2,
+            "compare {dir}/model.toml --channel 1,1 --svg {dir}/model.toml",
+            &["--svg", "model.toml", "input"],
+        ),
+        paper(
+            "CLI: history --svg is a folder",
+            2,
+            "history {dir}/model.toml --channel 1,1 --svg {dir}",
+            &["--svg", "folder"],
+        ),
+        paper(
+            "CLI: diagnose --write is the data file",
+            2,
+            "diagnose {dir}/model.toml --channel 1,1 --apply 1 --write {dir}/data.csv",
+            &["--write", "data.csv", "input"],
+        ),
     ]
 }
 

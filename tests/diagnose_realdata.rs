@@ -65,8 +65,30 @@ fn ballscrew_from_a_rough_rigid_body_finds_the_axial_mode_in_band() {
     }
 }
 
+/// `misfit_rms` per revision on one channel of `est` and of `val`.
+fn per_revision(revs: &[&str], ch: (usize, usize), est: &str, val: &str) -> [Vec<f64>; 2] {
+    [
+        revs.iter().map(|r| rms(r, est, ch)).collect(),
+        revs.iter().map(|r| rms(r, val, ch)).collect(),
+    ]
+}
+
+/// The numbers of the README tables (3 significant digits).
+fn matches_readme(got: &[f64], readme: &[f64]) {
+    for (g, r) in got.iter().zip(readme) {
+        assert!((g / r - 1.0).abs() < 6e-3, "{got:?} vs README {readme:?}");
+    }
+}
+
+/// Ball screw: estimation `hresL_m40pR` (11–300 Hz), validation `hres_40n8` (11–800 Hz),
+/// both outputs. The estimation error falls at every revision on both outputs; on the
+/// validation data it falls at every revision on the table except the retune (rev 1: a
+/// rigid body cannot follow the table above the axial mode, 78.1 → 80.9, both ~80 noise
+/// radii off), and on the motor side it falls to rev 2 and then stays within 1 % (5.70,
+/// 5.72, 5.75: the validation band holds modes near 475 and 615 Hz that the estimation
+/// data never saw).
 #[test]
-fn shipped_revisions_lower_the_error_on_both_experiments() {
+fn ballscrew_revisions_lower_the_error_on_estimation_and_validation() {
     let est = "configs/data/ballscrew/frf_hresL_m40pR.csv";
     let val = "configs/data/ballscrew/frf_hres_40n8.csv";
     let revs = [
@@ -74,32 +96,61 @@ fn shipped_revisions_lower_the_error_on_both_experiments() {
         "configs/ballscrew_rev1.toml",
         "configs/ballscrew_rev2.toml",
         "configs/ballscrew_rev3.toml",
+        "configs/ballscrew_rev4.toml",
     ];
-    for ch in [(1, 1), (2, 1)] {
-        let e: Vec<f64> = revs.iter().map(|r| rms(r, est, ch)).collect();
-        let v: Vec<f64> = revs.iter().map(|r| rms(r, val, ch)).collect();
-        println!("ball screw {ch:?}: estimation {e:?}, validation {v:?}");
-        assert!(e[3] < 0.2 * e[0], "{e:?}");
-        assert!(v[3] < 0.25 * v[0], "{v:?}");
+    let [me, mv] = per_revision(&revs, (1, 1), est, val);
+    let [te, tv] = per_revision(&revs, (2, 1), est, val);
+    println!("motor: est {me:?} val {mv:?}\ntable: est {te:?} val {tv:?}");
+    for e in [&me, &te] {
+        for w in e.windows(2) {
+            assert!(w[1] < w[0], "estimation must fall: {e:?}");
+        }
     }
+    for w in tv[1..].windows(2) {
+        assert!(w[1] < w[0], "table validation: {tv:?}");
+    }
+    assert!(tv[1] < 1.05 * tv[0], "{tv:?}");
+    assert!(mv[1] < mv[0] && mv[2] < mv[1], "{mv:?}");
+    assert!(mv[3] < 1.01 * mv[2] && mv[4] < 1.01 * mv[3], "{mv:?}");
+    matches_readme(&me, &[27.1, 3.84, 2.70, 2.65, 2.51]);
+    matches_readme(&mv, &[26.1, 6.35, 5.70, 5.72, 5.75]);
+    matches_readme(&te, &[43.5, 11.5, 6.24, 4.46, 2.95]);
+    matches_readme(&tv, &[78.1, 80.9, 21.0, 8.86, 6.82]);
+    // rev 4 is a sensor effect on the table encoder only (output 2).
+    let c = Config::load(Path::new(revs[4])).unwrap();
+    let e = c.physical.unwrap().effect;
+    assert_eq!(e.len(), 1);
+    assert_eq!(e[0].path, rshape::model::physical::EffectPath::Output);
+    assert_eq!(e[0].channel, Some(2));
+}
+
+/// Motor bench, both outputs, estimation multisine A, validation multisine B: the error
+/// falls at every revision on both experiments and both outputs.
+#[test]
+fn motor_bench_revisions_lower_the_error_on_a_and_b_on_both_outputs() {
+    let a = "configs/data/twomass/frf_multisineA.csv";
+    let b = "configs/data/twomass/frf_multisineB.csv";
     let revs = [
         "configs/twomass_both_rigid.toml",
         "configs/twomass_both_rev1.toml",
         "configs/twomass_both_rev2.toml",
         "configs/twomass_both_rev3.toml",
     ];
-    for ch in [(1, 1), (2, 1)] {
-        for data in [
-            "configs/data/twomass/frf_multisineA.csv",
-            "configs/data/twomass/frf_multisineB.csv",
-        ] {
-            let e: Vec<f64> = revs.iter().map(|r| rms(r, data, ch)).collect();
-            println!("motor bench {ch:?} {data}: {e:?}");
+    let readme = [
+        [[52.1, 11.4, 7.39, 5.18], [82.8, 20.0, 12.0, 7.99]],
+        [[55.1, 9.33, 4.91, 4.64], [85.4, 16.4, 8.48, 7.34]],
+    ];
+    for (k, ch) in [(1, 1), (2, 1)].into_iter().enumerate() {
+        let [ea, eb] = per_revision(&revs, ch, a, b);
+        println!("motor bench {ch:?}: A {ea:?} B {eb:?}");
+        for e in [&ea, &eb] {
             for w in e.windows(2) {
-                assert!(w[1] < w[0], "{e:?}");
+                assert!(w[1] < w[0], "{ch:?}: {e:?}");
             }
             assert!(e[3] < 0.15 * e[0], "{e:?}");
         }
+        matches_readme(&ea, &readme[k][0]);
+        matches_readme(&eb, &readme[k][1]);
     }
 }
 
@@ -157,8 +208,8 @@ fn factor_form_configs_compare_and_diagnose() {
         err.contains("cannot be converted") && err.lines().count() == 1,
         "{err}"
     );
-    // Closed-loop configs reach diagnose through the open-loop equivalent (here a standard
-    // factorization, which diagnose cannot extend: the same one-line reason).
+    // Closed-loop configs reach diagnose through the open-loop equivalent; their nominal
+    // N̂·D̂⁻¹ = 1/s² is converted to a [physical] rigid body.
     let out = Command::new(exe)
         .args([
             "diagnose",
@@ -168,10 +219,23 @@ fn factor_form_configs_compare_and_diagnose() {
         ])
         .output()
         .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines().next().unwrap().contains(
+            "the [closed_loop] nominal plant is a sum of physical terms: converted to [physical] (1 rigid body)"
+        ),
+        "{text}"
+    );
+    // A state-space [plant] is not converted: the one-line reason, exit 2.
+    let out = Command::new(exe)
+        .args(["diagnose", "configs/iss1r_reduced.toml", "--channel", "1,1"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("standard factorization") && err.lines().count() == 1,
+        err.contains("a state-space [plant] is not converted") && err.lines().count() == 1,
         "{err}"
     );
 }

@@ -36,6 +36,18 @@ pub fn merge(
     out: &Path,
     order: crate::fit::OrderChoice,
 ) -> Result<MergeOutcome> {
+    merge_then(shards, out, order, &mut || Ok(()))
+}
+
+/// As [`merge`], calling `before_write` once every shard has been read and checked and
+/// before anything is written (the CLI prepares the output folder there, so a bad shard
+/// leaves no trace in `out`).
+pub fn merge_then(
+    shards: &[PathBuf],
+    out: &Path,
+    order: crate::fit::OrderChoice,
+    before_write: &mut dyn FnMut() -> Result<()>,
+) -> Result<MergeOutcome> {
     let t = std::time::Instant::now();
     if shards.is_empty() {
         return Err(Error::Invalid("give at least one shard directory".into()));
@@ -86,6 +98,7 @@ pub fn merge(
     let config = crate::model::Config::load(&first.config).ok();
     let mut timings = BTreeMap::new();
     timings.insert("read".into(), t.elapsed().as_secs_f64() * 1e3);
+    before_write()?;
     let report = finish(
         out,
         &rows,
@@ -101,6 +114,7 @@ pub fn merge(
             factorization: config
                 .as_ref()
                 .and_then(crate::pipeline::closed_loop::a1_factorization),
+            closed_loop: first.closed_loop,
         },
     )?;
     Ok(MergeOutcome {

@@ -74,6 +74,9 @@ pub struct BatchReport {
     pub merged_from: Vec<PathBuf>,
     /// Milliseconds per stage.
     pub timings_ms: BTreeMap<String, f64>,
+    /// True for closed-loop data (the weight is `V`, not `r`; see [`crate::plot::Symbols`]).
+    #[serde(default)]
+    pub closed_loop: bool,
 }
 
 /// Coefficients of `r` (owned, deserializable twin of [`Coeffs`]).
@@ -116,6 +119,8 @@ pub struct FinishInput<'a> {
     pub order: crate::fit::OrderChoice,
     /// The model, for the A1 limit `σ_min(M̃(jω))` the fitted `r` must stay below.
     pub factorization: Option<&'a crate::model::Factorization>,
+    /// Closed-loop data (the weight is `V`).
+    pub closed_loop: bool,
 }
 
 /// The batch-wide stage, shared by `batch` and `merge`: fits one `r` above the combined
@@ -183,6 +188,7 @@ pub fn finish(
         },
         merged_from: inp.merged_from,
         timings_ms: timings,
+        closed_loop: inp.closed_loop,
     };
     let text = serde_json::to_string_pretty(&report)
         .map_err(|e| Error::Invalid(format!("batch.json: {e}")))?;

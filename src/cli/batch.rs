@@ -117,7 +117,8 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     let rows: Vec<SummaryRow> = results.iter().map(SummaryRow::from).collect();
     if let (true, Some(c)) = (std::io::stderr().is_terminal(), &combined) {
         eprintln!(
-            "fitting one r above the combined envelope ({} frequencies)…",
+            "fitting one {} above the combined envelope ({} frequencies)…",
+            crate::plot::Symbols::of(config.closed_loop.is_some()).weight,
             c.len()
         );
     }
@@ -134,6 +135,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             timings_ms: timings,
             order: a.order,
             factorization: crate::pipeline::closed_loop::a1_factorization(&config),
+            closed_loop: config.closed_loop.is_some(),
         },
     )?;
     print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());
@@ -144,7 +146,8 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     })
 }
 
-/// Prints the result of a batch or a merge.
+/// Prints the result of a batch or a merge, with the symbols of its data (`r`, `r_min` for
+/// open-loop data; `V`, `|V|_min` for closed-loop data, as the figures and `run`).
 pub fn print_summary(
     rep: &batch::BatchReport,
     rows: &[SummaryRow],
@@ -164,21 +167,23 @@ pub fn print_summary(
         rep.n_failed,
         secs
     );
+    let sym = crate::plot::Symbols::of(rep.closed_loop);
+    let (w, wmin) = (sym.weight, sym.weight_min);
     if rep.r_configured.is_some() {
         outln!(
-            "  configured r explains {} of {} successful dataset(s)",
+            "  configured {w} explains {} of {} successful dataset(s)",
             rep.n_consistent,
             rep.n_ok
         );
     }
     outln!(
-        "  combined envelope: {} frequencies, max r_min = {}",
+        "  combined envelope: {} frequencies, max {wmin} = {}",
         rep.n_frequencies,
         rep.max_r_min.map_or("-".into(), fmt_g)
     );
     match (&rep.r_fitted, &rep.fit_error) {
         (Some(j), _) => outln!(
-            "  fitted r covering all datasets: {} (coefficients in r.json)",
+            "  fitted {w} covering all datasets: {} (coefficients in r.json)",
             super::run::fit_tag(j)
         ),
         (None, Some(e)) => outln!("  fit failed: {e}"),

@@ -182,3 +182,37 @@ pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result
     }
     Ok(OutputManifest::begin(out)?)
 }
+
+/// Checks a single output file given by `flag` (`--svg FILE`, `--write FILE`) before any
+/// work: it must not be an existing folder nor one of the inputs (a figure or a revised
+/// config written over the config or the data would destroy it).  The file itself is
+/// written atomically (temporary file + rename) by the writer.
+pub fn check_out_file(
+    flag: &str,
+    path: &std::path::Path,
+    inputs: &[&std::path::Path],
+) -> Result<()> {
+    if path.is_dir() {
+        return Err(anyhow!(
+            "{flag} {}: is an existing folder; give a file name",
+            path.display()
+        ));
+    }
+    if let Ok(p) = path.canonicalize() {
+        for input in inputs {
+            if input.canonicalize().is_ok_and(|i| i == p) {
+                return Err(anyhow!(
+                    "{flag} {}: is the input {}; writing there would destroy it: choose a new file name",
+                    path.display(),
+                    input.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The data file a config names (for the output checks), if it loads.
+pub fn config_data(config: &std::path::Path) -> Option<PathBuf> {
+    crate::model::Config::load(config).ok().and_then(|c| c.data)
+}

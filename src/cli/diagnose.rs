@@ -3,7 +3,7 @@
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
-use crate::diagnose::factor_form::physical_from_factors;
+use crate::diagnose::plant_form::physical_from_config;
 use crate::diagnose::{
     apply_candidate, diagnose_channels, misfit_channels, prepare, retune_within, Channels,
     Diagnosis, Settings,
@@ -82,6 +82,16 @@ fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
 
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
+    if let Some(w) = &a.write {
+        let own = super::common::config_data(&a.input.config);
+        let inputs = [
+            Some(a.input.config.as_path()),
+            a.input.data.as_deref(),
+            own.as_deref(),
+        ];
+        let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
+        super::common::check_out_file("--write", w, &inputs)?;
+    }
     let loaded = a.input.load()?;
     // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,
     // with the noise radii carried over to it, through the hook `compare` uses too.
@@ -100,17 +110,16 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     let base = match &config.physical {
         Some(p) => p.clone(),
         None => {
-            let p = physical_from_factors(&config.factorization).map_err(|why| {
+            let (p, how) = physical_from_config(config).map_err(|why| {
                 anyhow!(
-                    "{}: diagnose adds effects to a [physical] model, and this factor form cannot be converted ({why}); `rshape compare` works on it as it is. To diagnose, write the plant as [physical] (configs/robot_physical.toml is the robot's factor form written by its physics)",
+                    "{}: diagnose adds effects to a [physical] model, and this model cannot be converted ({why}); `rshape compare` works on it as it is. To diagnose, write the plant as [physical] (configs/robot_physical.toml is the robot's factor form written by its physics)",
                     config.path.display()
                 )
             })?;
             if !a.json {
                 println!(
-                    "{}: the [model] factor form is a modal special factorization: converted to [physical] ({} modes); effects are added to that form (--write writes [physical])",
+                    "{}: {how}; effects are added to that form (--write writes [physical])",
                     config.path.display(),
-                    p.mode.len()
                 );
             }
             p
@@ -153,6 +162,11 @@ fn write_revision(
     let c = &d.candidates[k - 1];
     raw.physical = Some(revised);
     raw.model = None;
+    // A converted [plant] or [closed_loop] nominal is now the [physical] table.
+    raw.plant = None;
+    if let Some(cl) = &mut raw.closed_loop {
+        (cl.plant, cl.n_hat, cl.d_hat) = (None, None, None);
+    }
     raw.name = Some(format!(
         "{} + {}",
         raw.name

@@ -2,7 +2,7 @@
 //! Exit 0 when every merged dataset succeeded, 3 when some failed or are missing, 2 on an
 //! error.
 
-use crate::batch::{self, merge::merge};
+use crate::batch::{self, merge::merge_then};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
@@ -24,7 +24,18 @@ pub struct MergeArgs {
 /// Runs `rshape merge`.
 pub fn run(a: &MergeArgs) -> Result<i32> {
     let t = std::time::Instant::now();
-    let m = merge(&a.shards, &a.out, a.order)?;
+    // The shards are inputs: --out may not be one of them (nor a file); the previous
+    // merge's files in --out are cleared once every shard has been read.
+    let mut guard = None;
+    let shards: Vec<&std::path::Path> = a.shards.iter().map(|p| p.as_path()).collect();
+    let m = merge_then(&a.shards, &a.out, a.order, &mut || {
+        guard = Some(
+            super::common::prepare_out(&a.out, &shards)
+                .map_err(|e| crate::error::Error::Invalid(e.to_string()))?,
+        );
+        Ok(())
+    })?;
+    drop(guard);
     super::batch::print_summary(&m.report, &m.rows, &a.out, t.elapsed().as_secs_f64());
     if !m.missing.is_empty() {
         outln!(

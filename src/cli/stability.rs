@@ -6,7 +6,7 @@
 use super::common::InputArgs;
 use crate::fit::{run_fit, FitSettings, OrderChoice};
 use crate::model::controller::Controller;
-use crate::model::Config;
+use crate::model::{Config, FactorizationKind};
 use crate::plot::stability::{stability_svg, StabilityInput};
 use crate::report::fmt::fmt_g;
 use crate::stability::analyze;
@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 /// Arguments of `rshape stability`.
 #[derive(Debug, Args)]
 pub struct StabilityArgs {
-    /// The TOML config (a standard [model] or a [plant]; its [r] is the configured bound).
+    /// The TOML config (any factorization: [model] standard or special, [physical], [plant];
+    /// its [r] is the configured bound).
     pub config: PathBuf,
     /// The controller file (a [controller] table).
     #[arg(long)]
@@ -94,28 +95,63 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     let config = Config::load(&a.config)?;
     let controller = Controller::load(&a.controller)?;
     let mut rs: Vec<(String, TransferFunction)> = Vec::new();
-    if let Some(r) = &config.r {
+    // A [closed_loop] config holds the weight V of Crowder & de Callafon in `config.r`: it
+    // bounds the dual-Youla perturbation, not the factor perturbation of Theorem 1, so it is
+    // not a configured r here (its nominal factors are, with an r from --r-json).
+    let closed_loop = config.closed_loop.is_some();
+    if closed_loop && a.fit {
+        return Err(anyhow!(
+            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
+            a.config.display()
+        ));
+    }
+    if let Some(r) = config.r.as_ref().filter(|_| !closed_loop) {
         rs.push(("configured".into(), r.clone()));
     }
     let mut fit_text = String::new();
     if let Some(p) = &a.r_json {
         rs.push(("fitted".into(), read_r_json(p)?));
     }
-    if a.fit {
-        let out = a
-            .out
-            .as_ref()
-            .ok_or_else(|| anyhow!("--fit writes r.json and its exports: give --out DIR"))?;
+    // Grid from the data range, else from the plant's poles (via a first pass, which also
+    // checks the controller's size before anything is written).
+    let probe = analyze(&config.factorization, &controller, &[], &[1.0])?;
+    // With --fit, the data are read and the envelope computed before the folder is touched.
+    let fit_input = if a.fit {
+        if a.out.is_none() {
+            return Err(anyhow!(
+                "--fit writes r.json and its exports: give --out DIR"
+            ));
+        }
         let input = InputArgs {
             config: a.config.clone(),
             data: a.data.clone(),
             noise_radius: None,
         };
-        let (inputs, env) = input.envelope()?;
+        Some(input.envelope()?)
+    } else {
+        None
+    };
+    // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
+    // input's folder; the previous run's listed files are cleared.
+    let inputs: Vec<&Path> = [
+        Some(a.config.as_path()),
+        Some(a.controller.as_path()),
+        a.r_json.as_deref(),
+        a.data.as_deref(),
+        config.data.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    let _manifest = match &a.out {
+        Some(out) => Some(super::common::prepare_out(out, &inputs)?),
+        None => None,
+    };
+    if let (Some((inputs, env)), Some(out)) = (&fit_input, &a.out) {
         let f = &inputs.config.factorization;
         let a1 = |w: f64| f.a1_limit(w);
         let outcome = run_fit(
-            &env,
+            env,
             Some(&a1),
             &FitSettings::default(),
             OrderChoice::Auto { max: 8 },
@@ -124,13 +160,10 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         fit_text = outcome.text;
         rs.push(("fitted".into(), outcome.result.r.clone()));
     }
-    // Grid from the data range, else from the plant's poles (via a first pass).
-    let probe = analyze(&config.factorization, &controller, &[], &[1.0])?;
     let grid = grid_for(&config, &probe.0.closed_loop_poles);
     let (rep, curve) = analyze(&config.factorization, &controller, &rs, &grid)?;
     let robust = rep.internally_stable && rep.margins.iter().all(|m| m.robust);
     if let Some(out) = &a.out {
-        std::fs::create_dir_all(out).with_context(|| format!("{}", out.display()))?;
         let labelled: Vec<(String, Vec<f64>)> = rs
             .iter()
             .map(|(l, _)| l.clone())
@@ -174,12 +207,16 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         return Ok(1);
     }
     outln!(
-        "internally stable: {n} closed-loop poles, largest real part {}",
+        "internally stable: {n} closed-loop poles (the loop's and the factors' own), largest real part {}",
         fmt_g(rep.abscissa)
     );
     if let Some(t) = &rep.t_norm {
+        let form = match config.factorization.kind {
+            FactorizationKind::Standard => "T = [K; I](I+GK)^-1 M~^-1",
+            FactorizationKind::Special => "T = [JKC; I](M~ + N~JKC)^-1, special factorization",
+        };
         outln!(
-            "||T||_inf = {} at omega = {} rad/s (T = [K; I](I+GK)^-1 M~^-1)",
+            "||T||_inf = {} at omega = {} rad/s ({form})",
             fmt_g(t.gamma),
             fmt_g(t.omega)
         );
@@ -200,7 +237,9 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
             }
         }
     }
-    if rep.margins.is_empty() {
+    if rep.margins.is_empty() && closed_loop {
+        outln!("no r given: the [v] of a [closed_loop] config is not a factor bound; give --r-json for the Theorem 1 margin");
+    } else if rep.margins.is_empty() {
         outln!("no r given: add [r] to the config, --r-json or --fit for the Theorem 1 margin");
     } else {
         outln!(

@@ -453,8 +453,13 @@ pub fn explain(
             sig((wmax * p("tau_s")).to_degrees()),
             fmt_w(wmax)
         ),
-        Cand::Lag(_) => format!(
-            "magnitude droops and phase lags towards −90° above the corner, with no linear phase: a first-order lag{on} (actuator or sensor) at ω_c = {}",
+        Cand::Lag(sel) => format!(
+            "magnitude droops and phase lags towards −90° above the corner, with no linear phase: a first-order lag{on} ({}) at ω_c = {}",
+            match sel {
+                Sel::Output(_) => "a sensor",
+                Sel::Input(_) => "an actuator",
+                Sel::All => "actuator or sensor",
+            },
             fmt_w(p("omega_c"))
         ),
         Cand::Gain(_) => format!(

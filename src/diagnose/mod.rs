@@ -18,6 +18,7 @@ pub mod engine;
 pub mod factor_form;
 pub mod fit;
 pub mod holdout;
+pub mod plant_form;
 pub mod polish;
 pub mod problem;
 pub mod rank;

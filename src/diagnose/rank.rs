@@ -47,19 +47,18 @@ pub fn si_map(c: &Cand, th: &[f64], entries: &[(usize, usize)]) -> BTreeMap<Stri
 /// The candidates tried on a model with `n_out × n_in` channels observed.  Gains, signs,
 /// mode shifts and damping changes are not in the list: the retune (refit of the model's own
 /// residues, frequencies and dampings) covers them.  With several channels, path effects are
-/// tried on every channel and on each input (a dynamic effect on one output of a
-/// multi-output model cannot be exported to the special factorization, whose `C` is constant).
+/// tried on every channel, on each input and on each output (a sensor effect: the export
+/// splits the modal rows per output group, `model::physical::output_path`).
 pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
     let mut sels = vec![Sel::All];
     if data.n_ch() > 1 {
         let mut outs: Vec<usize> = data.entries.iter().map(|e| e.0).collect();
+        outs.sort();
         outs.dedup();
         let mut ins: Vec<usize> = data.entries.iter().map(|e| e.1).collect();
         ins.sort();
         ins.dedup();
-        // A dynamic effect on one output has no place in the constant `C` of the special
-        // factorization (the export of a multi-output model), so it is not proposed there.
-        if outs.len() > 1 && base.n_outputs() == 1 {
+        if outs.len() > 1 {
             sels.extend(outs.iter().map(|o| Sel::Output(*o)));
         }
         if ins.len() > 1 {
@@ -68,12 +67,12 @@ pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
     }
     let mut v = Vec::new();
     for s in &sels {
-        v.extend([
-            Cand::Delay(*s),
-            Cand::Lag(*s),
-            Cand::NmpZero(*s),
-            Cand::Zoh(*s),
-        ]);
+        v.extend([Cand::Delay(*s), Cand::Lag(*s)]);
+        // A sensor carries a delay or a lag; a hold or an NMP zero sits on the actuator
+        // side (or on every channel).
+        if !matches!(s, Sel::Output(_)) {
+            v.extend([Cand::NmpZero(*s), Cand::Zoh(*s)]);
+        }
     }
     v.extend([
         Cand::Mode,

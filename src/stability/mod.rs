@@ -1,12 +1,15 @@
 //! Robust stability with a perturbed coprime-factor model: Theorem 1 of Boulet & Francis
 //! (1998, and the short paper; Vidyasagar 1985).
 //!
-//! For the standard factorization `G = M̃⁻¹Ñ`, perturbations `‖[Δ_N −Δ_M](jω)‖ < |r(jω)|`
-//! and the loop `u = −K·y`, every plant of the set is stabilized by `K` iff
-//! 1. `K` internally stabilizes `G` (tested here on the eigenvalues of the closed-loop
-//!    state matrix), and
-//! 2. `‖r·T‖∞ ≤ 1` with `T = [K; I](I + GK)⁻¹M̃⁻¹` (the paper writes `(I − GK)⁻¹` for
-//!    `u = +K·y`; the norm is the same).
+//! For any factorization `G = C·M̃⁻¹·Ñ·J` (eq. (1): standard, special, the export of a
+//! physical model, the normalized factors of a plant), perturbations
+//! `‖[Δ_N −Δ_M](jω)‖ < |r(jω)|` and the loop `u = −K·y`, every plant of the set is
+//! stabilized by `K` iff
+//! 1. `K` internally stabilizes the loop of Fig. 1 (tested here on the eigenvalues of the
+//!    closed-loop state matrix), and
+//! 2. `‖r·T‖∞ ≤ 1` with `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹` ([`factor_loop`]); for the
+//!    standard factorization `T = [−K; I](I + GK)⁻¹M̃⁻¹` (the paper writes `(I − GK)⁻¹`
+//!    for `u = +K·y`; the norm is the same).
 //!
 //! The robust-stability margin `α* = 1/‖r·T‖∞` is the largest scale of `r` still proven
 //! robust; it is computed **exactly** as an H∞ norm ([`crate::system::hinf`]), and a grid
@@ -14,8 +17,8 @@
 //! For normalized factors `‖T‖∞` equals `1/b(G, K)`, the normalized-coprime-factor
 //! stability margin `b(G, K) = 1/‖[K; I](I + GK)⁻¹[I G]‖∞`: the crate computes both as a
 //! cross-check.
+pub mod factor_loop;
 pub mod theorem1;
 
-pub use theorem1::{
-    analyze, factor_system, gang_of_four, theorem1_system, GridCurve, MarginRow, RobustStability,
-};
+pub use factor_loop::{gang_of_four, modal_system, plant_system, t_sigma_max, theorem1_system};
+pub use theorem1::{analyze, GridCurve, MarginRow, RobustStability};

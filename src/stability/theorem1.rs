@@ -1,77 +1,15 @@
 //! The Theorem 1 test: closed-loop poles, exact margins, grid curves (see the module above).
 
+use super::factor_loop::{gang_of_four, t_sigma_max, theorem1_system};
 use crate::error::{Error, Result};
 use crate::model::controller::Controller;
-use crate::model::{Factorization, FactorizationKind};
+use crate::model::Factorization;
 use crate::system::eig::{eigenvalues, spectral_abscissa};
 use crate::system::freq_eval::FreqEvaluator;
 use crate::system::hinf::{hinf_norm, HinfNorm};
-use crate::system::interconnect::negative_feedback;
 use crate::system::{StateSpace, TransferFunction};
-use nalgebra::DMatrix;
 use num_complex::Complex64;
 use serde::Serialize;
-
-/// A realization of `[G  M̃⁻¹]` (inputs `[u; w]`), the system the factor perturbation sees.
-/// For normalized state-space factors it shares the plant's states; for factors typed as
-/// transfer functions it is the cascade `M̃⁻¹·[Ñ  I]`, whose hidden modes are poles of the
-/// (stable) factors, so the closed-loop eigenvalues decide internal stability.
-pub fn factor_system(f: &Factorization) -> Result<StateSpace> {
-    if f.kind != FactorizationKind::Standard {
-        return Err(Error::Invalid(
-            "the robust-stability test needs a standard factorization G = M̃⁻¹Ñ ([model] factorization = \"standard\" or a [plant])".into(),
-        ));
-    }
-    if let Some(ncf) = &f.realization {
-        return Ok(ncf.plant_and_m_inverse());
-    }
-    let (p, m) = (f.outputs(), f.inputs());
-    let mut rows = Vec::with_capacity(p);
-    for i in 0..p {
-        let mut row: Vec<TransferFunction> = (0..m).map(|j| f.n.entry(i, j).clone()).collect();
-        row.extend((0..p).map(|j| TransferFunction::gain(if i == j { 1.0 } else { 0.0 })));
-        rows.push(row);
-    }
-    let n_i = crate::system::TfMatrix::from_rows(rows).expect("rectangular");
-    let s = StateSpace::from_tf_matrix(&n_i).minimal(1e-12);
-    let mm = StateSpace::from_tf_matrix(&f.m).minimal(1e-12);
-    Ok(mm.inverse("M̃")?.series(&s))
-}
-
-/// The Theorem 1 system `w ↦ [u; y]`, `T = [−K; I](I + GK)⁻¹M̃⁻¹`, for `u = −K·y`.
-pub fn theorem1_system(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
-    negative_feedback(&factor_system(f)?, k, f.inputs())
-}
-
-/// The system `[d₁; d₂] ↦ [u; y]` of `y = G(u + d₂) + d₁`, `u = −K·y`, i.e.
-/// `[−K; I](I + GK)⁻¹[I  G]`, whose H∞ norm is `1/b(G, K)`.
-pub fn gang_of_four(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
-    let fs = factor_system(f)?;
-    let m = f.inputs();
-    let p = f.outputs();
-    let g = StateSpace {
-        a: fs.a.clone(),
-        b: fs.b.columns(0, m).into_owned(),
-        c: fs.c.clone(),
-        d: fs.d.columns(0, m).into_owned(),
-    };
-    let n = g.states();
-    let mut b = DMatrix::zeros(n, m + p + m);
-    b.view_mut((0, 0), (n, m)).copy_from(&g.b);
-    b.view_mut((0, m + p), (n, m)).copy_from(&g.b);
-    let mut d = DMatrix::zeros(p, m + p + m);
-    d.view_mut((0, 0), (p, m)).copy_from(&g.d);
-    d.view_mut((0, m), (p, p))
-        .copy_from(&DMatrix::identity(p, p));
-    d.view_mut((0, m + p), (p, m)).copy_from(&g.d);
-    let plant = StateSpace {
-        a: g.a.clone(),
-        b,
-        c: g.c.clone(),
-        d,
-    };
-    negative_feedback(&plant, k, m)
-}
 
 /// The margin of one bound `r`.
 #[derive(Debug, Clone, Serialize)]
@@ -132,23 +70,6 @@ fn complex_list<S: serde::Serializer>(
         seq.serialize_element(&[z.re, z.im])?;
     }
     seq.end()
-}
-
-/// `σ_max(T(jω))` from the factor values: `T = [−K; I](M̃ + ÑK)⁻¹` (since
-/// `(I + GK)⁻¹M̃⁻¹ = (M̃ + ÑK)⁻¹`), an evaluation independent of the state-space path.
-pub fn t_sigma_max(f: &Factorization, k: &FreqEvaluator, omega: f64) -> Option<f64> {
-    let at = f.at(omega);
-    let kw = k.freq(omega)?;
-    let lhs = &at.m + &at.n * &kw;
-    let x = lhs
-        .lu()
-        .solve(&DMatrix::<Complex64>::identity(at.m.nrows(), at.m.nrows()))?;
-    let (m, p) = kw.shape();
-    let mut t = DMatrix::zeros(m + p, p);
-    t.view_mut((0, 0), (m, p)).copy_from(&(-(&kw * &x)));
-    t.view_mut((m, 0), (p, p)).copy_from(&x);
-    let s = crate::system::linalg::spectral_norm(&t);
-    s.is_finite().then_some(s)
 }
 
 /// Runs the Theorem 1 test of `controller` on `f` for each labelled `r`, with grid curves

@@ -1,7 +1,7 @@
 //! The rational export of a physical model: the special (modal) factorization
 //! `C·M̃⁻¹·Ñ·J` of Sec. IV-A (see the module docs of [`super`]).
 
-use super::{EffectKind, EffectPath, PhysicalModel};
+use super::{EffectPath, PhysicalModel};
 use crate::model::factorization::Factorization;
 use crate::system::{Polynomial, TfMatrix, TransferFunction};
 use nalgebra::DMatrix;
@@ -63,31 +63,28 @@ impl PhysicalModel {
                 c_cols.push(col);
             }
         }
-        let n = m_diag.len();
-        let c = DMatrix::from_fn(p, n, |i, k| c_cols[k][i]);
         let order = self.pade_order.unwrap_or(6);
         let mut j = vec![TransferFunction::gain(1.0); m];
-        for e in &self.effect {
-            if e.path == EffectPath::Output && p * m != 1 {
-                if e.kind == EffectKind::Gain || e.kind == EffectKind::Sign {
-                    return Err(format!(
-                        "[physical] effect \"{}\" on the output path of a MIMO model: fold it into the output gains for the factorization",
-                        e.kind_name()
-                    ));
-                }
-                return Err(format!(
-                    "[physical] effect \"{}\" on the output path of a MIMO model has no place in the constant C of the special factorization; move it to the input path",
-                    e.kind_name()
-                ));
-            }
+        for e in self.effect.iter().filter(|e| e.path == EffectPath::Input) {
             let tf = e.to_tf(order);
-            let n_ch = if e.path == EffectPath::Input { m } else { p };
-            for (k, jk) in j.iter_mut().enumerate().take(n_ch) {
+            for (k, jk) in j.iter_mut().enumerate() {
                 if e.channel.is_none_or(|c| c == k + 1) {
                     *jk = jk.mul(&tf);
                 }
             }
         }
+        let rows = super::output_path::split_rows(
+            self.output_chains(order),
+            super::output_path::Rows {
+                m: m_diag,
+                n: n_rows,
+                c: c_cols,
+            },
+            &mut j,
+        );
+        let (m_diag, n_rows, c_cols) = (rows.m, rows.n, rows.c);
+        let n = m_diag.len();
+        let c = DMatrix::from_fn(p, n, |i, k| c_cols[k][i]);
         let mm = TfMatrix::diagonal(m_diag);
         let nn = TfMatrix::from_rows(n_rows).ok_or("[physical]: inconsistent input gains")?;
         Factorization::special(c, mm, nn, j).map_err(|e| format!("[physical]: {e}"))

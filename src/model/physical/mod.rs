@@ -38,16 +38,19 @@
 //! (default 1 rad/s). That `M̃` is in RH∞ but is not a unit (it vanishes at `s = 0`): the
 //! factorization is still coprime and `G = C M̃⁻¹ Ñ J` holds, but A1 then limits `|r|` near
 //! `ω = 0`. An integrator uses `M̃ = m s/(s + a)`, `Ñ = b/(s + a)`. A feedthrough `D` adds one
-//! row per output with `M̃ = 1`, `Ñ = D_i`, `C = e_i`. Input-path effects go into `J`; for a
-//! SISO model, output-path effects commute and go into `J` too; for a MIMO model a dynamic
-//! output-path effect has no place in the constant `C` and the export fails (the exact
-//! evaluation still works). Irrational effects enter `J` through a Padé approximation of order
+//! row per output with `M̃ = 1`, `Ñ = D_i`, `C = e_i`. Input-path effects go into `J`.
+//! Output-path effects that every output shares commute with the plant and go into `J` too
+//! (always so for one output); effects on some outputs only (a sensor lag or delay on one
+//! encoder) split each modal row into one row per group of outputs with the same effects,
+//! `Ñ_k` multiplied by the group's effects and `C` restricted to the group (`C` stays
+//! constant; see `output_path.rs`). Irrational effects enter `J` through a Padé approximation of order
 //! `pade_order` (default 6): a delay `τ` as the `[n/n]` Padé of `e^{−sτ}`, a ZOH as the Padé of
 //! its mean delay `T/2` (its sinc droop, `−0.9 dB` at a quarter of the sample rate, is
 //! dropped in the export and kept in the exact evaluation).
 
 mod effect;
 mod export;
+mod output_path;
 mod terms;
 mod validate;
 

@@ -1,0 +1,139 @@
+//! The loop of Fig. 1 of Boulet & Francis (1998) around any factorization
+//! `G = C·M̃⁻¹·Ñ·J` (eq. (1)): the realization the perturbation `Δ = [Δ_N  −Δ_M]` sees,
+//! the Theorem 1 system `T`, and `T(jω)` straight from the factor values.
+//!
+//! With the modal signal `ξ` of `M̃_p·ξ = Ñ_p·J·u`, `y = C·ξ`, the perturbation enters as
+//! `M̃·ξ = Ñ·J·u + w`, `w = Δ·z`, `z = [J·u; ξ]`. Closing `u = −K·y` gives
+//!
+//! `T : w ↦ z = [−J·K·C; I_n]·(M̃ + Ñ·J·K·C)⁻¹`,
+//!
+//! the matrix of condition 2 of Theorem 1 (the paper writes it for `u = +K·y` as
+//! `[JKC; I](I − M̃⁻¹ÑJKC)⁻¹M̃⁻¹`; the norm is the same). For the standard factorization
+//! (`C = I`, `J = I`) this is `[−K; I](I + GK)⁻¹M̃⁻¹`; for the special factorization of a
+//! flexible structure `ξ` holds one entry per mode and `T` has `m + n` rows and `n` columns.
+
+use crate::error::{Error, Result};
+use crate::model::Factorization;
+use crate::system::freq_eval::FreqEvaluator;
+use crate::system::interconnect::negative_feedback;
+use crate::system::{StateSpace, TfMatrix, TransferFunction};
+use nalgebra::DMatrix;
+use num_complex::Complex64;
+
+/// A realization of `M̃⁻¹·[Ñ·J  I_n]`: inputs `[u; w]`, output the modal signal `ξ`.
+///
+/// For normalized state-space factors (a `[plant]`) it is `[G  M̃⁻¹]` sharing the plant's
+/// states. For factors typed as transfer functions it is the cascade `M̃⁻¹·[Ñ·J  I]`, whose
+/// hidden modes are poles of the (stable) factors `Ñ`, `J` and zeros of `M̃`; the latter
+/// are poles of the modal system itself, so the closed-loop eigenvalues decide the
+/// internal stability of the loop of Fig. 1 (modes that `C` does not see included).
+pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
+    if let Some(ncf) = &f.realization {
+        return Ok(ncf.plant_and_m_inverse());
+    }
+    let (n, m) = (f.states(), f.inputs());
+    let rows: Vec<Vec<TransferFunction>> = (0..n)
+        .map(|i| {
+            let mut row: Vec<TransferFunction> =
+                (0..m).map(|j| f.n.entry(i, j).mul(&f.j[j])).collect();
+            row.extend((0..n).map(|k| TransferFunction::gain(if i == k { 1.0 } else { 0.0 })));
+            row
+        })
+        .collect();
+    let nj_i = TfMatrix::from_rows(rows).expect("rectangular");
+    let s = StateSpace::from_tf_matrix(&nj_i).minimal(1e-12);
+    let mm = StateSpace::from_tf_matrix(&f.m).minimal(1e-12);
+    Ok(mm.inverse("M̃")?.series(&s))
+}
+
+/// `K·C`: the controller reading the modal signal through the output matrix `C`.
+fn controller_on_modes(f: &Factorization, k: &StateSpace) -> StateSpace {
+    StateSpace {
+        a: k.a.clone(),
+        b: &k.b * &f.c,
+        c: k.c.clone(),
+        d: &k.d * &f.c,
+    }
+}
+
+/// `diag(J, I_n)` as a state-space system (no states when `J` is constant).
+fn j_and_identity(f: &Factorization) -> StateSpace {
+    let mut diag = f.j.clone();
+    diag.extend((0..f.states()).map(|_| TransferFunction::gain(1.0)));
+    StateSpace::from_tf_matrix(&TfMatrix::diagonal(diag))
+}
+
+/// The Theorem 1 system `w ↦ [J·u; ξ]`, `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹`, for `u = −K·y`
+/// (module docs). States: the modal system, then `K`, then `J`.
+pub fn theorem1_system(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
+    if k.d.shape() != (f.inputs(), f.outputs()) {
+        return Err(Error::Invalid(format!(
+            "the controller must be {}×{} (plant inputs × plant outputs), got {}×{}",
+            f.inputs(),
+            f.outputs(),
+            k.d.nrows(),
+            k.d.ncols()
+        )));
+    }
+    let closed = negative_feedback(&modal_system(f)?, &controller_on_modes(f, k), f.inputs())?;
+    Ok(j_and_identity(f).series(&closed))
+}
+
+/// A realization of the plant `G = C·M̃⁻¹·Ñ·J` (input `u`, output `y`), from the modal
+/// system.
+pub fn plant_system(f: &Factorization) -> Result<StateSpace> {
+    let ms = modal_system(f)?;
+    let m = f.inputs();
+    Ok(StateSpace {
+        a: ms.a.clone(),
+        b: ms.b.columns(0, m).into_owned(),
+        c: &f.c * &ms.c,
+        d: &f.c * ms.d.columns(0, m),
+    })
+}
+
+/// The system `[d₁; d₂] ↦ [u; y]` of `y = G(u + d₂) + d₁`, `u = −K·y`, i.e.
+/// `[−K; I](I + GK)⁻¹[I  G]`, whose H∞ norm is `1/b(G, K)`.
+pub fn gang_of_four(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
+    let g = plant_system(f)?;
+    let m = f.inputs();
+    let p = f.outputs();
+    let n = g.states();
+    let mut b = DMatrix::zeros(n, m + p + m);
+    b.view_mut((0, 0), (n, m)).copy_from(&g.b);
+    b.view_mut((0, m + p), (n, m)).copy_from(&g.b);
+    let mut d = DMatrix::zeros(p, m + p + m);
+    d.view_mut((0, 0), (p, m)).copy_from(&g.d);
+    d.view_mut((0, m), (p, p))
+        .copy_from(&DMatrix::identity(p, p));
+    d.view_mut((0, m + p), (p, m)).copy_from(&g.d);
+    let plant = StateSpace {
+        a: g.a.clone(),
+        b,
+        c: g.c.clone(),
+        d,
+    };
+    negative_feedback(&plant, k, m)
+}
+
+/// `σ_max(T(jω))` from the factor values, `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹` (module
+/// docs), an evaluation independent of the state-space path. `None` where `M̃ + ÑJKC` is
+/// singular or `K` has a pole at `jω`.
+pub fn t_sigma_max(f: &Factorization, k: &FreqEvaluator, omega: f64) -> Option<f64> {
+    let at = f.at(omega);
+    let kw = k.freq(omega)?;
+    let mut jkc = &kw * &at.c;
+    for (i, ji) in at.j.iter().enumerate() {
+        let mut row = jkc.row_mut(i);
+        row *= *ji;
+    }
+    let lhs = &at.m + &at.n * &jkc;
+    let nx = at.m.nrows();
+    let x = lhs.lu().solve(&DMatrix::<Complex64>::identity(nx, nx))?;
+    let m = jkc.nrows();
+    let mut t = DMatrix::zeros(m + nx, nx);
+    t.view_mut((0, 0), (m, nx)).copy_from(&(-(&jkc * &x)));
+    t.view_mut((m, 0), (nx, nx)).copy_from(&x);
+    let s = crate::system::linalg::spectral_norm(&t);
+    s.is_finite().then_some(s)
+}
