@@ -165,6 +165,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     let [configured, retuned_node] = roots(base, data)?;
     let root_model = retuned_node.model.clone();
     let retuned = retuned_node.measures;
+    // Information criteria use the least-squares costs (the polish may raise `measures.v`).
+    let v_ret = retuned_node.v_fit;
     let res = search(vec![configured, retuned_node], data, s)?;
     // First-level candidates: the retune, and each effect on top of it.
     let (_, flags0) = Problem::new(base, data)?.invalid_flags(&Default::default());
@@ -182,16 +184,16 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         params: BTreeMap::new(),
         uncertainty_2sigma: BTreeMap::new(),
         v_before: before.v,
-        v_after: retuned.v,
+        v_after: v_ret,
         misfit_rms_before: before.misfit_rms,
         misfit_rms_after: retuned.misfit_rms,
         invalid_fraction_before: before.invalid_fraction,
         invalid_fraction_after: retuned.invalid_fraction,
-        delta_bic: 2.0 * (before.v - retuned.v),
+        delta_bic: 2.0 * (before.v - v_ret),
         delta_bic_vs_retune: 0.0,
         n_params: 0,
         joint_refit: true,
-        passes: 2.0 * (before.v - retuned.v) > MIN_DELTA_BIC,
+        passes: 2.0 * (before.v - v_ret) > MIN_DELTA_BIC,
         tie_with_best: false,
         flags: vec![],
         no_fit: None,
@@ -207,11 +209,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     for (sc, child) in &res.first_level {
         let nn = sc.cand.n_params(data.n_ch());
         let th = &sc.mods.theta;
-        let (model, m, joint) = match child {
-            Some(c) => (c.model.clone(), c.measures, true),
+        let (model, m, v, joint) = match child {
+            Some(c) => (c.model.clone(), c.measures, c.v_fit, true),
             None => (
                 add_effect(&root_model, &sc.cand, th, data),
                 sc.measures,
+                sc.v,
                 false,
             ),
         };
@@ -229,7 +232,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
                 }
             }
         }
-        let d_root = 2.0 * (retuned.v - m.v) - nn as f64 * ln2f;
+        let d_root = 2.0 * (v_ret - v) - nn as f64 * ln2f;
         candidates.push(CandidateReport {
             rank: 0,
             effect: sc.cand.label(),
@@ -240,12 +243,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             },
             uncertainty_2sigma: unc,
             v_before: before.v,
-            v_after: m.v,
+            v_after: v,
             misfit_rms_before: before.misfit_rms,
             misfit_rms_after: m.misfit_rms,
             invalid_fraction_before: before.invalid_fraction,
             invalid_fraction_after: m.invalid_fraction,
-            delta_bic: 2.0 * (before.v - m.v) - nn as f64 * ln2f,
+            delta_bic: 2.0 * (before.v - v) - nn as f64 * ln2f,
             delta_bic_vs_retune: d_root,
             n_params: nn,
             joint_refit: joint,

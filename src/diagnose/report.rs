@@ -23,7 +23,9 @@ pub struct CandidateReport {
     pub uncertainty_2sigma: BTreeMap<String, f64>,
     /// Cost of the configured model.
     pub v_before: f64,
-    /// Cost with the candidate (after the joint refit when `joint_refit`).
+    /// Cost of the least-squares fit with the candidate (after the joint refit when
+    /// `joint_refit`); the measures after are those of its consistency polish when that made
+    /// it consistent.
     pub v_after: f64,
     /// Error measures of the configured model.
     pub misfit_rms_before: f64,
