@@ -15,7 +15,7 @@
 //! no frequency beyond 1e6× the band.
 //!
 //! The suite lives in `tests/hidden/`; this file runs the servo (every case, in CI) and the
-//! full robot sweep (ignored: about 40 s at opt-level 1); `tests/diagnose_hidden_robot.rs`
+//! full robot sweep (ignored: 22 s at opt-level 1 on a loaded 2-core machine, 11 s in release); `tests/diagnose_hidden_robot.rs`
 //! runs a robot subset in CI.
 
 mod hidden;
@@ -26,7 +26,7 @@ use hidden::{robot, run_suite, servo, ALL};
 /// than the others, 15 configured parameters): 42/42 cases pass (single 18/18, pair 9/9,
 /// triple 6/6, rough start 6/6, null 3/3), and 140/140 on seeds 1–10.
 #[test]
-#[ignore = "the full robot sweep (≈40 s at opt-level 1); tests/diagnose_hidden_robot.rs runs a subset in CI"]
+#[ignore = "the full robot sweep (≈22 s at opt-level 1); tests/diagnose_hidden_robot.rs runs seed 11 in CI"]
 fn hidden_effects_robot() {
     let (b, w) = robot();
     let o = run_suite("robot", b, w, &ALL);
