@@ -5,8 +5,8 @@ use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::plant_form::physical_from_config;
 use crate::diagnose::{
-    apply_candidate, diagnose_channels, misfit_channels, prepare, retune, Channels, Diagnosis,
-    Settings,
+    apply_candidate, diagnose_channels, misfit_channels, prepare, retune_within, Channels,
+    Diagnosis, Settings,
 };
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
@@ -155,7 +155,7 @@ fn write_revision(
 ) -> Result<()> {
     // The candidate (already refit jointly when the search got to it), refit once more.
     let applied = apply_candidate(base, d, k)?;
-    let revised = retune(&applied, data, None, false).model;
+    let revised = retune_within(&applied, base, data, None, false).model;
     let (rms_refit, inv_refit) = misfit_channels(&revised, data);
     // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
     let mut raw = raw.clone();
@@ -324,12 +324,14 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         println!("\nrunner-up sets (BIC gap to the chosen set):");
         for r in &d.runner_up {
             println!(
-                "  {:<40} +{}  misfit_rms {}, invalid {}{}",
+                "  {:<40} {}{}  misfit_rms {}, invalid {}{}",
                 if r.effects.is_empty() {
                     "(retune only)".to_string()
                 } else {
                     r.effects.join(" + ")
                 },
+                // A runner-up in a tie may have the lower BIC (the prior order chose).
+                if r.bic_gap >= 0.0 { "+" } else { "" },
                 sig(r.bic_gap),
                 sig(r.misfit_rms),
                 fmt_pct(r.invalid_fraction),

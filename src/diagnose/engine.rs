@@ -7,30 +7,33 @@
 //! * [`super::retune`]: the configured parameters, refit with wide bounds (residues by
 //!   least squares, modes placed by a grid from a rough start): the `retune` candidate.
 //! * [`super::search`]: beam search over effect sequences with a joint refit at every node.
-//! * Final holdout, per effect of the chosen set: fitted on 3 of every 4 data, the held-out
-//!   quarter's `V` must be lower with the effect than without it; for a multiplicative
-//!   effect, also fitted below 70 % of the band (log frequency), the top 30 % must be
-//!   predicted better. Both models are fitted on all data first and refit on the part from
-//!   there (so an effect the part does not see keeps its value). An effect that fails is
-//!   dropped and the rest refit. The extrapolation test decides only for a set of
-//!   multiplicative effects (a fit below the split cannot place a mode or a feedthrough that
-//!   acts above it); otherwise it is reported.
-//! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
+//! * Final holdout ([`super::holdout`]), per effect of the chosen set: fitted on 3 of every
+//!   4 data, the held-out quarter's `V` must be lower with the effect than without it; for a
+//!   multiplicative effect, also fitted below 70 % of the band (log frequency), the top 30 %
+//!   must be predicted better. An effect that fails is dropped and the rest refit. The
+//!   extrapolation test decides only for a set of multiplicative effects (a fit below the
+//!   split cannot place a mode or a feedthrough that acts above it); otherwise it is
+//!   reported.
+//! * Ties ([`super::ties`]): sets within 6 of the chosen set's BIC, with where to measure to
+//!   tell them apart.
+//! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`, judged on the model's
+//!   consistency polish ([`super::polish`]).
 
 use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Siso};
+use super::holdout::{holdouts, model_of};
+use super::polish::settle;
 pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
-use super::rank::{
-    disambiguate, prior, si_map, EXTRAPOLATION_SPLIT, MIN_DELTA_BIC, MIN_SPLIT_DATA, TIE_BIC,
-};
+use super::rank::{prior, si_map, MIN_DELTA_BIC, TIE_BIC};
 pub use super::report::{
     CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
 };
-use super::retune::{cost, retune, ADDED_NOTE};
-use super::search::{add_effect, roots, search, Node, Settings};
+use super::retune::{retune_within, ADDED_NOTE};
+use super::search::{add_effect, roots, search, Settings};
+use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use crate::report::fmt::fmt_pct;
@@ -52,63 +55,6 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
 
 fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
     Ok(Problem::new(m, data)?.measures(&Default::default()))
-}
-
-/// The model made of `root` (the configured model) and the effects `effects` (parameters as
-/// fitted when added), jointly refit on `mask` from a rough start.
-fn assemble(
-    root: &PhysicalModel,
-    effects: &[(super::candidates::Cand, Vec<f64>)],
-    data: &Channels,
-    mask: Option<&[usize]>,
-) -> PhysicalModel {
-    let mut m = root.clone();
-    for (c, th) in effects {
-        m = add_effect(&m, c, th, data);
-    }
-    retune(&m, data, mask, true).model
-}
-
-/// Final-set holdout of every effect of `node` (see the module docs).
-fn holdouts(root: &PhysicalModel, node: &Node, data: &Channels) -> Vec<Holdout> {
-    let f = data.len();
-    let fit: Vec<usize> = (0..f).filter(|k| k % 4 != 3).collect();
-    let ho: Vec<usize> = (0..f).filter(|k| k % 4 == 3).collect();
-    let cut = {
-        let (lo, hi) = (data.omega[0].ln(), data.omega[f - 1].ln());
-        (lo + EXTRAPOLATION_SPLIT * (hi - lo)).exp()
-    };
-    let (low, high): (Vec<usize>, Vec<usize>) = (0..f).partition(|k| data.omega[*k] < cut);
-    let extrap = low.len() >= MIN_SPLIT_DATA && high.len() >= MIN_SPLIT_DATA;
-    // Each model is fitted on all data first, then refit (LM from there) on the part: an
-    // effect the part does not see keeps its all-data value instead of drifting.
-    let part = |m: &PhysicalModel, mask: &[usize], test: &[usize]| {
-        cost(&retune(m, data, Some(mask), false).model, data, test)
-    };
-    let full = assemble(root, &node.effects, data, None);
-    let full_ho = part(&full, &fit, &ho);
-    let full_hi = extrap.then(|| part(&full, &low, &high));
-    (0..node.effects.len())
-        .map(|j| {
-            let others: Vec<_> = node
-                .effects
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| *i != j)
-                .map(|(_, e)| e.clone())
-                .collect();
-            let c = node.effects[j].0;
-            let wo = assemble(root, &others, data, None);
-            let wo_ho = part(&wo, &fit, &ho);
-            let extrapolation_ok = (extrap && c.multiplicative())
-                .then(|| full_hi.unwrap_or(f64::INFINITY) < part(&wo, &low, &high));
-            Holdout {
-                effect: c.label(),
-                interleaved_ok: full_ho < wo_ho,
-                extrapolation_ok,
-            }
-        })
-        .collect()
 }
 
 /// The effects `diagnose` added to `m`, with their current parameters.
@@ -219,6 +165,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     let [configured, retuned_node] = roots(base, data)?;
     let root_model = retuned_node.model.clone();
     let retuned = retuned_node.measures;
+    // Information criteria use the least-squares costs (the polish may raise `measures.v`).
+    let v_ret = retuned_node.v_fit;
     let res = search(vec![configured, retuned_node], data, s)?;
     // First-level candidates: the retune, and each effect on top of it.
     let (_, flags0) = Problem::new(base, data)?.invalid_flags(&Default::default());
@@ -236,16 +184,16 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         params: BTreeMap::new(),
         uncertainty_2sigma: BTreeMap::new(),
         v_before: before.v,
-        v_after: retuned.v,
+        v_after: v_ret,
         misfit_rms_before: before.misfit_rms,
         misfit_rms_after: retuned.misfit_rms,
         invalid_fraction_before: before.invalid_fraction,
         invalid_fraction_after: retuned.invalid_fraction,
-        delta_bic: 2.0 * (before.v - retuned.v),
+        delta_bic: 2.0 * (before.v - v_ret),
         delta_bic_vs_retune: 0.0,
         n_params: 0,
         joint_refit: true,
-        passes: 2.0 * (before.v - retuned.v) > MIN_DELTA_BIC,
+        passes: 2.0 * (before.v - v_ret) > MIN_DELTA_BIC,
         tie_with_best: false,
         flags: vec![],
         no_fit: None,
@@ -261,11 +209,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     for (sc, child) in &res.first_level {
         let nn = sc.cand.n_params(data.n_ch());
         let th = &sc.mods.theta;
-        let (model, m, joint) = match child {
-            Some(c) => (c.model.clone(), c.measures, true),
+        let (model, m, v, joint) = match child {
+            Some(c) => (c.model.clone(), c.measures, c.v_fit, true),
             None => (
                 add_effect(&root_model, &sc.cand, th, data),
                 sc.measures,
+                sc.v,
                 false,
             ),
         };
@@ -283,7 +232,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
                 }
             }
         }
-        let d_root = 2.0 * (retuned.v - m.v) - nn as f64 * ln2f;
+        let d_root = 2.0 * (v_ret - v) - nn as f64 * ln2f;
         candidates.push(CandidateReport {
             rank: 0,
             effect: sc.cand.label(),
@@ -294,12 +243,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             },
             uncertainty_2sigma: unc,
             v_before: before.v,
-            v_after: m.v,
+            v_after: v,
             misfit_rms_before: before.misfit_rms,
             misfit_rms_after: m.misfit_rms,
             invalid_fraction_before: before.invalid_fraction,
             invalid_fraction_after: m.invalid_fraction,
-            delta_bic: 2.0 * (before.v - m.v) - nn as f64 * ln2f,
+            delta_bic: 2.0 * (before.v - v) - nn as f64 * ln2f,
             delta_bic_vs_retune: d_root,
             n_params: nn,
             joint_refit: joint,
@@ -341,23 +290,9 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     for (k, c) in candidates.iter_mut().enumerate() {
         c.rank = k + 1;
     }
-    let mut ties = Vec::new();
-    if let Some(best) = candidates.first().cloned() {
-        for c in candidates.iter_mut().skip(1) {
-            c.tie_with_best =
-                c.passes && best.passes && (best.delta_bic - c.delta_bic).abs() < TIE_BIC;
-            if c.tie_with_best {
-                ties.push(Tie {
-                    effects: [best.effect.clone(), c.effect.clone()],
-                    bic_gap: (best.delta_bic - c.delta_bic).abs(),
-                    disambiguation: disambiguate(&best.model, &c.model, data),
-                });
-            }
-        }
-    }
     // The chosen set, its final holdout, runner-ups and ties.
     let mut node = res.nodes[res.chosen].clone();
-    let holdout = holdouts(base, &node, data);
+    let holdout = holdouts(base, &node, &res.nodes, data);
     // A fit below 70 % of the band cannot place an additive effect (a mode, a feedthrough)
     // that acts above it, so the extrapolation test decides only for sets of multiplicative
     // effects; otherwise it is reported.
@@ -378,18 +313,20 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             .map(|(_, e)| e.clone())
             .collect();
         dropped = failing.iter().map(|i| node.effects[*i].0.label()).collect();
-        let model = assemble(base, &keep, data, None);
+        let model = model_of(base, &keep, &res.nodes, data);
         node.measures = measures(&model, data)?;
+        node.v_fit = node.measures.v;
         node.model = model;
         node.steps.retain(|st| !dropped.contains(&st.effect));
         node.effects = keep;
     }
-    // A last joint refit of the chosen model.
-    let polished = retune(&node.model, data, None, false);
-    if polished.v_after < node.measures.v {
-        node.measures = measures(&polished.model, data)?;
-        node.model = polished.model;
+    // A last joint refit of the chosen model, and its consistency polish.
+    let refit = retune_within(&node.model, base, data, None, false);
+    if refit.v_after < node.v_fit {
+        node.v_fit = refit.v_after;
+        node.model = refit.model;
     }
+    (node.model, node.measures) = settle(node.model, base, data)?;
     let chosen_bic = res.nodes[res.chosen].bic;
     let mut runner_up: Vec<EffectSet> = res
         .nodes
@@ -408,20 +345,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     runner_up.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     runner_up.truncate(4);
     let chosen_labels = node.labels();
-    for (i, nd) in res.nodes.iter().enumerate() {
-        let gap = (nd.bic - chosen_bic).abs();
-        if i != res.chosen
-            && gap < TIE_BIC
-            && nd.effects.len() == res.nodes[res.chosen].effects.len()
-            && !nd.effects.is_empty()
-        {
-            ties.push(Tie {
-                effects: [chosen_labels.join(" + "), nd.labels().join(" + ")],
-                bic_gap: gap,
-                disambiguation: disambiguate(&node.model, &nd.model, data),
-            });
-        }
-    }
+    let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
+    ties.extend(candidate_ties(&mut candidates, &ties, data));
     let after = node.measures;
     let verdict = if !node.effects.is_empty() {
         "effects_found"

@@ -31,9 +31,10 @@ where
     )
 }
 
-/// [`lm`] with box bounds `lo ≤ θ ≤ hi`: the start is clamped into the box and every
-/// trial step is projected onto it (a step that the projection makes worse is rejected
-/// like any other, so `V` never rises).
+/// [`lm`] with box bounds `lo ≤ θ ≤ hi`: the start is clamped into the box, a parameter on
+/// a bound that the gradient pushes outward is held there for the step (active set), and
+/// every trial step is projected onto the box (a step that the projection makes worse is
+/// rejected like any other, so `V` never rises).
 pub fn lm_box<F>(
     f: F,
     theta0: &[f64],
@@ -87,14 +88,30 @@ where
         let jtj = jac.transpose() * &jac;
         let g = jac.transpose() * DVector::from_column_slice(&r);
         let dmax = (0..n).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
+        // Active bounds: a parameter on a bound that the descent direction pushes outward is
+        // held there (its row and column leave the step), so the projection of the step
+        // cannot spoil the model's prediction and stall the iteration at growing damping.
+        let active: Vec<bool> = (0..n)
+            .map(|i| {
+                let tol = 1e-12 * (1.0 + theta[i].abs());
+                (theta[i] <= lo[i] + tol && g[i] > 0.0) || (theta[i] >= hi[i] - tol && g[i] < 0.0)
+            })
+            .collect();
         let mut improved = false;
         for _ in 0..12 {
             let mut a = jtj.clone();
+            let mut rhs = -&g;
             for i in 0..n {
                 a[(i, i)] += lambda * jtj[(i, i)].max(1e-6 * dmax);
             }
+            for i in (0..n).filter(|i| active[*i]) {
+                a.row_mut(i).fill(0.0);
+                a.column_mut(i).fill(0.0);
+                a[(i, i)] = 1.0;
+                rhs[i] = 0.0;
+            }
             let step = match a.cholesky() {
-                Some(c) => c.solve(&(-&g)),
+                Some(c) => c.solve(&rhs),
                 None => {
                     lambda *= 10.0;
                     continue;

@@ -1,5 +1,5 @@
-//! Screening the candidates on top of a model (each fitted alone, the model fixed), their
-//! physical plausibility, and where two fitted models can be told apart.
+//! Screening the candidates on top of a model (each fitted alone, the model fixed) and their
+//! physical plausibility (where two fitted models can be told apart: [`super::ties`]).
 
 use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
 use super::channels::Channels;
@@ -241,45 +241,5 @@ impl Problem<'_> {
             .collect();
         out.sort_by(|a, b| b.delta_bic.total_cmp(&a.delta_bic));
         out
-    }
-}
-
-/// Where two fitted models differ by more than the (median relative) noise, beyond the band.
-pub fn disambiguate(a: &PhysicalModel, b: &PhysicalModel, data: &Channels) -> String {
-    let (wmin, wmax) = (data.omega[0], *data.omega.last().expect("data"));
-    let mut rel: Vec<f64> = (0..data.len())
-        .map(|k| data.radius[0][k] / data.g[0][k].norm().max(1e-300))
-        .collect();
-    rel.sort_by(|x, y| x.total_cmp(y));
-    let rel_noise = rel[rel.len() / 2];
-    let differs = |w: f64| {
-        let (ga, gb) = (a.eval(w), b.eval(w));
-        data.entries.iter().any(|e| {
-            let (x, y) = (ga[*e], gb[*e]);
-            (x - y).norm() > rel_noise * x.norm()
-        })
-    };
-    let above = (1..=200)
-        .map(|i| wmax * 10f64.powf(i as f64 * 2.0 / 200.0))
-        .find(|w| differs(*w));
-    let below = (1..=200)
-        .map(|i| wmin / 10f64.powf(i as f64 * 2.0 / 200.0))
-        .find(|w| differs(*w));
-    let tail = "measure there to tell them apart";
-    match (above, below) {
-        (Some(h), Some(l)) => format!(
-            "the two fitted models differ by more than the noise above {} and below {}: {tail}",
-            fmt_w(h),
-            fmt_w(l)
-        ),
-        (Some(h), None) => format!(
-            "the two fitted models differ by more than the noise above {}: {tail}",
-            fmt_w(h)
-        ),
-        (None, Some(l)) => format!(
-            "the two fitted models differ by more than the noise below {}: {tail}",
-            fmt_w(l)
-        ),
-        (None, None) => "the two fitted models agree within the noise from a hundredth of the lowest to a hundred times the highest measured frequency: lower the noise (more periods or averages) to tell them apart".into(),
     }
 }

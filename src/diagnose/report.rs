@@ -23,7 +23,9 @@ pub struct CandidateReport {
     pub uncertainty_2sigma: BTreeMap<String, f64>,
     /// Cost of the configured model.
     pub v_before: f64,
-    /// Cost with the candidate (after the joint refit when `joint_refit`).
+    /// Cost of the least-squares fit with the candidate (after the joint refit when
+    /// `joint_refit`); the measures after are those of its consistency polish when that made
+    /// it consistent.
     pub v_after: f64,
     /// Error measures of the configured model.
     pub misfit_rms_before: f64,
@@ -72,6 +74,11 @@ pub struct Tie {
     pub bic_gap: f64,
     /// Which measurement tells them apart.
     pub disambiguation: String,
+    /// The nearest frequency above the band (rad/s) where the two fitted models differ by
+    /// more than the noise (`None`: not within two decades).
+    pub separates_above: Option<f64>,
+    /// The same below the band.
+    pub separates_below: Option<f64>,
 }
 
 /// One step of the chosen path.

@@ -10,7 +10,7 @@
 //!
 //! | term | nonlinear parameters | box |
 //! |---|---|---|
-//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.25 … 1.25ω_n₀` (inside the band for a mode `diagnose` added), `ζ ∈ [1e-4, 0.7]` |
+//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.3 … 1.3ω_n₀` (inside the band for a mode `diagnose` added), `ζ ∈ [1e-4, 0.7]` |
 //! | rigid body with friction | `ln p` | a decade either side |
 //! | input gains (several inputs) | `b_i`, `i ≥ 2` | two decades, sign kept |
 //! | delay | `τ` | `[0, 10 τ₀ + 1/ω_max]` |
@@ -19,230 +19,20 @@
 //! Output gains (residues) and feedthrough are free (least squares): a gain error of any
 //! size, or a sign error, is absorbed in them, so a `gain` or `sign` path effect is kept as
 //! it is.  From a rough start (`rough = true`) each mode is first placed by a grid over
-//! `ω_n₀/1.25 … 1.25ω_n₀` and five damping values, the residues solved at every point.  The
+//! `ω_n₀/1.3 … 1.3ω_n₀` and five damping values, the residues solved at every point.  The
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use super::channels::Channels;
 use super::fit::lm_box;
-use super::problem::path_at;
-use crate::model::physical::{EffectKind, Feedthrough, Gains, PhysicalModel};
+use super::slots::{
+    anchor_value, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
+};
+use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
 /// Names of modes and terms `diagnose` adds start with this.
 pub const ADDED_NOTE: &str = "added by rshape diagnose";
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Term {
-    Rigid(usize),
-    Int(usize),
-    Mode(usize),
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Lin {
-    Out(Term, usize),
-    Feed(usize, usize),
-}
-
-#[derive(Debug, Clone, Copy)]
-enum Nl {
-    ModeW(usize),
-    ModeZ(usize),
-    RigidPole(usize),
-    In(Term, usize),
-    Delay(usize),
-    LogEffect(usize),
-}
-
-fn gains_of(m: &PhysicalModel, t: Term) -> (&Gains, &Gains, f64) {
-    match t {
-        Term::Rigid(i) => {
-            let r = &m.rigid_body[i];
-            (&r.output_gain, &r.input_gain, r.mass)
-        }
-        Term::Int(i) => {
-            let r = &m.integrator[i];
-            (&r.output_gain, &r.input_gain, r.mass)
-        }
-        Term::Mode(i) => {
-            let r = &m.mode[i];
-            (&r.output_gain, &r.input_gain, r.mass)
-        }
-    }
-}
-
-fn gains_mut(m: &mut PhysicalModel, t: Term) -> (&mut Gains, &mut Gains) {
-    match t {
-        Term::Rigid(i) => {
-            let r = &mut m.rigid_body[i];
-            (&mut r.output_gain, &mut r.input_gain)
-        }
-        Term::Int(i) => {
-            let r = &mut m.integrator[i];
-            (&mut r.output_gain, &mut r.input_gain)
-        }
-        Term::Mode(i) => {
-            let r = &mut m.mode[i];
-            (&mut r.output_gain, &mut r.input_gain)
-        }
-    }
-}
-
-fn set_entry(g: &mut Gains, n: usize, idx: usize, x: f64) {
-    let mut v = g.to_vec(n);
-    v[idx] = x;
-    *g = if n == 1 {
-        Gains::Scalar(v[0])
-    } else {
-        Gains::Vector(v)
-    };
-}
-
-fn terms(m: &PhysicalModel) -> Vec<Term> {
-    (0..m.rigid_body.len())
-        .map(Term::Rigid)
-        .chain((0..m.integrator.len()).map(Term::Int))
-        .chain((0..m.mode.len()).map(Term::Mode))
-        .collect()
-}
-
-/// The slots of `m` on the outputs the data observe.
-fn slots(m: &PhysicalModel, data: &Channels) -> (Vec<Lin>, Vec<Nl>) {
-    let (p, n_in) = (m.n_outputs(), m.n_inputs());
-    let outs: Vec<usize> = (0..p)
-        .filter(|o| data.entries.iter().any(|e| e.0 == *o))
-        .collect();
-    let mut lin = Vec::new();
-    let mut nl = Vec::new();
-    for t in terms(m) {
-        let (c, b, _) = gains_of(m, t);
-        let (c, b) = (c.to_vec(p), b.to_vec(n_in));
-        for o in &outs {
-            if c[*o] != 0.0 {
-                lin.push(Lin::Out(t, *o));
-            }
-        }
-        if n_in > 1 {
-            let first = b.iter().position(|x| *x != 0.0);
-            for (i, x) in b.iter().enumerate() {
-                if *x != 0.0 && Some(i) != first && data.entries.iter().any(|e| e.1 == i) {
-                    nl.push(Nl::In(t, i));
-                }
-            }
-        }
-    }
-    for (i, r) in m.rigid_body.iter().enumerate() {
-        if r.friction_pole.is_some_and(|p| p > 0.0) {
-            nl.push(Nl::RigidPole(i));
-        }
-    }
-    for i in 0..m.mode.len() {
-        nl.push(Nl::ModeW(i));
-        nl.push(Nl::ModeZ(i));
-    }
-    if m.feedthrough.is_some() {
-        for e in &data.entries {
-            lin.push(Lin::Feed(e.0, e.1));
-        }
-    }
-    for (i, e) in m.effect.iter().enumerate() {
-        match e.kind {
-            EffectKind::Delay if e.tau_s.is_some() => nl.push(Nl::Delay(i)),
-            EffectKind::Lag if e.omega_c.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            EffectKind::NmpZero if e.z.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            EffectKind::Zoh if e.t_s.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            _ => {}
-        }
-    }
-    (lin, nl)
-}
-
-fn get_nl(m: &PhysicalModel, s: Nl) -> f64 {
-    match s {
-        Nl::ModeW(i) => m.mode[i].omega_n.ln(),
-        Nl::ModeZ(i) => m.mode[i].zeta.ln(),
-        Nl::RigidPole(i) => m.rigid_body[i].friction_pole.unwrap_or(1.0).ln(),
-        Nl::In(t, i) => gains_of(m, t).1.to_vec(m.n_inputs())[i],
-        Nl::Delay(i) => m.effect[i].tau_s.unwrap_or(0.0),
-        Nl::LogEffect(i) => {
-            let e = &m.effect[i];
-            match e.kind {
-                EffectKind::Lag => e.omega_c,
-                EffectKind::NmpZero => e.z,
-                _ => e.t_s,
-            }
-            .unwrap_or(1.0)
-            .ln()
-        }
-    }
-}
-
-fn set_nl(m: &mut PhysicalModel, s: Nl, x: f64) {
-    let n_in = m.n_inputs();
-    match s {
-        Nl::ModeW(i) => m.mode[i].omega_n = x.exp(),
-        Nl::ModeZ(i) => m.mode[i].zeta = x.exp(),
-        Nl::RigidPole(i) => m.rigid_body[i].friction_pole = Some(x.exp()),
-        Nl::In(t, i) => set_entry(gains_mut(m, t).1, n_in, i, x),
-        Nl::Delay(i) => m.effect[i].tau_s = Some(x),
-        Nl::LogEffect(i) => {
-            let e = &mut m.effect[i];
-            let v = Some(x.exp());
-            match e.kind {
-                EffectKind::Lag => e.omega_c = v,
-                EffectKind::NmpZero => e.z = v,
-                _ => e.t_s = v,
-            }
-        }
-    }
-}
-
-fn set_lin(m: &mut PhysicalModel, s: Lin, x: f64) {
-    let (p, n_in) = (m.n_outputs(), m.n_inputs());
-    match s {
-        Lin::Out(t, o) => set_entry(gains_mut(m, t).0, p, o, x),
-        Lin::Feed(o, i) => {
-            m.feedthrough = Some(match m.feedthrough.take() {
-                Some(Feedthrough::Matrix(mut r)) => {
-                    r[o][i] = x;
-                    Feedthrough::Matrix(r)
-                }
-                _ if p * n_in == 1 => Feedthrough::Scalar(x),
-                _ => {
-                    let mut r = vec![vec![0.0; n_in]; p];
-                    r[o][i] = x;
-                    Feedthrough::Matrix(r)
-                }
-            })
-        }
-    }
-}
-
-/// `(lo, hi, typ)` of a nonlinear slot at its start value `x0`.
-fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) -> (f64, f64, f64) {
-    match s {
-        Nl::ModeW(i) => {
-            let (mut lo, mut hi) = (x0 - 1.25f64.ln(), x0 + 1.25f64.ln());
-            let added = m.mode[i]
-                .name
-                .as_deref()
-                .is_some_and(|n| n.starts_with(ADDED_NOTE));
-            if added {
-                lo = lo.max(w_min.ln());
-                hi = hi.min(w_max.ln()).max(lo);
-            }
-            (lo, hi, 1.0)
-        }
-        Nl::ModeZ(_) => (1e-4f64.ln(), 0.7f64.ln(), 1.0),
-        Nl::RigidPole(_) | Nl::LogEffect(_) => (x0 - 10f64.ln(), x0 + 10f64.ln(), 1.0),
-        Nl::In(..) => {
-            let (a, b) = (x0 / 100.0, 100.0 * x0);
-            (a.min(b), a.max(b), x0.abs().max(1e-300))
-        }
-        Nl::Delay(_) => (0.0, 10.0 * x0.abs() + 1.0 / w_max, 1.0 / w_max),
-    }
-}
 
 /// The result of a refit.
 #[derive(Debug, Clone)]
@@ -275,82 +65,65 @@ fn solve_linear_res(
     data: &Channels,
     mask: &[usize],
 ) -> DVector<f64> {
-    let n_in = m.n_inputs();
-    let rows = 2 * mask.len() * data.n_ch();
+    let (a, y) = design(m, lin, data, mask);
     let n = lin.len();
-    let mut a = DMatrix::<f64>::zeros(rows, n);
-    let mut y = DVector::<f64>::zeros(rows);
-    let mut row = 0;
-    for (ch, e) in data.entries.iter().enumerate() {
-        for &k in mask {
-            let w = data.omega[k];
-            let s = Complex64::new(0.0, w);
-            let wt = std::f64::consts::SQRT_2 / data.radius[ch][k];
-            let path = path_at(m, w, *e);
-            for (j, l) in lin.iter().enumerate() {
-                let v = match l {
-                    Lin::Out(t, o) if *o == e.0 => {
-                        let (_, b, mass) = gains_of(m, *t);
-                        let shape = match t {
-                            Term::Rigid(i) => {
-                                let pf = m.rigid_body[*i].friction_pole.unwrap_or(0.0);
-                                (s * (s + pf)).inv()
-                            }
-                            Term::Int(_) => s.inv(),
-                            Term::Mode(i) => {
-                                let md = &m.mode[*i];
-                                (s * s + 2.0 * md.zeta * md.omega_n * s + md.omega_n * md.omega_n)
-                                    .inv()
-                            }
-                        };
-                        path * shape * (b.to_vec(n_in)[e.1] / mass)
-                    }
-                    Lin::Feed(o, i) if (*o, *i) == *e => path,
-                    _ => Complex64::new(0.0, 0.0),
-                };
-                a[(row, j)] = v.re * wt;
-                a[(row + 1, j)] = v.im * wt;
-            }
-            let g = data.g[ch][k];
-            y[row] = g.re * wt;
-            y[row + 1] = g.im * wt;
-            row += 2;
+    let rows_per_ch = 2 * mask.len();
+    let mut x = DVector::<f64>::zeros(n);
+    for (chs, cols) in blocks(lin, data) {
+        if cols.is_empty() {
+            continue;
+        }
+        let rows: Vec<usize> = chs
+            .iter()
+            .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
+            .collect();
+        let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+        let yb = DVector::from_fn(rows.len(), |i, _| y[rows[i]]);
+        for (j, xj) in cols.iter().zip(qr_solve(ab, yb).iter()) {
+            x[*j] = *xj;
         }
     }
-    // Column scaling, then Householder QR; a column with a negligible pivot is dropped (its
-    // parameter set to 0), so a rank-deficient basis cannot blow up.
+    for (j, l) in lin.iter().enumerate() {
+        if !x[j].is_finite() {
+            x[j] = 0.0;
+        }
+        set_lin(m, *l, x[j]);
+    }
+    &y - &a * &x
+}
+
+/// Least squares `min ‖y − A x‖`: column scaling, then Householder QR; a column with a
+/// negligible pivot is dropped (its parameter set to 0), so a rank-deficient basis cannot
+/// blow up.
+fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
+    let n = a.ncols();
     let scale: Vec<f64> = (0..n)
         .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
         .collect();
     for (j, s) in scale.iter().enumerate() {
         a.column_mut(j).scale_mut(1.0 / s);
     }
-    let x = if n == 0 {
-        DVector::zeros(0)
-    } else {
-        let qr = a.clone().qr();
-        let r = qr.r();
-        let qty = qr.q().transpose() * &y;
-        let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
-        let mut x = DVector::<f64>::zeros(n);
-        for i in (0..n).rev() {
-            if r[(i, i)].abs() <= 1e-12 * rmax {
-                continue;
-            }
-            let mut acc = qty[i];
-            for j in i + 1..n {
-                acc -= r[(i, j)] * x[j];
-            }
-            x[i] = acc / r[(i, i)];
+    let qr = a.qr();
+    let r = qr.r();
+    // Qᵀy by the Householder reflections (no explicit Q).
+    let mut qty = y;
+    qr.q_tr_mul(&mut qty);
+    let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    let mut x = DVector::<f64>::zeros(n);
+    for i in (0..n).rev() {
+        if r[(i, i)].abs() <= 1e-12 * rmax {
+            continue;
         }
-        x
-    };
-    let res = &y - &a * &x;
-    for (j, l) in lin.iter().enumerate() {
-        let v = x[j] / scale[j];
-        set_lin(m, *l, if v.is_finite() { v } else { 0.0 });
+        let mut acc = qty[i];
+        for j in i + 1..n {
+            acc -= r[(i, j)] * x[j];
+        }
+        x[i] = acc / r[(i, i)];
     }
-    res
+    for (xi, s) in x.iter_mut().zip(&scale) {
+        *xi /= s;
+    }
+    x
 }
 
 /// Cost `V` of `m` on the data at `mask`.
@@ -370,9 +143,24 @@ pub fn cost(m: &PhysicalModel, data: &Channels, mask: &[usize]) -> f64 {
 }
 
 /// Refits every parameter of `m` jointly on the data at `mask` (all data when `None`); with
-/// `rough`, each mode is first placed by a grid (see the module documentation).
+/// `rough`, each mode is first placed by a grid (see the module documentation).  The boxes
+/// are around the values of `m` itself: [`retune_within`] with `m` as its own anchor.
 pub fn retune(
     m: &PhysicalModel,
+    data: &Channels,
+    mask: Option<&[usize]>,
+    rough: bool,
+) -> NominalRefit {
+    retune_within(m, m, data, mask, rough)
+}
+
+/// [`retune`] with the boxes of the configured parameters around their values in `anchor`,
+/// the configured model `m` was built from (effects added to it keep boxes around their
+/// current values).  A chain of refits (every node of the search, the holdouts) then cannot
+/// walk a configured mode, box by box, away from where the user put it.
+pub fn retune_within(
+    m: &PhysicalModel,
+    anchor: &PhysicalModel,
     data: &Channels,
     mask: Option<&[usize]>,
     rough: bool,
@@ -404,7 +192,7 @@ pub fn retune(
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
             for j in 0..33 {
-                let w = w0 * 1.25f64.powf(-1.0 + j as f64 / 16.0);
+                let w = w0 * MODE_BOX.powf(-1.0 + j as f64 / 16.0);
                 for z in [z0, 0.003, 0.01, 0.03, 0.1] {
                     let mut t = start.clone();
                     t.mode[i].omega_n = w;
@@ -422,10 +210,9 @@ pub fn retune(
     }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
-    for (s, x) in nl.iter().zip(&theta0) {
+    for s in &nl {
         // Bounds around the configured value, so a rough start may not wander further.
-        let (a, b, t) = bounds(m, *s, get_nl(m, *s), w_min, w_max);
-        let _ = x;
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
         lo.push(a);
         hi.push(b);
         typ.push(t);
@@ -493,7 +280,7 @@ pub fn refit_nominal(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::physical::{ModeSpec, PoleAtZeroSpec};
+    use crate::model::physical::{EffectKind, Gains, ModeSpec, PoleAtZeroSpec};
 
     fn two_mass(k: f64, w: f64, z: f64, rho: f64, tau: f64) -> PhysicalModel {
         let mut e = crate::model::physical::EffectSpec::new(EffectKind::Delay);
@@ -543,7 +330,7 @@ mod tests {
 
     #[test]
     fn bounds_hold_and_the_cost_never_rises() {
-        // The true mode is 3× the start: ω_n may move only to 1.25×.
+        // The true mode is 3× the start: ω_n may move only to 1.3×.
         let truth = two_mass(100.0, 1440.0, 0.02, 100.0, 1.0e-4);
         let start = two_mass(100.0, 480.0, 0.02, 100.0, 1.0e-4);
         let omega: Vec<f64> = (11..=250)
@@ -553,7 +340,7 @@ mod tests {
         let radius: Vec<f64> = g.iter().map(|x| 0.01 * x.norm()).collect();
         let r = refit_nominal(&start, &omega, &g, &radius);
         assert!(r.v_after <= r.v_before);
-        assert!(r.model.mode[0].omega_n <= 480.0 * 1.25 * (1.0 + 1e-12));
+        assert!(r.model.mode[0].omega_n <= 480.0 * MODE_BOX * (1.0 + 1e-12));
         assert!(r.model.mode[0].zeta >= 1e-4 && r.model.mode[0].zeta <= 0.7);
     }
 }

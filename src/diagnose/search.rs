@@ -13,15 +13,22 @@
 //!   reach it), the `beam` lowest `BIC = 2V + n_θ·ln(2F)` kept.
 //! * **Stop** at the first level with a consistent node (fewest effects that explain the
 //!   data), when no child passes, or after `max_effects` levels. The chosen set is the best
-//!   consistent node of that level, else the lowest BIC of all; the other nodes are its
-//!   runner-ups, those within 6 of its BIC are ties.
+//!   consistent node of that level, else the lowest BIC of all; among the nodes within 6 of
+//!   that BIC (a tie: the data do not choose) the one with the fewest parameters, then the
+//!   catalogue's prior order ([`prior`]: a delay before a ZOH before an NMP zero). The other
+//!   nodes are its runner-ups, those within 6 of its BIC are ties.
+//! * **Consistency** of a node is judged on its consistency polish ([`settle`]): a
+//!   least-squares fit within the noise in rms, with a few data just outside their disks, is
+//!   moved inside its own 95 % confidence region towards the disks.  The BIC stays that of
+//!   the least-squares fit.
 
 use super::candidates::Cand;
 use super::channels::Channels;
+use super::polish::settle;
 use super::problem::{Measures, Problem};
-use super::rank::{candidate_list, si_map, Screened, MIN_DELTA_BIC};
+use super::rank::{candidate_list, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC};
 use super::report::Step;
-use super::retune::{retune, ADDED_NOTE};
+use super::retune::{retune, retune_within, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 
@@ -50,8 +57,10 @@ pub struct Node {
     pub effects: Vec<(Cand, Vec<f64>)>,
     /// The jointly refit model.
     pub model: PhysicalModel,
-    /// Its measures.
+    /// Its measures (of the polished model when the polish made it consistent).
     pub measures: Measures,
+    /// Cost `V` of the least-squares fit (the BIC's; the polish may raise `measures.v`).
+    pub v_fit: f64,
     /// Number of parameters of the model (configured and added).
     pub n_params: usize,
     /// `2V + n_θ ln(2F)`.
@@ -110,22 +119,25 @@ fn bic(v: f64, n: usize, data: &Channels) -> f64 {
 pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     let r = retune(base, data, None, true);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
-    let measures = Problem::new(&r.model, data)?.measures(&Default::default());
+    let v_fit = r.v_after;
+    let (model, measures) = settle(r.model, base, data)?;
     Ok([
         Node {
             effects: vec![],
             bic: bic(m0.v, r.n_params, data),
             model: base.clone(),
             measures: m0,
+            v_fit: m0.v,
             n_params: r.n_params,
             steps: vec![],
             configured: true,
         },
         Node {
             effects: vec![],
-            bic: bic(measures.v, r.n_params, data),
-            model: r.model,
+            bic: bic(v_fit, r.n_params, data),
+            model,
             measures,
+            v_fit,
             n_params: r.n_params,
             steps: vec![],
             configured: false,
@@ -137,6 +149,8 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
 pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchResult> {
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut level: Vec<usize> = (0..roots.len()).collect();
+    // The configured model: the anchor of every refit's boxes.
+    let anchor = roots[0].model.clone();
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let (mut expanded, mut joint_refits) = (0, 0);
@@ -163,17 +177,18 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
                 if promising && tried <= s.beam {
                     tried += 1;
                     let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                    let r = retune(&added, data, None, node.configured);
+                    let r = retune_within(&added, &anchor, data, None, node.configured);
                     joint_refits += 1;
-                    let m = Problem::new(&r.model, data)?.measures(&Default::default());
+                    let v_fit = r.v_after;
+                    let (model, m) = settle(r.model, &anchor, data)?;
                     let n_new = sc.cand.n_params(data.n_ch());
                     // Against the best of the node and (for the configured model) its retune.
                     let ref_v = if node.configured {
-                        nodes[1].measures.v.min(node.measures.v)
+                        nodes[1].v_fit.min(node.v_fit)
                     } else {
-                        node.measures.v
+                        node.v_fit
                     };
-                    let d_bic = 2.0 * (ref_v - m.v) - n_new as f64 * ln2f;
+                    let d_bic = 2.0 * (ref_v - v_fit) - n_new as f64 * ln2f;
                     if d_bic > MIN_DELTA_BIC && m.invalid_fraction <= node.measures.invalid_fraction
                     {
                         let mut effects = node.effects.clone();
@@ -200,9 +215,10 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
                         });
                         let child = Node {
                             effects,
-                            bic: bic(m.v, r.n_params, data),
-                            model: r.model,
+                            bic: bic(v_fit, r.n_params, data),
+                            model,
                             measures: m,
+                            v_fit,
                             n_params: r.n_params,
                             steps,
                             configured: false,
@@ -233,12 +249,35 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
         .filter(|n| n.measures.consistent())
         .map(|n| n.effects.len())
         .min();
-    let chosen = (0..nodes.len())
+    let eligible: Vec<usize> = (0..nodes.len())
         .filter(|i| {
             consistent_depth
                 .is_none_or(|d| nodes[*i].effects.len() == d && nodes[*i].measures.consistent())
         })
-        .min_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic))
+        .collect();
+    // Within a BIC tie of the best, the data do not choose: fewer parameters, then the
+    // catalogue's prior order (a delay before a ZOH before an NMP zero) decide, and the tie
+    // is reported.
+    let best_bic = eligible
+        .iter()
+        .map(|i| nodes[*i].bic)
+        .fold(f64::INFINITY, f64::min);
+    let chosen = eligible
+        .iter()
+        .copied()
+        .filter(|i| nodes[*i].bic - best_bic < TIE_BIC)
+        .min_by(|a, b| {
+            let key = |i: usize| {
+                let n = &nodes[i];
+                (
+                    n.n_params,
+                    n.effects.iter().map(|e| prior(&e.0)).sum::<usize>(),
+                )
+            };
+            key(*a)
+                .cmp(&key(*b))
+                .then(nodes[*a].bic.total_cmp(&nodes[*b].bic))
+        })
         .unwrap_or(0);
     Ok(SearchResult {
         nodes,
