@@ -250,7 +250,7 @@ fn robot_special_factorization_margins_match_a_dense_grid_and_the_fitted_r_buys_
         assert!(row.2 >= row.1 * (1.0 - 1e-9), "{row:?}");
     }
     let (alpha_conf, alpha_fit) = (m[0].1, m[1].1);
-    // Reference values (python/numpy, the same formula on 20 000 points): 0.023707 and 5.88.
+    // Reference values (python/numpy, the same formula on 20 000 points): 0.023707 for the paper's r.
     assert!((alpha_conf - 0.023707).abs() < 1e-5, "{alpha_conf}");
     assert!(!rep["margins"][0]["robust"].as_bool().unwrap());
     assert!(rep["margins"][1]["robust"].as_bool().unwrap());
@@ -266,7 +266,7 @@ fn robot_special_factorization_margins_match_a_dense_grid_and_the_fitted_r_buys_
     assert!(text.contains("what the tighter r buys"), "{text}");
 
     // A configured r above the fitted one at every frequency (high-frequency gain 0.01 >
-    // the fitted r's 0.0086, checked on the dense grid and at ∞): α*_fitted ≥ α*_configured.
+    // the fitted r's 0.0085, checked on the dense grid and at ∞): α*_fitted ≥ α*_configured.
     let cfg_text = std::fs::read_to_string(repo("configs/robot.toml"))
         .unwrap()
         .replace("num = [5e-4, 75.0]", "num = [0.01, 75.0]")
