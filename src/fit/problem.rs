@@ -193,6 +193,8 @@ pub(crate) fn initial_points(grid: &[GridPoint], target: usize) -> Vec<bool> {
 /// working set of rows; rows violated by its solution are added (the local maxima of the
 /// violation along each group, and the worst ones) until none is violated, so the solution
 /// is optimal for the full LP.  With 1000 data the working set stays a few hundred rows.
+/// `retry_iter` caps the interior-point iterations of the retry with every row (see
+/// below), `max_iter` those of the working-set solves.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn active_set_solve(
     n: usize,
@@ -204,6 +206,7 @@ pub(crate) fn active_set_solve(
     init: &[bool],
     mask: &mut Vec<bool>,
     max_iter: u32,
+    retry_iter: u32,
 ) -> (LpOut, usize) {
     if mask.len() != rows.len() {
         // Rows of the initial points; the floor rows of B only at every fourth of them.
@@ -229,7 +232,7 @@ pub(crate) fn active_set_solve(
             ge,
             eq: eq.to_vec(),
         };
-        let out = lp.solve(max_iter);
+        let out = lp.solve(if all { retry_iter } else { max_iter });
         if !out.status.has_solution() || rounds > 40 {
             // A working set can leave the objective unbounded or the LP ill-posed: retry
             // once with every row before reporting the status.  An infeasible working set
@@ -350,6 +353,7 @@ pub(crate) fn max_slack(
         init,
         mask,
         max_iter,
+        max_iter,
     );
     if !out.status.has_solution() {
         return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
@@ -402,7 +406,18 @@ pub(crate) fn area_fixed_poles(
             }
         }
     }
-    let (out, rounds) = active_set_solve(k, &c, &rows, &group, &point, &[], init, mask, max_iter);
+    let (out, rounds) = active_set_solve(
+        k,
+        &c,
+        &rows,
+        &group,
+        &point,
+        &[],
+        init,
+        mask,
+        max_iter,
+        max_iter,
+    );
     if !out.status.has_solution() {
         return (out.status, vec![], f64::INFINITY, rounds);
     }
