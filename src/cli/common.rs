@@ -34,6 +34,15 @@ pub struct Inputs {
 }
 
 impl InputArgs {
+    /// The files this input reads: the config, `--data` and the data file the config names
+    /// (an output the subcommand writes may not be one of them, [`check_out_file`]).
+    pub fn files(&self) -> Vec<PathBuf> {
+        let mut files = vec![self.config.clone()];
+        files.extend(self.data.clone());
+        files.extend(config_data(&self.config));
+        files
+    }
+
     /// Loads the config and the data (from `--data` or the config).
     pub fn load(&self) -> Result<Inputs> {
         let config = Config::load(&self.config)?;
@@ -190,7 +199,7 @@ pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result
 pub fn check_out_file(
     flag: &str,
     path: &std::path::Path,
-    inputs: &[&std::path::Path],
+    inputs: &[impl AsRef<std::path::Path>],
 ) -> Result<()> {
     if path.is_dir() {
         return Err(anyhow!(
@@ -199,7 +208,7 @@ pub fn check_out_file(
         ));
     }
     if let Ok(p) = path.canonicalize() {
-        for input in inputs {
+        for input in inputs.iter().map(|i| i.as_ref()) {
             if input.canonicalize().is_ok_and(|i| i == p) {
                 return Err(anyhow!(
                     "{flag} {}: is the input {}; writing there would destroy it: choose a new file name",

@@ -84,14 +84,8 @@ pub fn fmt_bands(b: &[Band]) -> String {
 /// Runs `rshape compare`.
 pub fn run(a: &CompareArgs) -> Result<i32> {
     if let Some(svg) = &a.svg {
-        let own = super::common::config_data(&a.input.config);
-        let inputs = [
-            Some(a.input.config.as_path()),
-            a.input.data.as_deref(),
-            a.against.as_deref(),
-            own.as_deref(),
-        ];
-        let inputs: Vec<&std::path::Path> = inputs.into_iter().flatten().collect();
+        let mut inputs = a.input.files();
+        inputs.extend(a.against.clone());
         super::common::check_out_file("--svg", svg, &inputs)?;
     }
     let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?)?;

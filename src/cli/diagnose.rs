@@ -83,14 +83,7 @@ fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     if let Some(w) = &a.write {
-        let own = super::common::config_data(&a.input.config);
-        let inputs = [
-            Some(a.input.config.as_path()),
-            a.input.data.as_deref(),
-            own.as_deref(),
-        ];
-        let inputs: Vec<&Path> = inputs.into_iter().flatten().collect();
-        super::common::check_out_file("--write", w, &inputs)?;
+        super::common::check_out_file("--write", w, &a.input.files())?;
     }
     let loaded = a.input.load()?;
     // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,

@@ -52,14 +52,13 @@ pub struct Revision {
 /// Runs `rshape history`.
 pub fn run(a: &HistoryArgs) -> Result<i32> {
     if let Some(svg) = &a.svg {
-        let own: Vec<PathBuf> = a
-            .configs
-            .iter()
-            .filter_map(|c| super::common::config_data(c))
-            .collect();
-        let mut inputs: Vec<&std::path::Path> = a.configs.iter().map(|c| c.as_path()).collect();
-        inputs.extend(a.data.as_deref());
-        inputs.extend(own.iter().map(|p| p.as_path()));
+        let mut inputs = a.configs.clone();
+        inputs.extend(a.data.clone());
+        inputs.extend(
+            a.configs
+                .iter()
+                .filter_map(|c| super::common::config_data(c)),
+        );
         super::common::check_out_file("--svg", svg, &inputs)?;
     }
     let ch = channel_arg(&a.channel)?;

@@ -85,28 +85,31 @@ pub fn eigenvalues(a: &DMatrix<f64>, what: &str) -> Result<Vec<Complex64>> {
     // Failing that, the same on exact similarities of `A` (a diagonal balancing by powers
     // of two, then a fixed Householder reflection): the eigenvalues are the same, the
     // iteration's path is not.
-    let balanced = apply_balancing(a, &balancing(a));
-    let reflected = {
-        let n = a.nrows();
-        let v = nalgebra::DVector::from_fn(n, |i, _| {
-            ((i as f64 + 1.0) * 0.754_877_666_246_692_7).fract() - 0.5
-        });
-        let v = &v / v.norm();
-        let h = DMatrix::identity(n, n) - (&v * v.transpose()) * 2.0;
-        &h * &balanced * &h
+    // The similarities are built only when the plain attempt fails (this is on the H∞
+    // iteration's path, where a large Hamiltonian's extra products would cost every call).
+    let schur_of = |m: &DMatrix<f64>| {
+        DEFLATION_ULPS.iter().find_map(|ulps| {
+            nalgebra::linalg::Schur::try_new(m.clone(), ulps * f64::EPSILON, MAX_SWEEPS)
+        })
     };
-    for m in [a, &balanced, &reflected] {
-        for ulps in DEFLATION_ULPS {
-            if let Some(schur) =
-                nalgebra::linalg::Schur::try_new(m.clone(), ulps * f64::EPSILON, MAX_SWEEPS)
-            {
-                return Ok(schur.complex_eigenvalues().iter().copied().collect());
-            }
-        }
-    }
-    Err(Error::Invalid(format!(
-        "{what}: the eigenvalue (Schur) iteration did not converge in {MAX_SWEEPS} sweeps"
-    )))
+    let schur = schur_of(a).or_else(|| {
+        let balanced = apply_balancing(a, &balancing(a));
+        schur_of(&balanced).or_else(|| {
+            let n = a.nrows();
+            let v = nalgebra::DVector::from_fn(n, |i, _| {
+                ((i as f64 + 1.0) * 0.754_877_666_246_692_7).fract() - 0.5
+            });
+            let v = &v / v.norm();
+            let h = DMatrix::identity(n, n) - (&v * v.transpose()) * 2.0;
+            schur_of(&(&h * &balanced * &h))
+        })
+    });
+    let schur = schur.ok_or_else(|| {
+        Error::Invalid(format!(
+            "{what}: the eigenvalue (Schur) iteration did not converge in {MAX_SWEEPS} sweeps"
+        ))
+    })?;
+    Ok(schur.complex_eigenvalues().iter().copied().collect())
 }
 
 /// Deflation tolerances tried in turn, in units of `f64::EPSILON`.
