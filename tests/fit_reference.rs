@@ -272,19 +272,31 @@ fn envelope(k: usize) -> (Vec<f64>, Vec<f64>) {
 
 /// Every order 1–8 on all 30 envelopes (240 pairs): rshape's certified level is within
 /// 0.01 decade of the reference's wherever the reference reaches a unit, and a fixed order
-/// `N + 1` (fitted alone, not chained) is never worse than order `N`.  Run with
+/// `N + 1` fitted alone (not chained) is never worse than order `N` by more than the
+/// tolerance the fit is solved to (see [`alone_tolerance`]; chained orders are exactly
+/// monotone, tested below).  Run with
 /// `cargo test --release --test fit_reference -- --ignored --nocapture` to see the table.
 #[test]
-#[ignore = "3-6 min in release; issue 11 defect 3 partly open: a few of 240 pairs above the reference by more than 0.01 decade and fixed orders alone not always monotone (figures in README)"]
+#[ignore = "about 3 min in release, too long for CI at the test profile; the CI subset below holds the pairs that failed before"]
 fn rshape_reaches_the_reference_optimum_at_every_order() {
     let pairs: Vec<(usize, usize)> = (0..30).flat_map(|k| (1..=8).map(move |n| (k, n))).collect();
     sweep(&pairs, 200);
 }
 
+/// How much worse order `N + 1` alone may end than order `N` alone: each order's minimax
+/// level is found by bisection to `bisection_tol` (relative, on `|r|`), and the ranking
+/// then prefers the smallest mean among candidates within that much of the best maximum
+/// (src/fit/engine.rs), so two independent searches can each stop anywhere within
+/// `2·log10(1 + bisection_tol)` (0.0017 decade by default) of the same optimum.
+fn alone_tolerance(set: &FitSettings) -> f64 {
+    2.0 * (1.0 + set.bisection_tol).log10()
+}
+
 /// The part of the sweep that runs in CI: the pairs that failed before the disk-map
 /// centres and the positivity cuts of `src/fit/polyfit.rs` (rising envelopes 11, 19, 27 at
-/// orders 2–3, up to 0.94 decade; envelope 3 at order 3), and smooth, jagged and noisy
-/// envelopes of 1–7 decades (sized for CI: about 20 s with the test below at opt-level 1).
+/// orders 2–3, up to 0.94 decade; envelope 3 at order 3), the three that stayed above the
+/// reference before the relative cuts and the band-end centres (13/o4 +0.017, 27/o4
+/// +0.011, 27/o5 +0.014 decade), and smooth, jagged and noisy envelopes of 1–7 decades.
 #[test]
 fn rshape_reaches_the_reference_optimum_on_a_subset() {
     let pairs = [
@@ -296,8 +308,11 @@ fn rshape_reaches_the_reference_optimum_on_a_subset() {
         (1, 4),
         (12, 5),
         (16, 2),
+        (13, 4),
+        (27, 4),
+        (27, 5),
     ];
-    sweep(&pairs, 8);
+    sweep(&pairs, 11);
 }
 
 fn sweep(list: &[(usize, usize)], min_pairs: usize) {
@@ -324,7 +339,7 @@ fn sweep(list: &[(usize, usize)], min_pairs: usize) {
         assert!(fit.certificate.passed, "envelope {k}, order {order}");
         let ours = fit.certificate.max_log10_ratio;
         if let Some(((pk, pn), prev)) = levels.last() {
-            if *pk == k && *pn + 1 == order && ours > prev + 1e-9 {
+            if *pk == k && *pn + 1 == order && ours > prev + alone_tolerance(&set) {
                 failures.push(format!(
                     "envelope {k}: order {order} ({ours:.6}) worse than order {pn} ({prev:.6})"
                 ));

@@ -179,6 +179,80 @@ fn cut_rows(
     cuts.rows.len() > before
 }
 
+/// Relative accuracy demanded of the lower bounds and A1 at the grid (see [`relative_cuts`]).
+const REL_TOL: f64 = 1e-7;
+
+/// Rows within this fraction of their bound are rescaled too when any row misses it
+/// relatively, so that the next solution does not simply move the miss to the neighbours
+/// (measured on 7-decade envelopes: rescaling the violated rows alone took more than the 8
+/// rounds of [`CUT_ROUNDS`] at one level, one or two neighbours at a time).
+const NEAR: f64 = 0.1;
+
+/// Relative cuts for a solution `(a, b)` that meets the lower bounds and A1 on the grid
+/// only to the LP's absolute tolerance.  Where `A` and `B` are tiny (far from the centre of
+/// the disk map, a rising or falling `|r|` over many decades) a row met to 1e-8 can leave
+/// `A/B` far below its bound: on 7-decade envelopes of the reference sweep `A/B` was
+/// 0.001–0.8 of the lower bound, so the level "proved" was not reachable by a unit and the
+/// search stopped up to 0.017 decade above the reference fitter's optimum.  When a row
+/// misses its bound by more than [`REL_TOL`] relative, every row within [`NEAR`] of its
+/// bound is added again, divided by the solution's own magnitude there (`|A(u)| + c·|B(u)|`)
+/// instead of by its largest coefficient, so that the LP's tolerance becomes relative to the
+/// values it bounds.  The rows are the bounds themselves (valid at every level); a point
+/// already rescaled is not added twice.  Returns whether any cut was added.
+fn relative_cuts(n: usize, x: &[f64], grid: &[GridPoint], x0: f64, cuts: &mut Rows) -> bool {
+    const LOWER: u32 = 7;
+    const A1: u32 = 8;
+    let k = n + 1;
+    let (a, b) = (&x[..k], &x[k..2 * k]);
+    // (group, slack l·B − A or A − α·B, magnitude) per point and bound.
+    let at = |g: &GridPoint| {
+        let u = disk(g.x, x0);
+        let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
+        let lower = (g.lower > 0.0).then(|| {
+            (
+                LOWER,
+                g.lower * bv - av,
+                av.abs() + g.lower * bv.abs(),
+                1.0,
+                -g.lower,
+            )
+        });
+        let a1 =
+            g.a1.map(|al| (A1, av - al * bv, av.abs() + al * bv.abs(), -1.0, al));
+        (u, [lower, a1])
+    };
+    let missed = grid.iter().any(|g| {
+        at(g)
+            .1
+            .iter()
+            .flatten()
+            .any(|(_, slack, mag, _, _)| !(*slack <= REL_TOL * mag))
+    });
+    if !missed {
+        return false;
+    }
+    let done: std::collections::HashSet<(u32, usize)> = cuts
+        .group
+        .iter()
+        .zip(&cuts.point)
+        .map(|(g, p)| (*g, *p))
+        .collect();
+    let before = cuts.rows.len();
+    for (i, g) in grid.iter().enumerate() {
+        let (u, bounds) = at(g);
+        for (group, slack, mag, ca, cb) in bounds.into_iter().flatten() {
+            if !(slack > -NEAR * mag && mag > 0.0) || done.contains(&(group, i)) {
+                continue;
+            }
+            let row: Vec<f64> = ab_row(n, u, ca, cb).iter().map(|v| v / mag).collect();
+            cuts.rows.push((row, 0.0));
+            cuts.group.push(group);
+            cuts.point.push(i);
+        }
+    }
+    cuts.rows.len() > before
+}
+
 /// Largest violation `rhs − row·x` over normalized rows.
 fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
     let scale = 1.0 + x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -189,8 +263,10 @@ fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
 }
 
 /// Disk-map centres tried, in scaled `x`: the band centre, then — only when the search at
-/// the previous attempt had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`).
-/// The Chebyshev series of `A` and `B` are well scaled only
+/// the previous attempt had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`)
+/// and the two ends of the band (`x₀ = ω̂_hi²` and `1/ω̂_hi²`; the reference sweep's rising
+/// envelopes 27 at orders 3–5 reach the reference optimum only there, envelopes 5 and 20
+/// at orders 4–6 only at the quarter points).  The Chebyshev series of `A` and `B` are well scaled only
 /// near their centre: with all roots at one end of a wide band (a rising envelope: zeros at
 /// its top, poles above it) the centred series are tiny there and the LP's tolerance hides
 /// their sign, so the level it proves is not reachable by a unit; an off-centre map keeps
@@ -200,7 +276,8 @@ fn centres(prep: &Prepared) -> Vec<f64> {
     if w_hi < 1.5 {
         vec![1.0]
     } else {
-        vec![1.0, w_hi, 1.0 / w_hi]
+        let x_hi = w_hi * w_hi;
+        vec![1.0, w_hi, 1.0 / w_hi, x_hi, 1.0 / x_hi]
     }
 }
 
@@ -308,6 +385,17 @@ fn minimax_at(
             // Only a full-accuracy certificate of infeasibility decides the level; a
             // reduced-accuracy one is a doubt like any other status below.
             if out.status == SolverStatus::PrimalInfeasible {
+                // The cuts `B ≥ b_cut` are stricter than `B > 0`: with one of them in the
+                // LP, infeasible proves nothing about the level, and another attempt
+                // (another centre or cut floor) must decide it.
+                if cuts.group.contains(&4) {
+                    events.push(SolverEvent {
+                        order: n,
+                        stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
+                        status: out.status,
+                        action: "infeasible with the positivity cuts on B; level treated as not feasible (the other candidates stand)".into(),
+                    });
+                }
                 return None;
             }
             // A reduced-accuracy or capped solve still proves the level when its point
@@ -326,7 +414,9 @@ fn minimax_at(
                 });
                 return None;
             }
-            if !cut_rows(n, &out.x, b_cut, floor, &data, set.root_iter_cap, &mut cuts) {
+            if !cut_rows(n, &out.x, b_cut, floor, &data, set.root_iter_cap, &mut cuts)
+                && !relative_cuts(n, &out.x, &prep.grid, x0, &mut cuts)
+            {
                 return Some(out.x);
             }
         }
