@@ -12,10 +12,9 @@
 //! run goes on with the others.
 
 use super::basis::{reference_poles, GridPoint, PointKind};
+use super::levelsearch::minimax_level;
 use super::polyfit;
-use super::problem::{
-    area_fixed_poles, basis_rows, initial_points, max_slack, SolverEvent, SolverStatus,
-};
+use super::problem::{area_fixed_poles, basis_rows, initial_points, SolverEvent, SolverStatus};
 use super::spectral::{stable_roots, RootKind, Zpk};
 use super::{FitSettings, Objective};
 use num_complex::Complex64;
@@ -115,27 +114,6 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
-/// The level `max A/(U·B)` over the data with a bound reached by `(A, B)`
-/// (`+∞` when `B ≤ 0` somewhere, which a feasible max-slack solution never has).
-fn achieved_level(phi: &[Vec<f64>], grid: &[GridPoint], a: &[f64], b: &[f64]) -> f64 {
-    let dot = |r: &[f64], c: &[f64]| r.iter().zip(c).map(|(x, y)| x * y).sum::<f64>();
-    let mut t = 0.0f64;
-    for (ph, g) in phi.iter().zip(grid) {
-        if let Some(u) = g.upper.filter(|_| g.kind == PointKind::Datum) {
-            let bv = dot(ph, b);
-            if !(bv > 0.0) {
-                return f64::INFINITY;
-            }
-            t = t.max(dot(ph, a) / (u * bv));
-        }
-    }
-    if t.is_nan() {
-        f64::INFINITY
-    } else {
-        t
-    }
-}
-
 /// Result of one order: the candidates (best first) and the solver events.
 pub(crate) struct OrderFit {
     pub ranked: Vec<Scored>,
@@ -162,138 +140,23 @@ pub(crate) fn fit_order(
         action: action.into(),
     };
 
-    // 1. Minimax: bracket the level t (from the previous order when known), then a
-    //    safeguarded (ITP) search on the max-slack s(ln t), see below.  The
-    //    max-slack solutions are centred: they keep away from the floor, so the poles and
-    //    zeros keep away from the axis (a Dinkelbach iteration, tried, converged to boundary
-    //    solutions with poles on the axis).
+    // 1. Minimax in the partial-fraction basis ([`super::levelsearch`]).
     let phi = basis_rows(&q, &prep.grid);
     let init = initial_points(&prep.grid, 40);
     // Working sets (per row) carried from order to order: the row layout depends only on
     // the grid, and the rows that bind at order N mostly bind at order N+1.
     let (mut mask, mut area_mask) = std::mem::take(masks);
-    let solve = |t: f64,
-                 stage: &str,
-                 events: &mut Vec<SolverEvent>,
-                 lp: &mut usize,
-                 mask: &mut Vec<bool>| {
-        let (st, s, a, b, rounds) =
-            max_slack(&phi, &prep.grid, t, &init, mask, set.max_solver_iter);
-        *lp += rounds;
-        if st != SolverStatus::Solved {
-            events.push(event(
-                format!("{stage} t={t:.4e}"),
-                st,
-                if st.has_solution() {
-                    "used the reduced-accuracy solution; verified below"
-                } else {
-                    "treated the level as not feasible"
-                },
-            ));
-        }
-        let s = if st.has_solution() {
-            s
-        } else {
-            f64::NEG_INFINITY
-        };
-        (s, a, b)
-    };
-    let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let mut lo = 0.0f64; // ln t ≥ 0: upper = lower at the data
-    let mut s_lo = None::<f64>;
-    let mut s_hi = 0.0;
-    let mut best: Option<(f64, Vec<f64>, Vec<f64>)> = None;
-    let mut t_hi = prev.map_or(10.0, |p| p.t.max(1.0) * (1.0 + 1e-9));
-    for _ in 0..12 {
-        let (s, a, b) = solve(
-            t_hi,
-            "minimax bracket",
-            &mut events,
-            &mut lp_solves,
-            &mut mask,
-        );
-        if s >= 0.0 {
-            best = Some((t_hi, a, b));
-            s_hi = s;
-            break;
-        }
-        lo = t_hi.ln();
-        s_lo = s.is_finite().then_some(s);
-        t_hi *= 100.0;
-    }
-    if let Some((t0, a0, b0)) = &best {
-        // ITP search (interpolate, truncate, project; Oliveira & Takahashi 2020) on the
-        // max-slack s(ln t), never more than one step beyond bisection.  The interpolation
-        // is Illinois false position, used only while the slack at the feasible end is
-        // well below its cap s ≤ 1: at higher orders s(ln t) is close to a step (a feasible
-        // level's slack is limited only by the cap) and false position crawled from the
-        // infeasible end, so those steps are bisections.  A feasible (A, B) at level t
-        // also meets every bound at its own level max A/(U·B) ≤ t: that level is feasible
-        // too and tightens the bracket.
-        let mut hi = t0.ln().min(achieved_level(&phi, &prep.grid, a0, b0).ln());
-        let eps = 0.5 * tol;
-        let w0 = hi - lo;
-        let n_max = (w0 / tol).log2().ceil().max(0.0) + 1.0;
-        let k1 = 0.2 / w0.max(tol);
-        let mut j = 0.0;
-        let mut side = 0i8; // Illinois: halve the value kept at a repeated end
-        let mut hi_raw = s_hi;
-        while hi - lo > tol {
-            let w = hi - lo;
-            let half = 0.5 * (lo + hi);
-            let r = (eps * (n_max - j).exp2() - 0.5 * w).max(0.0);
-            j += 1.0;
-            let mid = match s_lo {
-                Some(sl) if s_hi > sl && hi_raw < 0.9 => {
-                    // Aim a little above the estimate so that a good one closes the bracket.
-                    let xf = (lo - sl * w / (s_hi - sl) + 0.3 * tol).min(hi);
-                    let sigma = (half - xf).signum();
-                    let delta = k1 * w * w;
-                    let xt = if delta <= (half - xf).abs() {
-                        xf + sigma * delta
-                    } else {
-                        half
-                    };
-                    let x = if (xt - half).abs() <= r {
-                        xt
-                    } else {
-                        half - sigma * r
-                    };
-                    x.clamp(lo + 1e-3 * w, hi - 1e-3 * w)
-                }
-                _ => half,
-            };
-            let t = mid.exp();
-            let (s, a, b) = solve(t, "minimax", &mut events, &mut lp_solves, &mut mask);
-            if s >= 0.0 {
-                hi = mid.min(achieved_level(&phi, &prep.grid, &a, &b).ln());
-                s_hi = s;
-                hi_raw = s;
-                best = Some((t, a, b));
-                if side == 1 {
-                    s_lo = s_lo.map(|v| 0.5 * v);
-                }
-                side = 1;
-            } else {
-                lo = mid;
-                s_lo = s.is_finite().then_some(s);
-                if side == -1 {
-                    s_hi *= 0.5;
-                }
-                side = -1;
-            }
-        }
-    } else {
-        let blocking = blocking_families(&phi, &prep.grid, &init, set.max_solver_iter);
-        lp_solves += 4;
-        events.push(event(
-            "minimax".into(),
-            SolverStatus::PrimalInfeasible,
-            &format!(
-                "no feasible level up to t = 1e24; {blocking}; other candidates tried (the constant r among them)"
-            ),
-        ));
-    }
+    let best = minimax_level(
+        &phi,
+        &prep.grid,
+        &init,
+        &mut mask,
+        prev.map(|p| p.t),
+        n,
+        set,
+        &mut events,
+        &mut lp_solves,
+    );
 
     let mut pole_sets: Vec<(String, Vec<Complex64>)> = Vec::new();
     if let Some((t, a, b)) = &best {
@@ -482,53 +345,5 @@ pub(crate) fn fit_order(
         ranked: cands,
         events,
         lp_solves,
-    }
-}
-
-/// Drops one constraint family from a grid point.
-type Relax = fn(&mut GridPoint);
-
-/// When no level is feasible: which constraint family blocks it.  Each family is dropped in
-/// turn and the level `t = 1e24` tried again; the families whose removal makes it feasible
-/// are named (the data lower bounds, the no-dip bounds between data, the floor, A1).
-fn blocking_families(phi: &[Vec<f64>], grid: &[GridPoint], init: &[bool], max_iter: u32) -> String {
-    let families: [(&str, Relax); 4] = [
-        ("the lower bounds at the data", |g| {
-            if g.kind == PointKind::Datum {
-                g.lower = 0.0;
-            }
-        }),
-        ("the no-dip bounds between data", |g| {
-            if g.kind == PointKind::Band {
-                g.lower = 0.0;
-            }
-        }),
-        ("the floor outside the band and at 0 and infinity", |g| {
-            if matches!(g.kind, PointKind::Outside | PointKind::Infinity) {
-                g.lower = 0.0;
-            }
-        }),
-        ("A1 (|r| < sigma_min(M))", |g| g.a1 = None),
-    ];
-    let mut found = Vec::new();
-    for (name, drop) in families {
-        let relaxed: Vec<GridPoint> = grid
-            .iter()
-            .map(|g| {
-                let mut g = *g;
-                drop(&mut g);
-                g
-            })
-            .collect();
-        let mut mask = Vec::new();
-        let (st, s, _, _, _) = max_slack(phi, &relaxed, 1e24, init, &mut mask, max_iter);
-        if st.has_solution() && s >= 0.0 {
-            found.push(name);
-        }
-    }
-    if found.is_empty() {
-        "no single constraint family blocks it alone (dropping any one of data bounds, no-dip, floor, A1 does not help): the LP failed numerically or several families conflict".into()
-    } else {
-        format!("blocked by {} (feasible without it)", found.join(" / "))
     }
 }

@@ -18,51 +18,15 @@
 //! below the best candidate already found: when that is infeasible the other candidates
 //! are optimal to the bisection tolerance and no more LPs are spent.
 
-use super::basis::{GridPoint, PointKind};
+use super::basis::PointKind;
 use super::chebseries::{self, cheb};
 use super::engine::{Prepared, Scored};
+use super::polyrows::{
+    cut_rows, disk, fixed_rows, level_rows, max_violation, relative_cuts, Rows, B_CUTS, B_CUT_GROUP,
+};
 use super::problem::{active_set_solve, initial_points, SolverEvent, SolverStatus};
 use super::spectral::Zpk;
 use super::FitSettings;
-
-/// The disk variable of `x = ω̂²` centred at `x₀` (`−1` at `ω = 0`, `0` at `x₀`, `1` at
-/// infinity).
-fn disk(x: f64, x0: f64) -> f64 {
-    if x.is_infinite() {
-        1.0
-    } else {
-        (x - x0) / (x + x0)
-    }
-}
-
-/// Rows `row·v ≥ rhs` (variables `[a; b]`), their groups and grid points; the level rows
-/// (`A ≤ t·upper·B`) are appended by [`level_rows`], the positivity cuts by [`cut_rows`].
-struct Rows {
-    rows: Vec<(Vec<f64>, f64)>,
-    group: Vec<u32>,
-    point: Vec<usize>,
-}
-
-fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
-    let m = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    if m > 0.0 && m.is_finite() {
-        row.iter_mut().for_each(|v| *v /= m);
-    }
-    r.rows.push((row, rhs / m.max(f64::MIN_POSITIVE)));
-    r.group.push(g);
-    r.point.push(p);
-}
-
-/// Floor on `Σ b_k T_k(u)` at the grid (normalized to 1 at `x = x₀`).
-const B_MIN: f64 = 1e-14;
-
-/// Floors on `Σ b_k T_k(u)` at a positivity cut (the normalization is 1 at `x = x₀`), in
-/// the order tried.  1e-7 keeps the LP from hiding the sign again (about 1e-8 of tolerance
-/// on normalized rows) but excludes units whose `B` is legitimately that small far from
-/// `x₀`; 1e-11 admits them and relies on the exact test after each solve.  Measured on the
-/// reference sweep: each alone left 3–5 of 240 pairs above the reference (up to 0.02 and
-/// 0.26 decade respectively), and different ones.
-const B_CUTS: [f64; 2] = [1e-7, 1e-11];
 
 /// Interior-point iterations of the retry with every row after a working-set solve short
 /// of a solution.  Measured on the reference sweep of `tests/fit_reference.rs` (all
@@ -74,193 +38,6 @@ const RETRY_ITER: u32 = 100;
 
 /// Rounds of positivity cuts per level.
 const CUT_ROUNDS: usize = 8;
-
-/// A row `ca·A(u) + cb·B(u)`.
-fn ab_row(n: usize, u: f64, ca: f64, cb: f64) -> Vec<f64> {
-    let k = n + 1;
-    let t = cheb(n, u);
-    let mut v = vec![0.0; 2 * k];
-    for j in 0..k {
-        v[j] = ca * t[j];
-        v[k + j] = cb * t[j];
-    }
-    v
-}
-
-fn fixed_rows(n: usize, grid: &[GridPoint], x0: f64) -> Rows {
-    let mut r = Rows {
-        rows: Vec::new(),
-        group: Vec::new(),
-        point: Vec::new(),
-    };
-    for (i, g) in grid.iter().enumerate() {
-        let u = disk(g.x, x0);
-        if g.lower > 0.0 {
-            push(&mut r, ab_row(n, u, 1.0, -g.lower), 0.0, 0, i);
-        }
-        if let Some(a) = g.a1 {
-            push(&mut r, ab_row(n, u, -1.0, a), 0.0, 2, i);
-        }
-        push(&mut r, ab_row(n, u, 0.0, 1.0), B_MIN, 3, i);
-    }
-    r
-}
-
-fn level_rows(n: usize, grid: &[GridPoint], x0: f64, t: f64, base: &Rows, cuts: &Rows) -> Rows {
-    let mut r = Rows {
-        rows: base.rows.clone(),
-        group: base.group.clone(),
-        point: base.point.clone(),
-    };
-    for (i, g) in grid.iter().enumerate() {
-        if let Some(up) = g.upper.filter(|_| g.kind == PointKind::Datum) {
-            push(&mut r, ab_row(n, disk(g.x, x0), -1.0, t * up), 0.0, 1, i);
-        }
-    }
-    r.rows.extend(cuts.rows.iter().cloned());
-    r.group.extend(&cuts.group);
-    r.point.extend(&cuts.point);
-    // Sort by (group, point) so that neighbours along a group are adjacent for the
-    // working-set rule.
-    let mut idx: Vec<usize> = (0..r.rows.len()).collect();
-    idx.sort_by_key(|&i| (r.group[i], r.point[i]));
-    Rows {
-        rows: idx.iter().map(|&i| r.rows[i].clone()).collect(),
-        group: idx.iter().map(|&i| r.group[i]).collect(),
-        point: idx.iter().map(|&i| r.point[i]).collect(),
-    }
-}
-
-/// Positivity cuts for a solution `(a, b)` of the LP on the grid: `B ≥ b_cut` and
-/// `A ≥ floor·B` at each point of `[−1, 1]` where they fail between grid points (found
-/// exactly by [`chebseries::below`]).  Both must hold on all of `[−1, 1]` (`x ∈ [0, ∞]`) for
-/// the spectral factors to exist (Youla; Boulet & Francis 1998, §3): the grid alone cannot
-/// see a sign change of `B` far above the band, where the disk form of a rising `|r|` is
-/// tiny.  Returns whether any cut was added.
-fn cut_rows(
-    n: usize,
-    x: &[f64],
-    b_cut: f64,
-    floor: f64,
-    data: &[(f64, f64)],
-    cap: usize,
-    cuts: &mut Rows,
-) -> bool {
-    let k = n + 1;
-    let (a, b) = (&x[..k], &x[k..2 * k]);
-    let before = cuts.rows.len();
-    // No dip between data: `A ≥ min(l_i, l_{i+1})·B` on each interval.  A dip narrower than
-    // the grid spacing sits at a zero pair of `A` close to the axis, so only the intervals
-    // holding the real part of such a root are tested (exactly, on the interval).
-    if let Some((za, _)) = chebseries::roots(a, cap) {
-        for z in za {
-            if z.im.abs() > 0.05 || !(z.re > -1.0 && z.re < 1.0) {
-                continue;
-            }
-            let j = data.partition_point(|(u, _)| *u <= z.re);
-            if j == 0 || j == data.len() {
-                continue;
-            }
-            let ((lo, l0), (hi, l1)) = (data[j - 1], data[j]);
-            let l = l0.min(l1);
-            let c: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - l * q).collect();
-            for u in chebseries::below_on(&c, lo, hi, 0.0, cap) {
-                push(cuts, ab_row(n, u, 1.0, -l), 0.0, 6, usize::MAX);
-            }
-        }
-    }
-    for u in chebseries::below(b, 0.1 * b_cut, cap) {
-        push(cuts, ab_row(n, u, 0.0, 1.0), b_cut, 4, usize::MAX);
-    }
-    let af: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - floor * q).collect();
-    for u in chebseries::below(&af, 0.0, cap) {
-        push(cuts, ab_row(n, u, 1.0, -floor), 0.0, 5, usize::MAX);
-    }
-    cuts.rows.len() > before
-}
-
-/// Relative accuracy demanded of the lower bounds and A1 at the grid (see [`relative_cuts`]).
-const REL_TOL: f64 = 1e-7;
-
-/// Rows within this fraction of their bound are rescaled too when any row misses it
-/// relatively, so that the next solution does not simply move the miss to the neighbours
-/// (measured on 7-decade envelopes: rescaling the violated rows alone took more than the 8
-/// rounds of [`CUT_ROUNDS`] at one level, one or two neighbours at a time).
-const NEAR: f64 = 0.1;
-
-/// Relative cuts for a solution `(a, b)` that meets the lower bounds and A1 on the grid
-/// only to the LP's absolute tolerance.  Where `A` and `B` are tiny (far from the centre of
-/// the disk map, a rising or falling `|r|` over many decades) a row met to 1e-8 can leave
-/// `A/B` far below its bound: on 7-decade envelopes of the reference sweep `A/B` was
-/// 0.001–0.8 of the lower bound, so the level "proved" was not reachable by a unit and the
-/// search stopped up to 0.017 decade above the reference fitter's optimum.  When a row
-/// misses its bound by more than [`REL_TOL`] relative, every row within [`NEAR`] of its
-/// bound is added again, divided by the solution's own magnitude there (`|A(u)| + c·|B(u)|`)
-/// instead of by its largest coefficient, so that the LP's tolerance becomes relative to the
-/// values it bounds.  The rows are the bounds themselves (valid at every level); a point
-/// already rescaled is not added twice.  Returns whether any cut was added.
-fn relative_cuts(n: usize, x: &[f64], grid: &[GridPoint], x0: f64, cuts: &mut Rows) -> bool {
-    const LOWER: u32 = 7;
-    const A1: u32 = 8;
-    let k = n + 1;
-    let (a, b) = (&x[..k], &x[k..2 * k]);
-    // (group, slack l·B − A or A − α·B, magnitude) per point and bound.
-    let at = |g: &GridPoint| {
-        let u = disk(g.x, x0);
-        let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
-        let lower = (g.lower > 0.0).then(|| {
-            (
-                LOWER,
-                g.lower * bv - av,
-                av.abs() + g.lower * bv.abs(),
-                1.0,
-                -g.lower,
-            )
-        });
-        let a1 =
-            g.a1.map(|al| (A1, av - al * bv, av.abs() + al * bv.abs(), -1.0, al));
-        (u, [lower, a1])
-    };
-    let missed = grid.iter().any(|g| {
-        at(g)
-            .1
-            .iter()
-            .flatten()
-            .any(|(_, slack, mag, _, _)| !(*slack <= REL_TOL * mag))
-    });
-    if !missed {
-        return false;
-    }
-    let done: std::collections::HashSet<(u32, usize)> = cuts
-        .group
-        .iter()
-        .zip(&cuts.point)
-        .map(|(g, p)| (*g, *p))
-        .collect();
-    let before = cuts.rows.len();
-    for (i, g) in grid.iter().enumerate() {
-        let (u, bounds) = at(g);
-        for (group, slack, mag, ca, cb) in bounds.into_iter().flatten() {
-            if !(slack > -NEAR * mag && mag > 0.0) || done.contains(&(group, i)) {
-                continue;
-            }
-            let row: Vec<f64> = ab_row(n, u, ca, cb).iter().map(|v| v / mag).collect();
-            cuts.rows.push((row, 0.0));
-            cuts.group.push(group);
-            cuts.point.push(i);
-        }
-    }
-    cuts.rows.len() > before
-}
-
-/// Largest violation `rhs − row·x` over normalized rows.
-fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
-    let scale = 1.0 + x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    rows.iter()
-        .map(|(r, h)| h - r.iter().zip(x).map(|(a, b)| a * b).sum::<f64>())
-        .fold(f64::NEG_INFINITY, f64::max)
-        / scale
-}
 
 /// Disk-map centres tried, in scaled `x`: the band centre, then — only when the search at
 /// the previous attempt had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`)
@@ -388,7 +165,7 @@ fn minimax_at(
                 // The cuts `B ≥ b_cut` are stricter than `B > 0`: with one of them in the
                 // LP, infeasible proves nothing about the level, and another attempt
                 // (another centre or cut floor) must decide it.
-                if cuts.group.contains(&4) {
+                if cuts.group.contains(&B_CUT_GROUP) {
                     events.push(SolverEvent {
                         order: n,
                         stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
