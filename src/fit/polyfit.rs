@@ -48,8 +48,8 @@ const CUT_ROUNDS: usize = 8;
 /// the previous attempt had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`)
 /// and the two ends of the band (`x₀ = ω̂_hi²` and `1/ω̂_hi²`; the reference sweep's rising
 /// envelopes 27 at orders 3–5 reach the reference optimum only there, envelopes 5 and 20
-/// at orders 4–6 only at the quarter points).  The Chebyshev series of `A` and `B` are well scaled only
-/// near their centre: with all roots at one end of a wide band (a rising envelope: zeros at
+/// at orders 4–6 only at the quarter points).  The Chebyshev series of `A` and `B` are
+/// well scaled only near their centre: with all roots at one end of a wide band (a rising envelope: zeros at
 /// its top, poles above it) the centred series are tiny there and the LP's tolerance hides
 /// their sign, so the level it proves is not reachable by a unit; an off-centre map keeps
 /// them of order one (measured on the reference sweep of `tests/fit_reference.rs`).

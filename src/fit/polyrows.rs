@@ -24,7 +24,7 @@ pub(super) struct Rows {
     pub(super) point: Vec<usize>,
 }
 
-pub(super) fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
+fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
     let m = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     if m > 0.0 && m.is_finite() {
         row.iter_mut().for_each(|v| *v /= m);
@@ -35,10 +35,20 @@ pub(super) fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) 
 }
 
 /// Floor on `Σ b_k T_k(u)` at the grid (normalized to 1 at `x = x₀`).
-pub(super) const B_MIN: f64 = 1e-14;
+const B_MIN: f64 = 1e-14;
 
+/// Row groups (the working set sorts rows by group, then grid point, so neighbours along a
+/// group are adjacent).
+const LOWER_GROUP: u32 = 0;
+const LEVEL_GROUP: u32 = 1;
+const A1_GROUP: u32 = 2;
+const B_FLOOR_GROUP: u32 = 3;
 /// The row group of the cuts `B ≥ b_cut` (stricter than `B > 0`, unlike every other row).
 pub(super) const B_CUT_GROUP: u32 = 4;
+const A_FLOOR_CUT_GROUP: u32 = 5;
+const NO_DIP_CUT_GROUP: u32 = 6;
+const LOWER_RELATIVE_GROUP: u32 = 7;
+const A1_RELATIVE_GROUP: u32 = 8;
 
 /// Floors on `Σ b_k T_k(u)` at a positivity cut (the normalization is 1 at `x = x₀`), in
 /// the order tried.  1e-7 keeps the LP from hiding the sign again (about 1e-8 of tolerance
@@ -49,7 +59,7 @@ pub(super) const B_CUT_GROUP: u32 = 4;
 pub(super) const B_CUTS: [f64; 2] = [1e-7, 1e-11];
 
 /// A row `ca·A(u) + cb·B(u)`.
-pub(super) fn ab_row(n: usize, u: f64, ca: f64, cb: f64) -> Vec<f64> {
+fn ab_row(n: usize, u: f64, ca: f64, cb: f64) -> Vec<f64> {
     let k = n + 1;
     let t = cheb(n, u);
     let mut v = vec![0.0; 2 * k];
@@ -69,12 +79,12 @@ pub(super) fn fixed_rows(n: usize, grid: &[GridPoint], x0: f64) -> Rows {
     for (i, g) in grid.iter().enumerate() {
         let u = disk(g.x, x0);
         if g.lower > 0.0 {
-            push(&mut r, ab_row(n, u, 1.0, -g.lower), 0.0, 0, i);
+            push(&mut r, ab_row(n, u, 1.0, -g.lower), 0.0, LOWER_GROUP, i);
         }
         if let Some(a) = g.a1 {
-            push(&mut r, ab_row(n, u, -1.0, a), 0.0, 2, i);
+            push(&mut r, ab_row(n, u, -1.0, a), 0.0, A1_GROUP, i);
         }
-        push(&mut r, ab_row(n, u, 0.0, 1.0), B_MIN, 3, i);
+        push(&mut r, ab_row(n, u, 0.0, 1.0), B_MIN, B_FLOOR_GROUP, i);
     }
     r
 }
@@ -94,7 +104,13 @@ pub(super) fn level_rows(
     };
     for (i, g) in grid.iter().enumerate() {
         if let Some(up) = g.upper.filter(|_| g.kind == PointKind::Datum) {
-            push(&mut r, ab_row(n, disk(g.x, x0), -1.0, t * up), 0.0, 1, i);
+            push(
+                &mut r,
+                ab_row(n, disk(g.x, x0), -1.0, t * up),
+                0.0,
+                LEVEL_GROUP,
+                i,
+            );
         }
     }
     r.rows.extend(cuts.rows.iter().cloned());
@@ -145,7 +161,13 @@ pub(super) fn cut_rows(
             let l = l0.min(l1);
             let c: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - l * q).collect();
             for u in chebseries::below_on(&c, lo, hi, 0.0, cap) {
-                push(cuts, ab_row(n, u, 1.0, -l), 0.0, 6, usize::MAX);
+                push(
+                    cuts,
+                    ab_row(n, u, 1.0, -l),
+                    0.0,
+                    NO_DIP_CUT_GROUP,
+                    usize::MAX,
+                );
             }
         }
     }
@@ -154,7 +176,13 @@ pub(super) fn cut_rows(
     }
     let af: Vec<f64> = a.iter().zip(b).map(|(p, q)| p - floor * q).collect();
     for u in chebseries::below(&af, 0.0, cap) {
-        push(cuts, ab_row(n, u, 1.0, -floor), 0.0, 5, usize::MAX);
+        push(
+            cuts,
+            ab_row(n, u, 1.0, -floor),
+            0.0,
+            A_FLOOR_CUT_GROUP,
+            usize::MAX,
+        );
     }
     cuts.rows.len() > before
 }
@@ -186,30 +214,28 @@ pub(super) fn relative_cuts(
     x0: f64,
     cuts: &mut Rows,
 ) -> bool {
-    const LOWER: u32 = 7;
-    const A1: u32 = 8;
     let k = n + 1;
     let (a, b) = (&x[..k], &x[k..2 * k]);
-    // (group, slack l·B − A or A − α·B, magnitude) per point and bound.
-    let at = |g: &GridPoint| {
-        let u = disk(g.x, x0);
-        let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
-        let lower = (g.lower > 0.0).then(|| {
-            (
-                LOWER,
-                g.lower * bv - av,
-                av.abs() + g.lower * bv.abs(),
-                1.0,
-                -g.lower,
-            )
-        });
-        let a1 =
-            g.a1.map(|al| (A1, av - al * bv, av.abs() + al * bv.abs(), -1.0, al));
-        (u, [lower, a1])
-    };
-    let missed = grid.iter().any(|g| {
-        at(g)
-            .1
+    // Per grid point: `u` and, per bound, (group, slack `l·B − A` or `A − α·B`, magnitude
+    // `|A| + c·|B|`, row coefficients of `A` and `B`), the series evaluated once.
+    let at: Vec<_> = grid
+        .iter()
+        .map(|g| {
+            let u = disk(g.x, x0);
+            let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
+            let lower = (g.lower > 0.0).then(|| {
+                let mag = av.abs() + g.lower * bv.abs();
+                (LOWER_RELATIVE_GROUP, g.lower * bv - av, mag, 1.0, -g.lower)
+            });
+            let a1 = g.a1.map(|al| {
+                let mag = av.abs() + al * bv.abs();
+                (A1_RELATIVE_GROUP, av - al * bv, mag, -1.0, al)
+            });
+            (u, [lower, a1])
+        })
+        .collect();
+    let missed = at.iter().any(|(_, bounds)| {
+        bounds
             .iter()
             .flatten()
             .any(|(_, slack, mag, _, _)| !(*slack <= REL_TOL * mag))
@@ -224,8 +250,7 @@ pub(super) fn relative_cuts(
         .map(|(g, p)| (*g, *p))
         .collect();
     let before = cuts.rows.len();
-    for (i, g) in grid.iter().enumerate() {
-        let (u, bounds) = at(g);
+    for (i, (u, bounds)) in at.into_iter().enumerate() {
         for (group, slack, mag, ca, cb) in bounds.into_iter().flatten() {
             if !(slack > -NEAR * mag && mag > 0.0) || done.contains(&(group, i)) {
                 continue;
