@@ -95,7 +95,9 @@ fn open_loop_batch_says_r() {
     for want in ["configured r explains", "max r_min = ", "fitted r covering"] {
         assert!(text.contains(want), "missing {want:?} in:\n{text}");
     }
-    assert!(!text.contains("V"), "{text}");
+    // The output folder is a random temporary name that may itself hold a `V`.
+    let words = text.replace(o.to_str().unwrap(), "<out>");
+    assert!(!words.contains("V"), "{text}");
     let batch: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(o.join("batch.json")).unwrap()).unwrap();
     assert_eq!(batch["closed_loop"], false);
