@@ -232,6 +232,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         fmt_g(d.retuned.misfit_rms),
         fmt_pct(d.retuned.invalid_fraction)
     );
+    print_changes(&d.retuned.moved, "the retune moved");
     if !d.candidates.is_empty() {
         println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, no more invalid data):");
         for c in &d.candidates {
@@ -298,6 +299,12 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
             println!("  {}: {}", e.effect, params_text(&e.params));
         }
     }
+    if !d.chosen.is_empty() {
+        print_changes(
+            &d.retuned_in_chosen,
+            "with the chosen set, the joint refit moved",
+        );
+    }
     for h in &d.holdout {
         println!(
             "holdout {}: interleaved {}{}",
@@ -353,6 +360,38 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         println!(
             "add candidate K with: rshape diagnose {} --apply K --write NEW.toml",
             config.path.display()
+        );
+    }
+}
+
+/// The configured parameters a refit moved, as a table (a common gain as one row).
+fn print_changes(c: &crate::diagnose::changes::Changes, what: &str) {
+    if c.changes.is_empty() {
+        return;
+    }
+    println!("  {what} (by more than 3σ):");
+    println!(
+        "    {:<28} {:>12} {:>12} {:>10}",
+        "parameter", "before", "after", "σ"
+    );
+    for ch in &c.changes {
+        println!(
+            "    {:<28} {:>12} {:>12} {:>10}",
+            if ch.parameter == "gain" {
+                "gain (common factor)".to_string()
+            } else {
+                ch.parameter.clone()
+            },
+            sig(ch.before),
+            sig(ch.after),
+            sig(ch.sigma)
+        );
+    }
+    if let Some(g) = &c.common_gain {
+        println!(
+            "    gain ×{}: one factor on {}",
+            sig(g.factor),
+            g.parameters.join(", ")
         );
     }
 }

@@ -20,6 +20,7 @@
 //!   consistency polish ([`super::polish`]).
 
 use super::candidates::{explain, sig};
+use super::changes::changes;
 use super::channels::Channels;
 use super::compare::{bands, Siso};
 use super::holdout::{holdouts, model_of};
@@ -29,7 +30,7 @@ use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
 use super::rank::{prior, si_map, MIN_DELTA_BIC, TIE_BIC};
 pub use super::report::{
-    CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, SearchStats, Tie,
+    CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, Retuned, SearchStats, Tie,
 };
 use super::retune::{retune_within, ADDED_NOTE};
 use super::search::{add_effect, roots, search, Settings};
@@ -147,7 +148,10 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             n_data: n,
             n_channels: data.n_ch(),
             before,
-            retuned: before,
+            retuned: Retuned {
+                measures: before,
+                moved: Default::default(),
+            },
             after: before,
             candidates: vec![],
             ties: vec![],
@@ -157,6 +161,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             holdout: vec![],
             dropped: vec![],
             final_effects: vec![],
+            retuned_in_chosen: Default::default(),
             cost_test: Some([n as f64, before.v]),
             search: mk_stats(0, 0),
             final_model: base.clone(),
@@ -165,6 +170,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     let [configured, retuned_node] = roots(base, data)?;
     let root_model = retuned_node.model.clone();
     let retuned = retuned_node.measures;
+    let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
     let res = search(vec![configured, retuned_node], data, s)?;
@@ -362,7 +368,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
     };
     let message = match verdict {
         "retuned" => format!(
-            "the configured model explains the data once its own parameters are refit (retune): misfit_rms {} → {}, invalid_fraction {} → {}; nothing added",
+            "the configured model explains the data once its own parameters are refit (retune{}): misfit_rms {} → {}, invalid_fraction {} → {}; nothing added",
+            if moved.changes.is_empty() {
+                String::new()
+            } else {
+                format!(": {}", moved.summary())
+            },
             sig(before.misfit_rms),
             sig(retuned.misfit_rms),
             fmt_pct(before.invalid_fraction),
@@ -389,7 +400,10 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         n_data: n,
         n_channels: data.n_ch(),
         before,
-        retuned,
+        retuned: Retuned {
+            measures: retuned,
+            moved,
+        },
         after,
         candidates,
         ties,
@@ -416,6 +430,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             }
             fe
         },
+        retuned_in_chosen: changes(base, &node.model, data),
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         search: mk_stats(res.expanded, res.joint_refits),
         final_model: node.model,

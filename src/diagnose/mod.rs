@@ -13,6 +13,7 @@ pub mod figures;
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
 pub mod agreement;
 pub mod candidates;
+pub mod changes;
 pub mod channels;
 pub mod engine;
 pub mod factor_form;

@@ -3,6 +3,7 @@
 //! the verdict (the JSON names of the `--json` output).
 
 use super::candidates::Cand;
+use super::changes::Changes;
 use super::compare::Band;
 use super::problem::Measures;
 use crate::model::physical::PhysicalModel;
@@ -174,8 +175,8 @@ pub struct Diagnosis {
     pub n_channels: usize,
     /// Measures of the model as given.
     pub before: Measures,
-    /// Measures after the retune (no effect added).
-    pub retuned: Measures,
+    /// Measures after the retune (no effect added), and the configured parameters it moved.
+    pub retuned: Retuned,
     /// Measures of the final model.
     pub after: Measures,
     /// First-level candidates (the retune and each effect on top of it), ranked (what
@@ -195,6 +196,8 @@ pub struct Diagnosis {
     pub dropped: Vec<String>,
     /// The added effects with their jointly refit parameters.
     pub final_effects: Vec<FinalEffect>,
+    /// The configured parameters the final joint refit (of the chosen set) moved.
+    pub retuned_in_chosen: Changes,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
     /// Search statistics.
@@ -202,4 +205,22 @@ pub struct Diagnosis {
     /// The final model (effects added, everything refit jointly).
     #[serde(skip)]
     pub final_model: PhysicalModel,
+}
+
+/// The retune: its measures and what it moved (`retuned.changes` in the JSON).
+#[derive(Debug, Clone, Serialize)]
+pub struct Retuned {
+    /// Error measures after the retune.
+    #[serde(flatten)]
+    pub measures: Measures,
+    /// The configured parameters it moved by more than 3σ.
+    #[serde(flatten)]
+    pub moved: Changes,
+}
+
+impl std::ops::Deref for Retuned {
+    type Target = Measures;
+    fn deref(&self) -> &Measures {
+        &self.measures
+    }
 }
