@@ -1,12 +1,12 @@
 //! `rshape diagnose CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--json]
-//! [--apply K --write NEW.toml]`.
+//! [--apply K|chosen [--force] --write NEW.toml]`.
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::plant_form::physical_from_config;
 use crate::diagnose::{
-    apply_candidate, diagnose_channels, misfit_channels, prepare, retune_within, Channels,
-    Diagnosis, Settings,
+    apply_candidate, apply_chosen, diagnose_channels, misfit_channels, prepare, retune_within,
+    Channels, Diagnosis, Settings,
 };
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
@@ -29,15 +29,40 @@ pub struct DiagnoseArgs {
     /// Effect sets kept per level of the search.
     #[arg(long, default_value_t = 3)]
     pub beam: usize,
-    /// Add the K-th ranked candidate (1-based) and write the revised config (with --write).
-    #[arg(long, requires = "write")]
-    pub apply: Option<usize>,
+    /// Write a revised config (with --write): `K` adds the K-th ranked candidate (1-based;
+    /// a candidate the tool rejected is refused unless --force), `chosen` the chosen effect
+    /// set, jointly refit, in one revision.
+    #[arg(long, requires = "write", value_parser = parse_apply, value_name = "K|chosen")]
+    pub apply: Option<Apply>,
+    /// With --apply K: write the candidate even though the tool rejected it.
+    #[arg(long, requires = "apply")]
+    pub force: bool,
     /// Where to write the revised config.
     #[arg(long, requires = "apply")]
     pub write: Option<PathBuf>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// What `--apply` writes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Apply {
+    /// The K-th ranked first-level candidate (1-based).
+    Rank(usize),
+    /// The chosen effect set.
+    Chosen,
+}
+
+fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
+    if s == "chosen" {
+        return Ok(Apply::Chosen);
+    }
+    s.parse::<usize>()
+        .ok()
+        .filter(|k| *k >= 1)
+        .map(Apply::Rank)
+        .ok_or_else(|| format!("`{s}`: give a candidate rank (1, 2, …) or `chosen`"))
 }
 
 fn rel_to(target: &Path, from_dir: &Path) -> PathBuf {
@@ -124,8 +149,8 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         beam: a.beam.max(1),
     };
     let d = diagnose_channels(&base, &data, &settings)?;
-    if let (Some(k), Some(out)) = (a.apply, &a.write) {
-        write_revision(a, config, &raw, &data, &d, &base, k, out)?;
+    if let (Some(what), Some(out)) = (a.apply, &a.write) {
+        write_revision(a, config, &raw, &data, &d, &base, what, out)?;
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
@@ -143,16 +168,46 @@ fn write_revision(
     data: &Channels,
     d: &Diagnosis,
     base: &crate::model::physical::PhysicalModel,
-    k: usize,
+    what: Apply,
     out: &Path,
 ) -> Result<()> {
-    // The candidate (already refit jointly when the search got to it), refit once more.
-    let applied = apply_candidate(base, d, k)?;
-    let revised = retune_within(&applied, base, data, None, false).model;
+    // What is written: the label, its parameters, the explanation and the error before.
+    let (revised, label, params, explanation, flag) = match what {
+        Apply::Rank(k) => {
+            // The candidate (already refit jointly when the search got to it), refit once more.
+            let applied = apply_candidate(base, d, k, a.force)?;
+            let c = &d.candidates[k - 1];
+            (
+                retune_within(&applied, base, data, None, false).model,
+                c.effect.clone(),
+                params_text(&c.params),
+                c.explanation.clone(),
+                format!("{k}{}", if a.force { " --force" } else { "" }),
+            )
+        }
+        Apply::Chosen => {
+            let m = apply_chosen(d)?;
+            let label = if d.chosen.is_empty() {
+                "retune".to_string()
+            } else {
+                d.chosen.join(" + ")
+            };
+            let params = d
+                .final_effects
+                .iter()
+                .map(|e| format!("{}: {}", e.effect, params_text(&e.params)))
+                .chain(
+                    (!d.retuned_in_chosen.changes.is_empty())
+                        .then(|| format!("retuned: {}", d.retuned_in_chosen.summary())),
+                )
+                .collect::<Vec<_>>()
+                .join("; ");
+            (m, label, params, d.message.clone(), "chosen".to_string())
+        }
+    };
     let (rms_refit, inv_refit) = misfit_channels(&revised, data);
     // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
     let mut raw = raw.clone();
-    let c = &d.candidates[k - 1];
     raw.physical = Some(revised);
     raw.model = None;
     // A converted [plant] or [closed_loop] nominal is now the [physical] table.
@@ -165,7 +220,7 @@ fn write_revision(
         raw.name
             .clone()
             .unwrap_or_else(|| config.path.display().to_string()),
-        c.effect
+        label
     ));
     let out_dir = out
         .parent()
@@ -181,15 +236,13 @@ fn write_revision(
     }
     let text = toml::to_string_pretty(&raw)?;
     let header = format!(
-        "# Revised by `rshape diagnose {} --apply {k}`: {} ({}), every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {}, invalid_fraction {} -> {}.\n",
+        "# Revised by `rshape diagnose {} --apply {flag}`: {label} ({params}), every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {}, invalid_fraction {} -> {}.\n",
         config.path.display(),
-        c.effect,
-        params_text(&c.params),
-        c.explanation,
+        explanation.replace('\n', " "),
         data.path.display(),
-        sig(c.misfit_rms_before),
+        sig(d.before.misfit_rms),
         sig(rms_refit),
-        fmt_pct(c.invalid_fraction_before),
+        fmt_pct(d.before.invalid_fraction),
         fmt_pct(inv_refit),
     );
     let full = format!("{header}{text}");
@@ -198,7 +251,7 @@ fn write_revision(
         .map_err(|e| anyhow!("internal: the revised config does not parse: {e}"))?;
     crate::util::write_atomic(out, full.as_bytes())?;
     if !a.json {
-        println!("wrote {} (candidate {k}: {})", out.display(), c.effect);
+        println!("wrote {} (--apply {flag}: {label})", out.display());
     }
     Ok(())
 }
@@ -358,7 +411,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
     println!("verdict: {}: {}", d.verdict, d.message);
     if hint_apply && !d.candidates.is_empty() {
         println!(
-            "add candidate K with: rshape diagnose {} --apply K --write NEW.toml",
+            "write the chosen set with: rshape diagnose {} --apply chosen --write NEW.toml (or one candidate that passes: --apply K)",
             config.path.display()
         );
     }

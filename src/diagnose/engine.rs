@@ -438,8 +438,15 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
 }
 
 /// The revised model of first-level candidate `rank` (1-based): the retuned model with the
-/// candidate added and every parameter refit jointly.
-pub fn apply_candidate(_base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Result<PhysicalModel> {
+/// candidate added and every parameter refit jointly.  A candidate the diagnosis rejected
+/// (not `passes`: a plausibility flag, too small a ΔBIC, more invalid data) is refused with
+/// its reason unless `force`; a candidate with no fit always is.
+pub fn apply_candidate(
+    _base: &PhysicalModel,
+    d: &Diagnosis,
+    rank: usize,
+    force: bool,
+) -> Result<PhysicalModel> {
     let c = d.candidates.get(rank.wrapping_sub(1)).ok_or_else(|| {
         Error::Invalid(format!(
             "--apply {rank}: there are {} candidates (1..={})",
@@ -453,5 +460,28 @@ pub fn apply_candidate(_base: &PhysicalModel, d: &Diagnosis, rank: usize) -> Res
             c.effect
         )));
     }
+    if let (Some(why), false) = (c.rejection(), force) {
+        return Err(Error::Invalid(format!(
+            "--apply {rank}: {} was rejected: {why}; add --force to write it anyway",
+            c.effect
+        )));
+    }
     Ok(c.model.clone())
+}
+
+/// The revised model of the chosen effect set (`--apply chosen`): every chosen effect
+/// written into the model and every parameter refit jointly, as `final_model`; with no
+/// effect chosen, the retuned model when the retune explains the data.
+pub fn apply_chosen(d: &Diagnosis) -> Result<PhysicalModel> {
+    match d.verdict.as_str() {
+        "effects_found" | "retuned" => Ok(d.final_model.clone()),
+        "consistent" => Err(Error::Invalid(
+            "--apply chosen: the model already explains the data within the noise; nothing to write"
+                .into(),
+        )),
+        _ => Err(Error::Invalid(format!(
+            "--apply chosen: no effect set was chosen ({}); nothing to write",
+            d.message
+        ))),
+    }
 }

@@ -31,6 +31,6 @@ mod starts;
 pub mod ties;
 
 pub use channels::{misfit_channels, Channels};
-pub use engine::{apply_candidate, diagnose, diagnose_channels, Diagnosis};
+pub use engine::{apply_candidate, apply_chosen, diagnose, diagnose_channels, Diagnosis};
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
 pub use search::Settings;

@@ -66,6 +66,38 @@ pub struct CandidateReport {
     pub model: PhysicalModel,
 }
 
+impl CandidateReport {
+    /// Why the tool rejected this candidate (`None` when it passes): no fit, a plausibility
+    /// flag, too small a ΔBIC, or more invalid data than the retune alone.
+    pub fn rejection(&self) -> Option<String> {
+        if self.passes {
+            return None;
+        }
+        Some(if let Some(why) = &self.no_fit {
+            format!("no fit ({why})")
+        } else if !self.flags.is_empty() {
+            self.flags.join("; ")
+        } else if self.cand.is_none() {
+            format!(
+                "the refit lowers the cost too little (ΔBIC {:.3} ≤ {})",
+                self.delta_bic,
+                super::rank::MIN_DELTA_BIC
+            )
+        } else if self.delta_bic_vs_retune <= super::rank::MIN_DELTA_BIC {
+            format!(
+                "ΔBIC {:.3} against the retune alone (needs > {})",
+                self.delta_bic_vs_retune,
+                super::rank::MIN_DELTA_BIC
+            )
+        } else {
+            format!(
+                "more invalid data than the retune alone ({:.1} % with it)",
+                100.0 * self.invalid_fraction_after
+            )
+        })
+    }
+}
+
 /// A tie between two effects or two effect sets.
 #[derive(Debug, Clone, Serialize)]
 pub struct Tie {
