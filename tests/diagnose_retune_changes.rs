@@ -169,7 +169,8 @@ fn sigma_matches_the_spread_over_noise_draws() {
 }
 
 /// Inside a chosen set: a hidden mode at 900 rad/s and a 15 % gain error.  The chosen set is the
-/// mode, and `retuned_in_chosen` names the common gain ×1.15 (nothing else moved).
+/// mode, reported with its final values and σ, and `retuned_in_chosen` names the common
+/// gain ×1.15 (nothing else moved).
 #[test]
 fn a_retune_inside_the_chosen_set_is_named_too() {
     let (base, w) = servo();
@@ -187,5 +188,16 @@ fn a_retune_inside_the_chosen_set_is_named_too() {
         assert!((c.changes[0].after - 1.15).abs() < 0.01, "{}", c.summary());
         // The added mode's residue is not a configured gain.
         assert_eq!(c.common_gain.as_ref().unwrap().parameters.len(), 3);
+        // The chosen mode is reported with its final values and a σ that covers the truth
+        // (within 4σ).
+        let fe = &d.final_effects[0];
+        assert_eq!(fe.effect, "mode");
+        for (k, truth) in [("omega_n", 900.0), ("zeta", 0.02), ("rho", rho * 1.15)] {
+            let (v, s) = (fe.params[k], fe.sigma[k]);
+            assert!(
+                (v - truth).abs() < 4.0 * s,
+                "seed {seed}: {k} = {v} ± {s}, truth {truth}"
+            );
+        }
     }
 }

@@ -334,7 +334,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         println!("\nchosen path (beam search, joint refit of every parameter at each node):");
         for s in &d.steps {
             println!(
-                "  step {}: + {} ({}) → misfit_rms {}, invalid {} (joint refit of {} parameters; before the refit {}, {})",
+                "  step {}: + {} ({}, after the refit) → misfit_rms {}, invalid {} (joint refit of {} parameters; before the refit {}, {})",
                 s.step,
                 s.effect,
                 params_text(&s.params),
@@ -347,9 +347,18 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         }
     }
     if !d.final_effects.is_empty() {
-        println!("\nadded effects after the joint refit:");
+        println!("\nchosen effects in the final model (every parameter refit jointly; ± 1σ):");
         for e in &d.final_effects {
-            println!("  {}: {}", e.effect, params_text(&e.params));
+            let p = e
+                .params
+                .iter()
+                .map(|(n, v)| match e.sigma.get(n) {
+                    Some(u) => format!("{n} = {} ± {}", sig(*v), sig(*u)),
+                    None => format!("{n} = {}", sig(*v)),
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            println!("  {}: {p}", e.effect);
         }
     }
     if !d.chosen.is_empty() {

@@ -260,7 +260,7 @@ fn residual(m: &PhysicalModel, data: &Channels, out: &mut Vec<f64>) {
 /// Standard deviations of every slot coordinate of `m` (`lin` then `nl`) from
 /// `cov = (2JᵀJ)⁻¹`, by an SVD of the column-scaled Jacobian; a coordinate with a
 /// noticeable share in a direction the data do not determine gets `∞`.
-fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
+pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
     let n = lin.len() + nl.len();
     let mut r0 = Vec::new();
     residual(m, data, &mut r0);

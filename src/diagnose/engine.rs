@@ -23,6 +23,7 @@ use super::candidates::{explain, sig};
 use super::changes::changes;
 use super::channels::Channels;
 use super::compare::{bands, Siso};
+pub use super::final_effects::final_effects;
 use super::holdout::{holdouts, model_of};
 use super::polish::settle;
 pub use super::problem::Measures as ErrorMeasures;
@@ -32,11 +33,11 @@ use super::rank::{prior, si_map, MIN_DELTA_BIC, TIE_BIC};
 pub use super::report::{
     CandidateReport, Diagnosis, EffectSet, FinalEffect, Holdout, Retuned, SearchStats, Tie,
 };
-use super::retune::{retune_within, ADDED_NOTE};
+use super::retune::retune_within;
 use super::search::{add_effect, roots, search, Settings};
 use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
-use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::model::physical::PhysicalModel;
 use crate::report::fmt::fmt_pct;
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -56,70 +57,6 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
 
 fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
     Ok(Problem::new(m, data)?.measures(&Default::default()))
-}
-
-/// The effects `diagnose` added to `m`, with their current parameters.
-pub fn final_effects(m: &PhysicalModel) -> Vec<FinalEffect> {
-    let added = |s: &Option<String>| s.as_deref().is_some_and(|n| n.starts_with(ADDED_NOTE));
-    let label = |s: &Option<String>| {
-        s.as_deref()
-            .and_then(|n| n.strip_prefix(ADDED_NOTE))
-            .map(|n| n.trim_start_matches(": ").to_string())
-            .unwrap_or_default()
-    };
-    let mut out = Vec::new();
-    for md in m.mode.iter().filter(|x| added(&x.name)) {
-        let mut p = BTreeMap::new();
-        p.insert("omega_n".to_string(), md.omega_n);
-        p.insert("zeta".to_string(), md.zeta);
-        for (i, c) in md.output_gain.to_vec(m.n_outputs()).iter().enumerate() {
-            let b = md.input_gain.to_vec(m.n_inputs());
-            for (j, bj) in b.iter().enumerate() {
-                let name = if m.n_outputs() * m.n_inputs() == 1 {
-                    "rho".to_string()
-                } else {
-                    format!("rho_{}_{}", i + 1, j + 1)
-                };
-                p.insert(name, c * bj / md.mass);
-            }
-        }
-        out.push(FinalEffect {
-            effect: label(&md.name),
-            params: p,
-        });
-    }
-    for (list, order) in [(&m.rigid_body, 2.0), (&m.integrator, 1.0)] {
-        for r in list.iter().filter(|x| added(&x.name)) {
-            let mut p = BTreeMap::new();
-            p.insert("order".to_string(), order);
-            let c = r.output_gain.to_vec(m.n_outputs());
-            p.insert(
-                "c".to_string(),
-                c[0] * r.input_gain.to_vec(m.n_inputs())[0] / r.mass,
-            );
-            out.push(FinalEffect {
-                effect: label(&r.name),
-                params: p,
-            });
-        }
-    }
-    for e in m.effect.iter().filter(|e| added(&e.note)) {
-        let mut p = BTreeMap::new();
-        let (k, v) = match e.kind {
-            EffectKind::Delay => ("tau_s", e.tau_s),
-            EffectKind::Lag => ("omega_c", e.omega_c),
-            EffectKind::NmpZero => ("z", e.z),
-            EffectKind::Zoh => ("t_s", e.t_s),
-            EffectKind::Gain => ("k", e.k),
-            EffectKind::Sign => ("k", Some(-1.0)),
-        };
-        p.insert(k.to_string(), v.unwrap_or(f64::NAN));
-        out.push(FinalEffect {
-            effect: label(&e.note),
-            params: p,
-        });
-    }
-    out
 }
 
 /// Diagnoses the channels `data` jointly: retune, search, final holdout, report.
@@ -412,24 +349,12 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         runner_up,
         holdout,
         dropped,
-        final_effects: {
-            let mut fe = final_effects(&node.model);
-            // Friction changes a configured rigid body: report its refit pole.
-            for (c, _) in &node.effects {
-                if let super::candidates::Cand::Friction(i) = c {
-                    let mut p = BTreeMap::new();
-                    p.insert("rigid_body".to_string(), (*i + 1) as f64);
-                    if let Some(x) = node.model.rigid_body[*i].friction_pole {
-                        p.insert("pole".to_string(), x);
-                    }
-                    fe.push(FinalEffect {
-                        effect: "friction".into(),
-                        params: p,
-                    });
-                }
-            }
-            fe
-        },
+        final_effects: final_effects(
+            &node.model,
+            &node.effects.iter().map(|e| e.0).collect::<Vec<_>>(),
+            data,
+            true,
+        ),
         retuned_in_chosen: changes(base, &node.model, data),
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         search: mk_stats(res.expanded, res.joint_refits),

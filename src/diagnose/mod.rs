@@ -17,6 +17,7 @@ pub mod changes;
 pub mod channels;
 pub mod engine;
 pub mod factor_form;
+pub mod final_effects;
 pub mod fit;
 pub mod holdout;
 pub mod plant_form;

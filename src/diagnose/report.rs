@@ -121,8 +121,10 @@ pub struct Step {
     pub step: usize,
     /// Added effect.
     pub effect: String,
-    /// Its parameters (fitted alone on the previous model).
+    /// Its parameters after this step's joint refit.
     pub params: BTreeMap<String, f64>,
+    /// Its parameters fitted alone on the previous model (before the joint refit).
+    pub params_fitted_alone: BTreeMap<String, f64>,
     /// Explanation.
     pub explanation: String,
     /// Measures after the step (effect added and every parameter refit jointly).
@@ -165,6 +167,8 @@ pub struct FinalEffect {
     pub effect: String,
     /// Parameters (SI, rad/s).
     pub params: BTreeMap<String, f64>,
+    /// One standard deviation of each refit parameter (those with one).
+    pub sigma: BTreeMap<String, f64>,
 }
 
 /// The final-set holdout of one effect.
@@ -226,7 +230,8 @@ pub struct Diagnosis {
     pub holdout: Vec<Holdout>,
     /// Effects the final holdout removed.
     pub dropped: Vec<String>,
-    /// The added effects with their jointly refit parameters.
+    /// Every chosen effect (in `chosen` order) with its parameters in the final model and
+    /// their σ.
     pub final_effects: Vec<FinalEffect>,
     /// The configured parameters the final joint refit (of the chosen set) moved.
     pub retuned_in_chosen: Changes,

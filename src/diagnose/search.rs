@@ -24,6 +24,7 @@
 
 use super::candidates::Cand;
 use super::channels::Channels;
+use super::final_effects::final_effects;
 use super::polish::settle;
 use super::problem::{Measures, Problem};
 use super::rank::{candidate_list, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC};
@@ -197,7 +198,16 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchR
                         steps.push(Step {
                             step: depth,
                             effect: sc.cand.label(),
-                            params: si_map(&sc.cand, &sc.mods.theta, &data.entries),
+                            params: final_effects(
+                                &model,
+                                &effects.iter().map(|e| e.0).collect::<Vec<_>>(),
+                                data,
+                                false,
+                            )
+                            .pop()
+                            .map(|e| e.params)
+                            .unwrap_or_default(),
+                            params_fitted_alone: si_map(&sc.cand, &sc.mods.theta, &data.entries),
                             explanation: super::candidates::explain(
                                 &sc.cand,
                                 &sc.mods.theta,

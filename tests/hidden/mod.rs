@@ -182,6 +182,21 @@ pub fn check(
         return Err(format!("set {got:?}, want {want:?}"));
     }
     let mut errs = Vec::new();
+    // Every chosen effect is reported with its final parameters, in order, each refit
+    // parameter with a finite σ (issue 20, defect 6).
+    let fe: Vec<&str> = d.final_effects.iter().map(|e| e.effect.as_str()).collect();
+    if fe != d.chosen.iter().map(|s| s.as_str()).collect::<Vec<_>>() {
+        errs.push(format!("final_effects {fe:?} != chosen {:?}", d.chosen));
+    }
+    for e in &d.final_effects {
+        for k in e.params.keys() {
+            let fixed = ["order", "mode", "rigid_body"].contains(&k.as_str())
+                || ["gain", "sign"].iter().any(|g| e.effect.starts_with(g));
+            if !fixed && !e.sigma.get(k).is_some_and(|s| s.is_finite() && *s > 0.0) {
+                errs.push(format!("{}.{k}: no σ", e.effect));
+            }
+        }
+    }
     let fm = &d.final_model;
     for h in hidden {
         let mut checks: Vec<(String, f64, f64, f64)> = Vec::new();
