@@ -379,6 +379,12 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
             }
         );
     }
+    if !d.eliminated.is_empty() {
+        println!(
+            "dropped by the backward elimination (the data do not need them): {}",
+            d.eliminated.join(", ")
+        );
+    }
     if !d.dropped.is_empty() {
         println!("dropped by the holdout: {}", d.dropped.join(", "));
     }

@@ -97,6 +97,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
             runner_up: vec![],
             holdout: vec![],
             dropped: vec![],
+            eliminated: vec![],
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
             cost_test: Some([n as f64, before.v]),
@@ -263,6 +264,8 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         node.steps.retain(|st| !dropped.contains(&st.effect));
         node.effects = keep;
     }
+    // Backward elimination: effects the data do not need (vacuous ones) are dropped.
+    let eliminated = super::backward::eliminate(base, &mut node, &res.nodes, data)?;
     // A last joint refit of the chosen model, and its consistency polish.
     let refit = retune_within(&node.model, base, data, None, false);
     if refit.v_after < node.v_fit {
@@ -349,6 +352,7 @@ pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) ->
         runner_up,
         holdout,
         dropped,
+        eliminated,
         final_effects: final_effects(
             &node.model,
             &node.effects.iter().map(|e| e.0).collect::<Vec<_>>(),

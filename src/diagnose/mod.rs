@@ -12,6 +12,7 @@ pub mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
 pub mod agreement;
+pub mod backward;
 pub mod candidates;
 pub mod changes;
 pub mod channels;

@@ -230,6 +230,8 @@ pub struct Diagnosis {
     pub holdout: Vec<Holdout>,
     /// Effects the final holdout removed.
     pub dropped: Vec<String>,
+    /// Effects the backward elimination removed (the data do not need them: ΔBIC ≤ 10).
+    pub eliminated: Vec<String>,
     /// Every chosen effect (in `chosen` order) with its parameters in the final model and
     /// their σ.
     pub final_effects: Vec<FinalEffect>,

@@ -1,0 +1,57 @@
+//! Backward elimination after the forward search: an effect of the chosen set that the data
+//! do not need — removing it (and refitting the rest jointly) costs no more than the
+//! acceptance threshold, `ΔBIC = 2(V_without − V) − n_e·ln(2F) ≤ 10` — is dropped, the
+//! weakest first, until every remaining effect is needed.  This removes vacuous effects the
+//! forward search kept, such as a lag whose corner refit far above the band (it contributes
+//! nothing there once other effects were added).
+
+use super::channels::Channels;
+use super::holdout::model_of;
+use super::problem::Problem;
+use super::rank::MIN_DELTA_BIC;
+use super::retune::retune_within;
+use super::search::Node;
+use crate::error::Result;
+use crate::model::physical::PhysicalModel;
+
+/// Drops the effects of `node` the data do not need (see the module docs), refitting the
+/// rest; `nodes` are the search's nodes (reused models of the smaller sets).  Returns the
+/// labels dropped, in order.
+pub fn eliminate(
+    base: &PhysicalModel,
+    node: &mut Node,
+    nodes: &[Node],
+    data: &Channels,
+) -> Result<Vec<String>> {
+    let ln2f = (2.0 * data.n_data() as f64).ln();
+    let mut dropped = Vec::new();
+    while !node.effects.is_empty() {
+        let mut worst: Option<(usize, f64, PhysicalModel, f64)> = None;
+        for j in 0..node.effects.len() {
+            let others: Vec<_> = node
+                .effects
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != j)
+                .map(|(_, e)| e.clone())
+                .collect();
+            let wo = model_of(base, &others, nodes, data);
+            let r = retune_within(&wo, base, data, None, false);
+            let n_e = node.effects[j].0.n_params(data.n_ch());
+            let d_bic = 2.0 * (r.v_after - node.v_fit) - n_e as f64 * ln2f;
+            if d_bic <= MIN_DELTA_BIC && worst.as_ref().is_none_or(|w| d_bic < w.1) {
+                worst = Some((j, d_bic, r.model, r.v_after));
+            }
+        }
+        let Some((j, _, model, v)) = worst else {
+            break;
+        };
+        dropped.push(node.effects[j].0.label());
+        node.effects.remove(j);
+        node.measures = Problem::new(&model, data)?.measures(&Default::default());
+        node.model = model;
+        node.v_fit = v;
+        node.steps.retain(|st| !dropped.contains(&st.effect));
+    }
+    Ok(dropped)
+}
