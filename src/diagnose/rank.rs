@@ -10,6 +10,9 @@ use std::collections::BTreeMap;
 
 /// ΔBIC a candidate needs to be accepted.
 pub const MIN_DELTA_BIC: f64 = 10.0;
+
+/// Largest phase lag (rad) a delay candidate may have at the band top: half a cycle.
+pub const MAX_DELAY_PHASE: f64 = std::f64::consts::PI;
 /// BIC gap under which two candidates (or two effect sets) are a tie.
 pub const TIE_BIC: f64 = 6.0;
 /// Extrapolation holdout: fit below this share of the band (log frequency), predict above.
@@ -160,6 +163,23 @@ pub fn plausibility(
             }
         }
         Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
+        // More than half a cycle of lag at the band top is not a transport or computation
+        // delay a servo loop works with; it fits the slope of dynamics the model lacks.
+        Cand::Delay(_) if th[0].abs() * w_max > MAX_DELAY_PHASE => flags.push(format!(
+            "implausible: a delay of {} s lags {:.0}° at the band top {} (more than {:.0}°): the phase slope is unmodelled dynamics, not a delay",
+            sig(th[0].abs()),
+            (th[0].abs() * w_max).to_degrees(),
+            fmt_w(w_max),
+            MAX_DELAY_PHASE.to_degrees()
+        )),
+        // A zero-order hold whose Nyquist frequency π/T lies inside the band: the data above
+        // it would be aliases, not a hold's roll-off.
+        Cand::Zoh(_) if std::f64::consts::PI / th[0].exp() < w_max => flags.push(format!(
+            "implausible: a zero-order hold with T = {} s has its Nyquist frequency {} inside the measured band (up to {})",
+            sig(th[0].exp()),
+            fmt_w(std::f64::consts::PI / th[0].exp()),
+            fmt_w(w_max)
+        )),
         Cand::Lag(_) | Cand::NmpZero(_) | Cand::Zoh(_) | Cand::Friction(_) | Cand::Delay(_)
             if at(0) =>
         {
