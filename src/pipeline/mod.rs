@@ -2,6 +2,7 @@
 //! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
 //! writes; neither prints.
 pub mod closed_loop;
+pub mod envelope;
 pub mod integration;
 pub mod outputs;
 
@@ -60,9 +61,13 @@ pub fn run(
 ) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
-    let radii = integration::noise_radii(config, data, noise_radius)?;
-    let (envelope, mut warnings, closed_loop) = timings.time("envelope", || {
-        closed_loop::envelope(config, data, radii.as_deref())
+    let envelope::EnvelopeOutcome {
+        envelope,
+        noise_radii: radii,
+        mut warnings,
+        closed_loop,
+    } = timings.time("envelope", || {
+        envelope::envelope(config, data, noise_radius)
     })?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
