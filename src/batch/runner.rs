@@ -7,7 +7,6 @@ use super::discover::Dataset;
 use crate::consistency::{check, Envelope};
 use crate::error::{Error, Result};
 use crate::model::Config;
-use crate::pipeline::integration;
 use crate::report::envelope_csv;
 use crate::util::write_atomic_nosync;
 use rayon::prelude::*;
@@ -84,7 +83,7 @@ fn fill(
     out: &Path,
     res: &mut DatasetResult,
 ) -> Result<()> {
-    let data = crate::pipeline::closed_loop::read_data(config, &d.path)?;
+    let data = crate::pipeline::envelope::load_data(config, &d.path)?;
     if data.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no data rows",
@@ -92,10 +91,10 @@ fn fill(
         )));
     }
     res.n_data = data.len();
-    let radii = integration::noise_radii(config, &data, d.noise_radius.or(opts.noise_radius))?;
-    let (env, warnings, _) =
-        crate::pipeline::closed_loop::envelope(config, &data, radii.as_deref())?;
-    res.warnings = warnings;
+    let outcome =
+        crate::pipeline::envelope::envelope(config, &data, d.noise_radius.or(opts.noise_radius))?;
+    let env = outcome.envelope;
+    res.warnings = outcome.warnings;
     res.max_r_min = env.r_min.iter().copied().reduce(f64::max);
     if let Some(r) = &config.r {
         let c = check(r, &env);
