@@ -2,6 +2,9 @@
 //! noisy data) and the check of the configured `r`, each written to
 //! `OUT/datasets/NAME/`.  A failing dataset becomes a failed row; the others complete.
 //! Results come back in dataset order whatever the scheduling (rayon's indexed collect).
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::discover::Dataset;
 use crate::consistency::{check, Envelope};

@@ -1,6 +1,9 @@
 //! Check of a given unit `r` against an envelope: the data are consistent iff
 //! `|r(jω_i)| > r_min,i` at every datum (Theorem 2, Theorem 3 and Theorem 4 all reduce to
 //! this once the envelope is known).  A1 (`|r| < σ_min(M̃)`) is reported at every datum.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::envelope::Envelope;
 use crate::system::TransferFunction;

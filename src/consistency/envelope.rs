@@ -1,5 +1,8 @@
 //! The lower envelope: per datum, the smallest `|r(jω_i)|` consistent with it, with the A1
 //! limit `σ_min(M̃(jω_i))` beside it.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::noise_free::{r_min_special, r_min_standard};
 use crate::data::FrfData;

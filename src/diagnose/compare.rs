@@ -20,6 +20,9 @@
 //!   with `r_min = 0` never fails). With the noise-free fallback the test is conservative:
 //!   a datum fails when neither the noise disk alone (`c_k > 1`) nor `r` alone
 //!   (`r_min > |r(jω)|`) explains it. `with_r_exact` says which test was used.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::consistency::{noise_free_envelope, noisy_envelope, BisectionSettings};
 use crate::data::FrfData;

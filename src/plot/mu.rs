@@ -1,6 +1,9 @@
 //! `mu.svg`: the structured singular value `μ_Γ{F_L[V(jω_i), φ_i⁻¹]}` per datum for the
 //! configured `r`, with the line `μ = 1` (the analogue of Fig. 8).  By Lemma 5 / Theorem 4
 //! a datum is consistent with the model, `r` and the noise level iff `μ_Γ > 1` there.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::style::*;
 use super::symbols::Symbols;

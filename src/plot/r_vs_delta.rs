@@ -1,6 +1,9 @@
 //! `r_vs_delta.svg`: the analogue of Fig. 3 (noise-free: `|r(jω)|` against the norms of the
 //! minimum-norm perturbations `‖Δᵢ‖` of eq. (8)) and of Fig. 8 (noisy: against the
 //! Theorem 4 bisection values), on log-log axes, with the A1 limit `σ_min(M̃(jω))`.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::style::{self, *};
 use super::symbols::Symbols;

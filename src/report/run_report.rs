@@ -1,6 +1,9 @@
 //! `report.json` of `rshape run`: the verdict of the check of the configured `r`, the
 //! per-datum envelope, the fitted `r` (as in `r.json`) with its certificate, and the time
 //! per stage.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::data::FrfData;
 use crate::model::Config;

@@ -1,4 +1,7 @@
 //! The Theorem 1 test: closed-loop poles, exact margins, grid curves (see the module above).
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::factor_loop::{gang_of_four, t_sigma_max, theorem1_system};
 use crate::error::{Error, Result};
