@@ -68,7 +68,6 @@
 #![warn(missing_docs)]
 
 pub mod batch;
-pub mod cli;
 pub mod consistency;
 pub mod data;
 pub mod diagnose;
@@ -79,6 +78,7 @@ pub mod mu;
 pub mod pipeline;
 pub mod plot;
 pub mod report;
+pub mod settings;
 pub mod stability;
 pub mod system;
 pub mod util;

@@ -154,6 +154,17 @@ pub struct BisectionSettings {
     pub mu: MuSettings,
 }
 
+impl BisectionSettings {
+    /// Checks every field, the μ settings included; the error names the first bad one.
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("BisectionSettings")
+            .fraction("rel_tol", self.rel_tol)
+            .at_least("max_iter", self.max_iter, 1, "must be at least 1")
+            .finish()?;
+        self.mu.validate()
+    }
+}
+
 impl Default for BisectionSettings {
     fn default() -> Self {
         Self {
@@ -320,6 +331,9 @@ pub fn noisy_envelope_report(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<NoisyReport> {
+    settings
+        .validate()
+        .map_err(|e| Error::Invalid(e.to_string()))?;
     check_sizes(f, data)?;
     if data.outputs() != 1 || data.inputs() != 1 {
         return Err(Error::Invalid(format!(

@@ -32,12 +32,14 @@ mod polyrows;
 pub mod problem;
 pub mod realization;
 pub mod run;
+mod settings_check;
 pub mod spectral;
 
 pub use certificate::Certificate;
 pub use order::{fit_auto, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
 pub use run::{run_fit, FitOutcome, OrderChoice};
+pub use settings_check::MAX_ORDER;
 pub use spectral::Zpk;
 
 use crate::consistency::Envelope;

@@ -73,6 +73,18 @@ pub struct MuSettings {
     pub svd_max_iter: usize,
 }
 
+impl MuSettings {
+    /// Checks every field; the error names the first bad one ([`crate::settings`]).
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("MuSettings")
+            .fraction("rel_gap", self.rel_gap)
+            .at_least("max_evals", self.max_evals, 1, "must be at least 1")
+            .positive("log_d_range", self.log_d_range)
+            .at_least("svd_max_iter", self.svd_max_iter, 1, "must be at least 1")
+            .finish()
+    }
+}
+
 impl Default for MuSettings {
     fn default() -> Self {
         Self {
