@@ -23,11 +23,7 @@
 //! envelope:
 //!
 //! ```
-//! use rshape::consistency::check;
-//! use rshape::data::FrfData;
-//! use rshape::fit::{fit_unit, FitSettings};
-//! use rshape::model::Config;
-//! use rshape::pipeline::envelope::envelope;
+//! use rshape::{check, envelope, fit_unit, Config, FitSettings, FrfData};
 //! use nalgebra::DMatrix;
 //! use num_complex::Complex64;
 //! use std::path::Path;
@@ -84,3 +80,25 @@ pub mod system;
 pub mod util;
 
 pub use error::{Error, Result};
+
+// The curated surface: the types and calls of the pipeline, in its order.  Everything else
+// stays reachable through its module for advanced use.
+
+/// Per-frequency envelope of the smallest consistent `|r|`, chosen for the config
+/// ([`pipeline::envelope::envelope`]), and the check of a given `r` against it.
+pub use consistency::{check, CheckReport, Envelope};
+/// Data in: frequency-response measurements and their CSV reader.
+pub use data::{read_frf_csv, FrfData};
+/// Fit and certificate of the smallest unit `r(s)` above the envelope.
+pub use fit::{fit_auto, fit_unit, Certificate, FitError, FitResult, FitSettings};
+/// Model in: a loaded config ([`model::Config`]) and its factorization.
+pub use model::{Config, Factorization};
+pub use pipeline::envelope::{envelope, EnvelopeOutcome};
+/// The whole `rshape run` pipeline on loaded inputs.
+pub use pipeline::{run, RunOutcome};
+/// A settings field out of its range.
+pub use settings::InvalidSetting;
+/// Robust stability of a controller with a given `r` (Theorem 1).
+pub use stability::analyze as robust_stability;
+/// Transfer functions (`r`, entries of the factors).
+pub use system::TransferFunction;
