@@ -167,7 +167,10 @@ fn motor_bench_experiments_disagree_beyond_their_noise() {
         let r = data_vs_data(&sa, &sb).unwrap();
         println!("{ch:?}: {r:?}");
         assert_eq!(r.n_common, 60);
-        assert_eq!(r.verdict, "disagree");
+        assert_eq!(
+            r.verdict,
+            rshape::diagnose::agreement::AgreementVerdict::Disagree
+        );
         assert!(r.disagree_fraction > 0.3 && r.distance_rms > 2.0, "{r:?}");
     }
 }

@@ -1,8 +1,8 @@
 //! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
 
 use super::common::{fmt_g, InputArgs};
-use crate::diagnose::agreement::data_vs_data;
-use crate::diagnose::compare::{compare, prepare, Band, CompareReport, PlantModel};
+use crate::diagnose::agreement::{data_vs_data, AgreementVerdict};
+use crate::diagnose::compare::{compare, prepare, Band, CompareReport, CompareVerdict, PlantModel};
 use crate::diagnose::figures::bode_overlay;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -164,10 +164,10 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     println!(
         "verdict: {}{}",
         rep.verdict,
-        match rep.verdict.as_str() {
-            "consistent" => " (invalid_fraction ≤ 5 % and misfit_rms ≤ 1: the data are explained within the noise)",
-            "inconsistent" => " (run `rshape diagnose` to find the missing effect)",
-            _ => " (no noise radius: give --noise-radius, a noise_radius column or [noise])",
+        match rep.verdict {
+            CompareVerdict::Consistent => " (invalid_fraction ≤ 5 % and misfit_rms ≤ 1: the data are explained within the noise)",
+            CompareVerdict::Inconsistent => " (run `rshape diagnose` to find the missing effect)",
+            CompareVerdict::UnknownNoise => " (no noise radius: give --noise-radius, a noise_radius column or [noise])",
         }
     );
     if let Some(f) = &rep.figure {
@@ -182,7 +182,7 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
             fmt_g(ag.distance_rms),
             crate::report::fmt::fmt_pct(ag.disagree_fraction),
             fmt_bands(&ag.bands),
-            if ag.verdict == "agree" {
+            if ag.verdict == AgreementVerdict::Agree {
                 ": the two experiments agree within their noise"
             } else {
                 ": the two experiments disagree by more than their noise, so no model can reach the noise on both"

@@ -46,7 +46,7 @@ pub struct Revision {
     /// `r_env_max`.
     pub r_env_max: Option<f64>,
     /// Verdict.
-    pub verdict: String,
+    pub verdict: crate::diagnose::compare::CompareVerdict,
 }
 
 /// Runs `rshape history`.
