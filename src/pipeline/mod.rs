@@ -4,6 +4,7 @@
 pub mod closed_loop;
 pub mod integration;
 pub mod outputs;
+pub mod stability;
 
 use crate::consistency::{check, CheckReport, Envelope};
 use crate::data::FrfData;
