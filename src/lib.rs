@@ -25,6 +25,7 @@ pub mod pipeline;
 pub mod plot;
 pub mod report;
 pub mod stability;
+pub mod synthesis;
 pub mod system;
 pub mod util;
 

@@ -50,7 +50,11 @@ fn reference_peak(ss: &StateSpace) -> f64 {
     let mut best = ss.d.clone().svd(false, false).singular_values.max();
     best = best.max(sigma(ss, 0.0));
     for k in 0..grid.len() {
-        let left = if k > 0 { vals[k - 1] } else { f64::NEG_INFINITY };
+        let left = if k > 0 {
+            vals[k - 1]
+        } else {
+            f64::NEG_INFINITY
+        };
         let right = if k + 1 < grid.len() {
             vals[k + 1]
         } else {
@@ -183,7 +187,12 @@ fn issue22_interior_peak_is_not_certified_robust() {
     assert!(!row.robust);
     // b/r for normalized factors and a constant r agrees with α*.
     let b = rep.b_gk.unwrap();
-    assert!((row.alpha - b / 0.0158).abs() < 1e-8, "{} vs {}", row.alpha, b / 0.0158);
+    assert!(
+        (row.alpha - b / 0.0158).abs() < 1e-8,
+        "{} vs {}",
+        row.alpha,
+        b / 0.0158
+    );
     // The CLI says NO and exits 1.
     let o = rshape(&[
         "stability",

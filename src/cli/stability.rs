@@ -48,7 +48,11 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
             a.config.display()
         ));
     }
-    let given = a.r_json.as_deref().map(stability::read_r_json).transpose()?;
+    let given = a
+        .r_json
+        .as_deref()
+        .map(stability::read_r_json)
+        .transpose()?;
     let mut rs = stability::bounds(&config, given);
     // The controller's size is checked before anything is written.
     stability::check_controller(&config, &controller)?;
