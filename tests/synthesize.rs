@@ -48,11 +48,11 @@ fn random_plant(seed: u64) -> StateSpace {
     let m = rng.gen_range(1..=3);
     let mut r = |_, _| rng.gen_range(-1.0..1.0);
     let a0 = DMatrix::from_fn(n, n, &mut r) * 2.0;
-    let shift = if seed % 3 == 0 { 1.5 } else { -0.5 };
+    let shift = if seed.is_multiple_of(3) { 1.5 } else { -0.5 };
     let a = a0 - DMatrix::identity(n, n) * shift;
     let b = DMatrix::from_fn(n, m, &mut r);
     let c = DMatrix::from_fn(p, n, &mut r);
-    let d = if seed % 2 == 0 {
+    let d = if seed.is_multiple_of(2) {
         DMatrix::from_fn(p, m, &mut r) * 0.5
     } else {
         DMatrix::zeros(p, m)
@@ -281,4 +281,50 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
     assert!(!out.exists());
+}
+
+/// A `[model]` config (the robot's special factorization): the controller is designed for
+/// the normalized factors of the plant the factors define and proved with the config's own
+/// factors; `stability --controller` on the written controller gives the same verdict.
+#[test]
+fn special_factorization_config_is_synthesized_for_its_plant_and_proved_with_its_factors() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = common::repo("configs/robot.toml");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let code = o.status.code();
+    assert!(
+        matches!(code, Some(0) | Some(1)),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    assert!(
+        stdout(&o).contains("not the normalized ones"),
+        "{}",
+        stdout(&o)
+    );
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+            .unwrap();
+    let b_opt = syn["b_opt"].as_f64().unwrap();
+    let b_gk = syn["b_gk"].as_f64().unwrap();
+    assert!(
+        b_gk >= b_opt / 1.1 * (1.0 - 1e-9) && b_gk <= b_opt * (1.0 + 1e-8),
+        "{b_gk} {b_opt}"
+    );
+    let poles = syn["closed_loop_poles"].as_array().unwrap();
+    assert!(poles.iter().all(|z| z[0].as_f64().unwrap() < 0.0));
+    let s = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        out.join("controller.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
 }

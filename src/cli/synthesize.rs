@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 /// Arguments of `rshape synthesize`.
 #[derive(Debug, Args)]
 pub struct SynthesizeArgs {
-    /// The TOML config with a [plant] (its [r] is the configured bound).
+    /// The TOML config ([plant], or [model]/[physical] factors; its [r] is the configured bound).
     pub config: PathBuf,
     /// A fitted r (the r.json written by `rshape run` or `rshape fit`).
     #[arg(long)]

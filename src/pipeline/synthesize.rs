@@ -18,6 +18,7 @@ use nalgebra::DMatrix;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Settings of the synthesis.
 #[derive(Debug, Clone, Copy)]
@@ -65,14 +66,18 @@ pub struct SynthesisOutcome {
     pub notes: Vec<String>,
 }
 
-/// The normalized factors the synthesis works on: those of the config's `[plant]`.
-pub fn plant_factors<'a>(config: &'a Config, path: &Path) -> Result<&'a NormalizedLcf> {
-    config.factorization.realization.as_deref().ok_or_else(|| {
-        Error::Invalid(format!(
-            "{}: synthesize needs a [plant] section (its normalized coprime factors are the model the controller is designed for); [model] and [physical] configs are not supported yet",
-            path.display()
-        ))
-    })
+/// The normalized factors the synthesis works on: those of the config's `[plant]`, else
+/// those of a minimal realization of the plant `G = C·M̃⁻¹·Ñ·J` of its factors (a `[model]`
+/// or the export of a `[physical]` model). Errors (one line) when the plant has no
+/// normalized coprime factors (an unstable mode the output does not see).
+pub fn plant_factors(config: &Config, path: &Path) -> Result<Arc<NormalizedLcf>> {
+    if let Some(ncf) = &config.factorization.realization {
+        return Ok(ncf.clone());
+    }
+    let g = crate::stability::plant_system(&config.factorization)?.minimal(1e-10);
+    NormalizedLcf::new(g)
+        .map(Arc::new)
+        .map_err(|e| Error::Invalid(format!("{}: the plant of the factors: {e}", path.display())))
 }
 
 /// Synthesizes the Glover–McFarlane controller of the config's plant and proves it with the
@@ -94,7 +99,7 @@ pub fn run(
             )));
         }
     }
-    let gm = synthesize(ncf, settings.gamma_factor)?;
+    let gm = synthesize(&ncf, settings.gamma_factor)?;
     let controller = Controller {
         path: controller_path.to_path_buf(),
         k: gm.k.clone(),
@@ -102,10 +107,17 @@ pub fn run(
     };
     let stability = stab::run(config, &controller, rs, data)?;
     let mut notes = Vec::new();
+    let normalized = config.factorization.realization.is_some();
+    if !normalized {
+        notes.push(
+            "the config's factors are not the normalized ones: the controller maximizes b(G,K) of the plant they define; Theorem 1 margins are with the config's factors".to_string(),
+        );
+    }
     let mut bounds = Vec::new();
     for (row, (label, r)) in stability.report.margins.iter().zip(rs) {
         let constant = r.num.degree() == 0 && r.den.degree() == 0;
-        let alpha_opt = constant.then(|| gm.b_opt / r.at_infinity().abs());
+        // α* = b(G,K)/|r| holds for normalized factors only.
+        let alpha_opt = (constant && normalized).then(|| gm.b_opt / r.at_infinity().abs());
         if let Some(a) = alpha_opt.filter(|a| *a < 1.0) {
             notes.push(format!(
                 "{label} r: no controller reaches alpha >= 1: b_opt = {} < |r| = {} (best alpha {})",
@@ -114,7 +126,7 @@ pub fn run(
                 fmt_g(a)
             ));
         }
-        if !constant {
+        if !constant && normalized {
             notes.push(format!(
                 "{label} r is frequency dependent: the controller is the Glover–McFarlane optimum for a constant bound; its Theorem 1 margin with this r is {}",
                 fmt_g(row.alpha)

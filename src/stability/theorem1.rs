@@ -193,9 +193,11 @@ pub fn analyze(
         let h = hinf_norm(&rt).map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?;
         let alpha = 1.0 / h.gamma;
         let alpha_lower = 1.0 / h.upper;
+        // A grid point where T could not be evaluated (0 in the figure's curve) bounds nothing.
         let alpha_grid = inv_t
             .iter()
             .zip(rc)
+            .filter(|(i, _)| **i > 0.0)
             .map(|(i, r)| i / r)
             .fold(f64::INFINITY, f64::min);
         let constant_r = r.num.degree() == 0 && r.den.degree() == 0;
