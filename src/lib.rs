@@ -76,6 +76,7 @@ pub mod plot;
 pub mod report;
 pub mod settings;
 pub mod stability;
+pub mod synthesis;
 pub mod system;
 pub mod util;
 

@@ -23,6 +23,7 @@ pub mod history;
 pub mod merge;
 pub mod run;
 pub mod stability;
+pub mod synthesize;
 
 use clap::{Parser, Subcommand};
 
@@ -59,6 +60,8 @@ pub enum Command {
     Fit(fit::FitArgs),
     /// Theorem 1: does a controller stabilize every plant of the set (margin with each r)?
     Stability(stability::StabilityArgs),
+    /// Synthesize the Glover–McFarlane controller and prove it with Theorem 1.
+    Synthesize(synthesize::SynthesizeArgs),
 }
 
 /// Runs the CLI and returns the process exit code.
@@ -91,6 +94,7 @@ pub fn main() -> i32 {
         Command::History(a) => history::run(&a),
         Command::Fit(a) => fit::run(&a),
         Command::Stability(a) => stability::run(&a),
+        Command::Synthesize(a) => synthesize::run(&a),
     };
     match result {
         Ok(code) => code,

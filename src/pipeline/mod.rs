@@ -5,6 +5,8 @@ pub mod closed_loop;
 pub mod envelope;
 pub mod integration;
 pub mod outputs;
+pub mod stability;
+pub mod synthesize;
 
 use crate::consistency::{check, CheckReport, Envelope};
 use crate::data::FrfData;
