@@ -10,7 +10,7 @@ mod cli;
 #[allow(unused_imports)]
 use rshape::{
     batch, consistency, data, diagnose, error, fit, model, mu, pipeline, plot, report, settings,
-    stability, system, util,
+    stability, synthesis, system, util,
 };
 
 fn main() {
