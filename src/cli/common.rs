@@ -51,6 +51,14 @@ impl InputArgs {
         let f = &config.factorization;
         if let Some(ch) = config.raw.channel {
             let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
+            if !fits {
+                crate::data::check_channel(
+                    &data.path,
+                    (ch.output, ch.input),
+                    (data.outputs(), data.inputs()),
+                )
+                .map_err(|e| anyhow::anyhow!("{}: {e}", self.config.display()))?;
+            }
             if !fits
                 && ch.output >= 1
                 && ch.input >= 1

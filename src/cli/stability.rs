@@ -11,7 +11,7 @@ use crate::plot::stability::{stability_svg, StabilityInput};
 use crate::report::fmt::fmt_g;
 use crate::stability::analyze;
 use crate::system::{logspace, TransferFunction};
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -48,7 +48,7 @@ struct RFile {
 }
 
 fn read_r_json(path: &Path) -> Result<TransferFunction> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let text = crate::util::read_text_file(path)?;
     let r: RFile = serde_json::from_str(&text).map_err(|e| {
         anyhow!(
             "{}: {e}; expected the r.json of `rshape fit` (keys num, den)",
@@ -61,7 +61,15 @@ fn read_r_json(path: &Path) -> Result<TransferFunction> {
             path.display()
         ));
     }
-    Ok(TransferFunction::new(r.num, r.den))
+    let r = TransferFunction::new(r.num, r.den);
+    if let Some(why) = r.unit_violation() {
+        return Err(anyhow!(
+            "{}: r = {} is not a unit of RH∞: {why}; Theorem 1 needs a stable, minimum-phase, biproper r (the r.json of `rshape fit` is one)",
+            path.display(),
+            r.brief()
+        ));
+    }
+    Ok(r)
 }
 
 fn grid_for(config: &Config, poles: &[num_complex::Complex64]) -> Vec<f64> {

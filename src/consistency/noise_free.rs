@@ -81,12 +81,18 @@ pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, As
 /// A non-finite datum gives a non-finite `Z` (never a panic).
 fn qr_z(f: &FactorsAt, phi: &DMatrix<Complex64>) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
     let (p, m_in) = phi.shape();
-    let u = &f.n - &f.m * phi;
+    // Prescale by c = max(1, max|Φ_ij|): W/c = Q·(R/c) and (R/c)^{-*}(U/c)ᴴ = R^{-*}Uᴴ, so
+    // Z is unchanged while no Householder norm or product M̃Φ overflows (a datum of 1e308
+    // gave NaN).  The entries' moduli use hypot, finite up to f64::MAX.
+    let c = phi.iter().map(|z| z.norm()).fold(1.0, f64::max);
+    let c = if c.is_finite() { c } else { 1.0 };
+    let phi_c = phi.map(|z| z / c);
+    let u = f.n.map(|z| z / c) - &f.m * &phi_c;
     let mut w = DMatrix::<Complex64>::zeros(m_in + p, m_in);
     for k in 0..m_in {
-        w[(k, k)] = Complex64::new(-1.0, 0.0);
+        w[(k, k)] = Complex64::new(-1.0 / c, 0.0);
     }
-    w.view_mut((m_in, 0), (p, m_in)).copy_from(&(-phi));
+    w.view_mut((m_in, 0), (p, m_in)).copy_from(&(-phi_c));
     let qr = w.qr();
     let (q, r) = (qr.q(), qr.r());
     let zh = r
