@@ -235,8 +235,12 @@ pub fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Largest config or small text file read whole (the data files are streamed).
+/// Largest config, controller or `r.json` read whole.
 pub const MAX_TEXT_FILE: u64 = 64 << 20;
+
+/// Largest data file read whole (closed-loop data, noise std files, envelope files; the
+/// FRF files of `envelope` are streamed and have no such cap).
+pub const MAX_DATA_FILE: u64 = 1 << 30;
 
 fn file_kind(meta: &std::fs::Metadata) -> &'static str {
     #[cfg(unix)]

@@ -634,6 +634,10 @@ fn cli_kinds() -> Vec<Kind> {
     ]
 }
 
+/// SISO data whose datum at 1 rad/s has `r_min` at the A1 limit `σ_min(M̃)`: no admissible
+/// `r` explains it, so every fit fails.
+const BEYOND_A1: &str = "omega_rad_s,re_1_1,im_1_1\n0.1,0.55,-0.1\n1,1e8,1e8\n10,0.55,-0.1\n";
+
 /// A file body that `run_kind` creates as a named pipe (FIFO) without a writer.
 const FIFO: &[u8] = b"<FIFO>";
 
@@ -925,22 +929,25 @@ fn hardening_kinds() -> Vec<Kind> {
         .config(SISO)
         .data(siso_data("", &[])),
         kind(
-            "CLI: a failed fit leaves no out/",
+            "CLI: a fit that fails leaves no out/",
             2,
-            "fit {dir}/model.toml --out {dir}/out",
-            &["data.csv:3", "not a number"],
+            "fit {dir}/model.toml --order 0 --out {dir}/out",
+            &["order 0", "A1"],
         )
         .config(SISO)
-        .data("omega_rad_s,re_1_1,im_1_1\n1,0.5,0.1\n2,abc,0.1\n"),
+        .data(BEYOND_A1),
         kind(
-            "CLI: a failed stability run leaves no out/",
+            "CLI: a stability --fit that fails leaves no out/",
             2,
-            "stability {dir}/model.toml --controller {dir}/k.toml --out {dir}/out",
-            &["k.toml", "1×1"],
+            "stability {dir}/model.toml --controller {dir}/k.toml --fit --out {dir}/out",
+            &["failed its certificate", "A1"],
         )
         .config(SISO)
-        .data(siso_data("", &[]))
-        .file("k.toml", "[controller]\nd = [[1, 0], [0, 1]]\n"),
+        .data(BEYOND_A1)
+        .file(
+            "k.toml",
+            "[controller]\ntf = [[{ num = [2, 1], den = [1, 4] }]]\n",
+        ),
         kind(
             "CLI: --out under /proc",
             2,

@@ -113,7 +113,7 @@ pub fn decimal_hint(field: &str) -> &'static str {
 /// Reads a whole text file as UTF-8 (a UTF-8 byte-order mark is dropped, UTF-16 with a
 /// byte-order mark is decoded).  Text that is not UTF-8 is an error naming its line.
 pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = crate::util::read_regular(path, crate::util::MAX_TEXT_FILE)?;
+    let bytes = crate::util::read_regular(path, crate::util::MAX_DATA_FILE)?;
     let bytes = decode_utf16(bytes, path)?;
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     match std::str::from_utf8(bytes) {

@@ -127,12 +127,15 @@ impl TransferFunction {
         let poles = self.den.roots();
         let zeros = self.num.roots();
         if !poles.converged || !zeros.converged {
-            return Some("its poles and zeros could not be computed (root iteration cap)".into());
+            return Some(format!(
+                "its poles and zeros could not be computed from the coefficients of degree {} (root iteration cap): give r of lower order",
+                self.den.degree()
+            ));
         }
-        if let Some(p) = poles.roots.iter().find(|p| !(p.re < 0.0)) {
+        if let Some(p) = poles.roots.iter().find(|p| p.re >= 0.0 || p.re.is_nan()) {
             return Some(format!("it is not stable (pole at {})", fmt(*p)));
         }
-        if let Some(z) = zeros.roots.iter().find(|z| !(z.re < 0.0)) {
+        if let Some(z) = zeros.roots.iter().find(|z| z.re >= 0.0 || z.re.is_nan()) {
             return Some(format!("it is not minimum phase (zero at {})", fmt(*z)));
         }
         None

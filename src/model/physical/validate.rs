@@ -45,7 +45,7 @@ impl PhysicalModel {
                     md.omega_n
                 ));
             }
-            if !(md.omega_n > 0.0) {
+            if md.omega_n <= 0.0 {
                 return Err(format!(
                     "{at}: omega_n = {} must be positive (rad/s)",
                     md.omega_n
