@@ -46,28 +46,14 @@ pub fn resolve_r(
         })?,
         _ => return Err(anyhow!("give both --r-num and --r-den")),
     };
-    if !r.is_unit() {
+    if let Some(why) = r.unit_violation() {
         let source = match num {
             Some(_) => "--r-num/--r-den".to_string(),
             None => format!("{}: [r]", config.path.display()),
         };
-        let why = if !r.is_biproper() {
-            format!(
-                "it is not biproper (numerator degree {}, denominator degree {})",
-                r.num.degree(),
-                r.den.degree()
-            )
-        } else if let Some(p) = r.poles().into_iter().find(|p| p.re >= 0.0) {
-            format!("it is not stable (pole at {p})")
-        } else if let Some(z) = r.zeros().into_iter().find(|z| z.re >= 0.0) {
-            format!("it is not minimum phase (zero at {z})")
-        } else {
-            "its poles or zeros are not in the open left half-plane".to_string()
-        };
         return Err(anyhow!(
-            "{source}: r = ({:?})/({:?}) is not a unit of RH∞: {why}; give equal degrees and poles and zeros in the open left half-plane",
-            r.num.coeffs(),
-            r.den.coeffs()
+            "{source}: r = {} is not a unit of RH∞: {why}; give equal degrees and poles and zeros in the open left half-plane",
+            r.brief()
         ));
     }
     Ok(r)

@@ -24,13 +24,13 @@ pub struct DiagnoseArgs {
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
     /// Most effects to add.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub max_effects: usize,
     /// Effect sets kept per level of the search.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub beam: usize,
     /// Add the K-th ranked candidate (1-based) and write the revised config (with --write).
-    #[arg(long, requires = "write")]
+    #[arg(long, requires = "write", allow_negative_numbers = true)]
     pub apply: Option<usize>,
     /// Where to write the revised config.
     #[arg(long, requires = "apply")]

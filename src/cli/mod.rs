@@ -99,10 +99,27 @@ pub fn main() -> i32 {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", one_line(&format!("{e:#}")));
+            eprintln!("error: {}", capped(&one_line(&format!("{e:#}"))));
             2
         }
     }
 }
 
 pub use crate::report::fmt::one_line;
+
+/// Longest error message printed, in characters: the start (what and where) and the end
+/// (what to do) are kept, a middle that quotes input at length is cut.
+pub const MAX_MESSAGE_CHARS: usize = 600;
+
+fn capped(msg: &str) -> String {
+    let n = msg.chars().count();
+    if n <= MAX_MESSAGE_CHARS {
+        return msg.to_string();
+    }
+    let head: String = msg.chars().take(MAX_MESSAGE_CHARS - 160).collect();
+    let tail: String = msg.chars().skip(n - 150).collect();
+    format!(
+        "{head} … [{} characters cut] … {tail}",
+        n - (MAX_MESSAGE_CHARS - 160) - 150
+    )
+}

@@ -106,6 +106,16 @@ pub fn noise_free_envelope(f: &Factorization, data: &FrfData) -> Result<Envelope
             omega: *omega,
             msg: format!("{} ({})", e.message(), data.path.display()),
         })?;
+        if r.is_nan() {
+            // Never a NaN in an output with exit 0 (an overflow that prescaling missed).
+            return Err(Error::Assumption {
+                omega: *omega,
+                msg: format!(
+                    "the smallest consistent |r| is not a number (the datum overflows the arithmetic); rescale the data ({})",
+                    data.path.display()
+                ),
+            });
+        }
         r_min.push(r);
         a1.push(at.a1_limit());
     }

@@ -37,7 +37,7 @@ impl NoisyFailure {
     pub fn message(&self) -> &'static str {
         match self {
             Self::NotSiso => "the noisy test (Theorem 4) is for SISO data and models; select a channel",
-            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the [model] entries",
+            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the model ([model] entries, or the [physical] parameters)",
             Self::JSingular => "J(jω) = 0: choose an input factor J without zeros on the jω-axis",
             Self::A6 => "assumption A6 fails: the datum φ is zero or not finite; remove this datum",
             Self::A7 => "assumption A7 fails: φ − C·M̃⁻¹·Ñ·J = 0 (the datum equals the nominal model); remove this datum",

@@ -91,6 +91,17 @@ pub fn load_data(config: &Config, data_path: &Path) -> Result<FrfData> {
     let f = &config.factorization;
     if let Some(ch) = config.raw.channel {
         let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
+        if !fits {
+            crate::data::check_channel(
+                &data.path,
+                (ch.output, ch.input),
+                (data.outputs(), data.inputs()),
+            )
+            .map_err(|e| Error::Config {
+                path: config.path.clone(),
+                msg: e.to_string(),
+            })?;
+        }
         if !fits
             && ch.output >= 1
             && ch.input >= 1

@@ -21,10 +21,7 @@ struct RFile {
 
 /// Reads the `r` of an `r.json` written by `rshape fit` or `rshape run` (keys `num`, `den`).
 pub fn read_r_json(path: &Path) -> Result<TransferFunction> {
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::util::read_text_file(path)?;
     let r: RFile = serde_json::from_str(&text).map_err(|e| {
         Error::Invalid(format!(
             "{}: {e}; expected the r.json of `rshape fit` (keys num, den)",
@@ -37,7 +34,15 @@ pub fn read_r_json(path: &Path) -> Result<TransferFunction> {
             path.display()
         )));
     }
-    Ok(TransferFunction::new(r.num, r.den))
+    let r = TransferFunction::new(r.num, r.den);
+    if let Some(why) = r.unit_violation() {
+        return Err(Error::Invalid(format!(
+            "{}: r = {} is not a unit of RH∞: {why}; Theorem 1 needs a stable, minimum-phase, biproper r (the r.json of `rshape fit` is one)",
+            path.display(),
+            r.brief()
+        )));
+    }
+    Ok(r)
 }
 
 /// The labelled bounds of a config: its `[r]` as `configured` (not for a `[closed_loop]`

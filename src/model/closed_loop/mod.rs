@@ -215,6 +215,9 @@ fn factors(
                     ));
                 }
             }
+            // A common right-half-plane zero would otherwise surface as an "unstable
+            // loop" that blames the controller's stabilizing property.
+            crate::model::coprime::check_right_coprime(&n, &d, "[closed_loop]", (kn, kd))?;
             Ok(Some(RightFactors {
                 n,
                 d,
