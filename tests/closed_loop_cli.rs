@@ -382,6 +382,7 @@ fn figure_symbols_follow_the_kind_of_data() {
                 r_min: &r_min,
                 r_min_label: "per datum",
                 failing: &failing,
+                a1_failing: &[],
                 r_configured: Some(&r),
                 r_fitted: Some(&r),
                 grid: &grid,
@@ -395,6 +396,7 @@ fn figure_symbols_follow_the_kind_of_data() {
                 title: "t",
                 omega: &omega,
                 mu: &[3.0, 0.5, 1.2, 2.0],
+                a1_failing: &[],
             },
             sym,
         )

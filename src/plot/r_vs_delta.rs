@@ -18,8 +18,11 @@ pub struct RVsDeltaInput<'a> {
     pub r_min: &'a [f64],
     /// Legend label of the per-datum values, e.g. `‖Δᵢ‖ (Theorem 2, eq. 8)`.
     pub r_min_label: &'a str,
-    /// Per datum: true when the configured `r` fails to explain it.
+    /// Per datum: true when the configured `r` fails to explain it (`|r| ≤ r_min`).
     pub failing: &'a [bool],
+    /// Per datum: true when the configured `r` breaks A1 there (`|r| ≥ σ_min(M̃)`: not
+    /// admissible); empty when unknown.
+    pub a1_failing: &'a [bool],
     /// The configured `r`, when there is one.
     pub r_configured: Option<&'a TransferFunction>,
     /// The fitted `r`, when there is one.
@@ -56,9 +59,9 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
         + usize::from(conf.is_some())
         + usize::from(fit.is_some())
         + usize::from(inp.a1_on_grid.is_some())
+        + usize::from(inp.a1_failing.iter().any(|f| *f))
         + usize::from(inp.r_min.iter().any(|r| r.is_infinite()))
         + usize::from(inp.r_min.contains(&0.0));
-    let floor = ylo;
     let (ylo, yhi) = reserve_bottom(ylo, yhi, legend_fraction(rows, SIZE.1 - 120));
 
     let mut svg = String::new();
@@ -111,16 +114,23 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                 ))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
         }
-        let pts = |want_fail: bool| -> Vec<(f64, f64)> {
-            inp.omega
-                .iter()
-                .zip(inp.r_min)
-                .zip(inp.failing)
-                .filter(|((_, r), f)| **f == want_fail && r.is_finite() && **r > 0.0)
-                .map(|((w, r), _)| (*w, style::clamp(*r, ylo, yhi)))
+        // 0: explained, 1: |r| ≤ r_min, 2: |r| > r_min but A1 fails (not admissible).
+        let class = |i: usize| -> u8 {
+            if inp.failing[i] {
+                1
+            } else if inp.a1_failing.get(i).copied().unwrap_or(false) {
+                2
+            } else {
+                0
+            }
+        };
+        let pts = |want: u8| -> Vec<(f64, f64)> {
+            (0..inp.omega.len())
+                .filter(|&i| class(i) == want && inp.r_min[i].is_finite() && inp.r_min[i] > 0.0)
+                .map(|i| (inp.omega[i], style::clamp(inp.r_min[i], ylo, yhi)))
                 .collect()
         };
-        let ok = pts(false);
+        let ok = pts(0);
         if !ok.is_empty() {
             chart
                 .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
@@ -132,7 +142,27 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                 })
                 .legend(|(x, y)| Circle::new((x + 12, y), 5, C_GREEN.filled()));
         }
-        let bad = pts(true);
+        let inadmissible = pts(2);
+        if !inadmissible.is_empty() {
+            let sq = |(x, y): (i32, i32)| [(x - 6, y - 6), (x + 6, y + 6)];
+            chart
+                .draw_series(inadmissible.iter().map(|p| {
+                    EmptyElement::at(*p)
+                        + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
+                        + Cross::new((0, 0), 4, C_PURPLE.stroke_width(2))
+                }))
+                .map_err(plot_err)?
+                .label(format!(
+                    "{}: NOT ADMISSIBLE, configured |{w}(jω)| ≥ σ_min(M̃) (A1 fails)",
+                    inp.r_min_label
+                ))
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
+                        + Cross::new((0, 0), 4, C_PURPLE.stroke_width(2))
+                });
+        }
+        let bad = pts(1);
         if !bad.is_empty() {
             chart
                 .draw_series(bad.iter().map(|p| {
@@ -177,7 +207,7 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
             .iter()
             .zip(inp.r_min)
             .filter(|(_, r)| **r == 0.0)
-            .map(|(w, _)| (*w, floor))
+            .map(|(w, _)| (*w, ylo))
             .collect();
         if !zeros.is_empty() {
             let tri = |(x, y): (i32, i32)| vec![(x - 4, y - 7), (x + 4, y - 7), (x, y)];
