@@ -107,14 +107,24 @@ fn paper_mimo_report_and_figures() {
         assert!(t.contains(label), "r_vs_delta.svg lacks `{label}`");
     }
     let t = svg_text(&out.path().join("bode.svg"));
+    // One panel per channel (2×3 grid): each named, with its own magnitude and phase axes;
+    // G21 is identically zero in the paper's model.
     for label in [
-        "magnitude |G(jω)| (absolute)",
-        "phase ∠G(jω) (degrees)",
-        "G11: nominal model (line), data (markers)",
-        "G23: nominal model (line), data (markers)",
+        "G11: output 1, input 1",
+        "G23: output 2, input 3",
+        "G21: output 2, input 1 (model ≡ 0)",
+        "|G12(jω)|",
+        "∠G22(jω) (degrees)",
+        "nominal model G(jω) (line)",
+        "measured data (markers)",
     ] {
         assert!(t.contains(label), "bode.svg lacks `{label}`");
     }
+    assert_eq!(
+        t.matches("frequency ω (rad/s)").count(),
+        6,
+        "one phase axis per channel"
+    );
     assert!(
         !t.contains("noise disk"),
         "no error bars for noise-free data"

@@ -169,8 +169,22 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
             .map(|(l, _)| l.clone())
             .zip(curve.r.iter().cloned())
             .collect();
+        // The title names the model and the controller (a figure travels without its folder).
+        let name = config
+            .raw
+            .name
+            .clone()
+            .unwrap_or_else(|| config.path.display().to_string());
+        let k = a
+            .controller
+            .file_name()
+            .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let mut title = format!("Theorem 1: 1/σ_max(T) vs |r| — {name}, K = {k}");
+        if title.chars().count() > 80 {
+            title = format!("{}…", title.chars().take(79).collect::<String>());
+        }
         let svg = stability_svg(&StabilityInput {
-            title: "Theorem 1: 1/σ_max(T) against |r|",
+            title: &title,
             omega: &curve.omega,
             inv_t: &curve.inv_t,
             r: &labelled,

@@ -147,6 +147,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
             noise_radius: out.noise_radii.as_deref(),
             grid: &grid,
             model: &model,
+            symbol: if cl { "Φ" } else { "G" },
         })?,
     ));
     if let Some(mu) = &out.mu {

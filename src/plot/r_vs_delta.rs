@@ -55,21 +55,24 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
         .chain(inp.a1_on_grid.into_iter().flatten());
     let (ylo, yhi) = log_range(ys, 2.5).unwrap_or((1e-3, 1e3));
     let (ylo, yhi) = (ylo.max(yhi * 1e-12), yhi);
-    let rows = 2
+    // the explained data, then each curve and marker kind present
+    let rows = 1
         + usize::from(conf.is_some())
         + usize::from(fit.is_some())
         + usize::from(inp.a1_on_grid.is_some())
         + usize::from(inp.a1_failing.iter().any(|f| *f))
+        + usize::from(inp.failing.iter().any(|f| *f))
         + usize::from(inp.r_min.iter().any(|r| r.is_infinite()))
         + usize::from(inp.r_min.contains(&0.0));
-    let (ylo, yhi) = reserve_bottom(ylo, yhi, legend_fraction(rows, SIZE.1 - 120));
 
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
+        let (plot, below) = root.split_vertically(SIZE.1);
+        let mut leg = Legend::default();
         let mut chart = loglog_chart(
-            &root,
+            &plot,
             inp.title,
             (xlo, xhi),
             (ylo, yhi),
@@ -88,31 +91,37 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
             let s = ShapeStyle::from(&C_PURPLE).stroke_width(2);
             chart
                 .draw_series(DashedLineSeries::new(curve(a1), 8, 5, s))
-                .map_err(plot_err)?
-                .label("A1 limit σ_min(M̃(jω)): |r| must stay below")
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+                .map_err(plot_err)?;
+            leg.add(
+                "A1 limit σ_min(M̃(jω)): |r| must stay below",
+                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+            );
         }
         if let Some(c) = &conf {
             let s = ShapeStyle::from(&C_BLUE).stroke_width(3);
             chart
                 .draw_series(LineSeries::new(curve(c), s))
-                .map_err(plot_err)?
-                .label(format!(
+                .map_err(plot_err)?;
+            leg.add(
+                format!(
                     "|{w}(jω)|, configured {w} = {}",
                     tf_label(inp.r_configured.expect("set"))
-                ))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+                ),
+                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+            );
         }
         if let Some(f) = &fit {
             let s = ShapeStyle::from(&C_ORANGE).stroke_width(3);
             chart
                 .draw_series(DashedLineSeries::new(curve(f), 12, 4, s))
-                .map_err(plot_err)?
-                .label(format!(
+                .map_err(plot_err)?;
+            leg.add(
+                format!(
                     "|{w}(jω)|, fitted {w} = {}",
                     tf_label(inp.r_fitted.expect("set"))
-                ))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+                ),
+                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+            );
         }
         // 0: explained, 1: |r| ≤ r_min, 2: |r| > r_min but A1 fails (not admissible).
         let class = |i: usize| -> u8 {
@@ -134,13 +143,15 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
         if !ok.is_empty() {
             chart
                 .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
-                .map_err(plot_err)?
-                .label(if inp.r_configured.is_some() {
+                .map_err(plot_err)?;
+            leg.add(
+                if inp.r_configured.is_some() {
                     format!("{}: explained by the configured {w}", inp.r_min_label)
                 } else {
                     inp.r_min_label.to_string()
-                })
-                .legend(|(x, y)| Circle::new((x + 12, y), 5, C_GREEN.filled()));
+                },
+                |(x, y)| Circle::new((x + 12, y), 5, C_GREEN.filled()),
+            );
         }
         let inadmissible = pts(2);
         if !inadmissible.is_empty() {
@@ -151,16 +162,18 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                         + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
                         + Cross::new((0, 0), 4, C_PURPLE.stroke_width(2))
                 }))
-                .map_err(plot_err)?
-                .label(format!(
+                .map_err(plot_err)?;
+            leg.add(
+                format!(
                     "{}: NOT ADMISSIBLE, configured |{w}(jω)| ≥ σ_min(M̃) (A1 fails)",
                     inp.r_min_label
-                ))
-                .legend(move |(x, y)| {
+                ),
+                move |(x, y)| {
                     EmptyElement::at((x + 12, y))
                         + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
                         + Cross::new((0, 0), 4, C_PURPLE.stroke_width(2))
-                });
+                },
+            );
         }
         let bad = pts(1);
         if !bad.is_empty() {
@@ -170,16 +183,18 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                         + Circle::new((0, 0), 8, C_RED.stroke_width(3))
                         + Cross::new((0, 0), 5, C_RED.stroke_width(2))
                 }))
-                .map_err(plot_err)?
-                .label(format!(
+                .map_err(plot_err)?;
+            leg.add(
+                format!(
                     "{}: FAILING, configured |{w}(jω)| ≤ {wmin}",
                     inp.r_min_label
-                ))
-                .legend(|(x, y)| {
+                ),
+                |(x, y)| {
                     EmptyElement::at((x + 12, y))
                         + Circle::new((0, 0), 7, C_RED.stroke_width(3))
                         + Cross::new((0, 0), 4, C_RED.stroke_width(2))
-                });
+                },
+            );
         }
         let infinite: Vec<(f64, f64)> = inp
             .omega
@@ -196,11 +211,11 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                         .iter()
                         .map(|p| EmptyElement::at(*p) + Polygon::new(tri((0, 0)), C_RED.filled())),
                 )
-                .map_err(plot_err)?
-                .label(format!(
-                    "{wmin} = ∞: no admissible {w} explains the datum (drawn at the top)"
-                ))
-                .legend(move |(x, y)| Polygon::new(tri((x + 12, y - 6)), C_RED.filled()));
+                .map_err(plot_err)?;
+            leg.add(
+                format!("{wmin} = ∞: no admissible {w} explains the datum (drawn at the top)"),
+                move |(x, y)| Polygon::new(tri((x + 12, y - 6)), C_RED.filled()),
+            );
         }
         let zeros: Vec<(f64, f64)> = inp
             .omega
@@ -218,14 +233,16 @@ pub fn r_vs_delta_svg_with(inp: &RVsDeltaInput, sym: &Symbols) -> Result<String>
                         .iter()
                         .map(|p| EmptyElement::at(*p) + Polygon::new(tri((0, 0)), col.filled())),
                 )
-                .map_err(plot_err)?
-                .label(format!(
+                .map_err(plot_err)?;
+            leg.add(
+                format!(
                     "{wmin} = 0 at {} data: explained by the noise alone (drawn at the bottom)",
                     zeros.len()
-                ))
-                .legend(move |(x, y)| Polygon::new(tri((x + 12, y + 4)), col.filled()));
+                ),
+                move |(x, y)| Polygon::new(tri((x + 12, y + 4)), col.filled()),
+            );
         }
-        legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+        leg.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
     Ok(svg)
