@@ -7,7 +7,8 @@ use std::path::Path;
 
 /// Writes `contents` to `path` atomically: a temporary file in the same directory is written,
 /// flushed and renamed over `path`, so a reader never sees a half-written file and a failed
-/// run leaves no output behind.
+/// run leaves no output behind.  The file's mode is 0666 less the umask, as for any file a
+/// program creates.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     write_via_temp(path, contents, true)
 }
@@ -49,7 +50,16 @@ impl AtomicFile {
             path: dir.to_path_buf(),
             source,
         })?;
-        let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|source| Error::Io {
+        // Created with mode 0666 less the umask, as `File::create` would (0644 under umask
+        // 022); tempfile's default 0600 would survive the rename and hide results from
+        // colleagues and web servers.
+        let mut builder = tempfile::Builder::new();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = builder.tempfile_in(dir).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
         })?;

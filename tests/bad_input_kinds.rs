@@ -2,7 +2,7 @@
 //! the subcommands, with what rshape must answer.  For each kind: the exit code (2 for a
 //! bad input, 0 where the input is accepted), a one-line message that names the file and
 //! line, or the frequency, or the flag, and says what to do; never a panic; no output file
-//! written or left behind on failure.  README's "Bad input" table lists the same kinds with
+//! written or left behind on failure.  docs/guide/bad-input.md's table lists the same kinds with
 //! the message each gets (`RSHAPE_BAD_INPUT_TABLE=FILE` writes the table from a run).
 mod common;
 
@@ -1168,7 +1168,7 @@ fn every_kind_gets_its_answer() {
 
 #[test]
 fn readme_lists_every_kind() {
-    let readme = std::fs::read_to_string(common::repo("README.md")).unwrap();
+    let readme = std::fs::read_to_string(common::repo("docs/guide/bad-input.md")).unwrap();
     let missing: Vec<_> = all_kinds()
         .iter()
         .map(|k| k.name)
@@ -1176,6 +1176,6 @@ fn readme_lists_every_kind() {
         .collect();
     assert!(
         missing.is_empty(),
-        "README's bad-input table lacks: {missing:?}"
+        "docs/guide/bad-input.md's table lacks: {missing:?}"
     );
 }

@@ -73,10 +73,13 @@ fn per_revision(revs: &[&str], ch: (usize, usize), est: &str, val: &str) -> [Vec
     ]
 }
 
-/// The numbers of the README tables (3 significant digits).
+/// The numbers of the tables in docs/guide/discovery.md (3 significant digits).
 fn matches_readme(got: &[f64], readme: &[f64]) {
     for (g, r) in got.iter().zip(readme) {
-        assert!((g / r - 1.0).abs() < 6e-3, "{got:?} vs README {readme:?}");
+        assert!(
+            (g / r - 1.0).abs() < 6e-3,
+            "{got:?} vs docs/guide/discovery.md {readme:?}"
+        );
     }
 }
 

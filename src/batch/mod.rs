@@ -66,7 +66,8 @@ pub struct BatchReport {
     pub n_frequencies: usize,
     /// Largest finite `r_min` of the combined envelope.
     pub max_r_min: Option<f64>,
-    /// True when the configured `r` explains every datum of every successful dataset.
+    /// True when the configured `r` explains every datum of every successful dataset and A1
+    /// holds at each (false when `r` is not admissible somewhere).
     pub consistent_all: Option<bool>,
     /// The `r` fitted above the combined envelope, as in `r.json`.
     pub r_fitted: Option<Value>,

@@ -31,8 +31,10 @@ pub struct DatasetResult {
     pub n_data: usize,
     /// Largest `r_min` (`inf` when a datum has no admissible `r`).
     pub max_r_min: Option<f64>,
-    /// True when the configured `r` explains every datum.
+    /// True when the configured `r` explains every datum and A1 holds at each.
     pub consistent: Option<bool>,
+    /// Verdict on the configured `r` (`not_admissible` when A1 fails at some datum).
+    pub verdict: Option<crate::consistency::Verdict>,
     /// Frequencies (rad/s) the configured `r` does not explain.
     pub failing_omegas: Vec<f64>,
     /// Warnings (e.g. a fallback envelope).
@@ -68,6 +70,7 @@ pub fn run_one(config: &Config, d: &Dataset, opts: &RunOptions, out: &Path) -> D
         n_data: 0,
         max_r_min: None,
         consistent: None,
+        verdict: None,
         failing_omegas: Vec::new(),
         warnings: Vec::new(),
         envelope: None,
@@ -102,6 +105,7 @@ fn fill(
     if let Some(r) = &config.r {
         let c = check(r, &env);
         res.consistent = Some(c.consistent);
+        res.verdict = Some(c.verdict);
         res.failing_omegas = c.failing_omegas;
     }
     if opts.per_dataset_files {

@@ -15,6 +15,9 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// Seconds between the progress lines of a batch whose stderr is not a terminal.
+pub const PROGRESS_EVERY: f64 = 5.0;
+
 /// Arguments of `rshape batch`.
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("source").required(true).args(["data_dir", "manifest"])))]
@@ -109,7 +112,27 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     };
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
-    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &|| bar.inc(1));
+    // Off a terminal (a log file, a pipe, a cluster job) the bar is hidden: a line on
+    // stderr every PROGRESS_EVERY seconds, and at the end, says how far the batch is.
+    let periodic = !std::io::stderr().is_terminal();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let last = std::sync::Mutex::new(Instant::now());
+    let n_sets = datasets.len();
+    let tick = || {
+        bar.inc(1);
+        let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if periodic {
+            let mut l = last.lock().unwrap_or_else(|e| e.into_inner());
+            if k == n_sets || l.elapsed().as_secs_f64() >= PROGRESS_EVERY {
+                *l = Instant::now();
+                eprintln!(
+                    "batch: {k}/{n_sets} datasets done ({:.0} s)",
+                    t.elapsed().as_secs_f64()
+                );
+            }
+        }
+    };
+    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &tick);
     let results = match a.jobs {
         // More threads than datasets only cost memory (each has its own stack).
         Some(n) => rayon::ThreadPoolBuilder::new()
@@ -126,7 +149,8 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     let combined = combine(results.iter().filter_map(|r| r.envelope.as_ref()));
     timings.insert("combine".to_string(), t.elapsed().as_secs_f64() * 1e3);
     let rows: Vec<SummaryRow> = results.iter().map(SummaryRow::from).collect();
-    if let (true, Some(c)) = (std::io::stderr().is_terminal(), &combined) {
+    if let Some(c) = &combined {
+        // The fit may take seconds: say so on a terminal and in a log alike.
         eprintln!(
             "fitting one {} above the combined envelope ({} frequencies)…",
             crate::plot::Symbols::of(config.closed_loop.is_some()).weight,

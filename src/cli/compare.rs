@@ -59,26 +59,52 @@ pub fn run_compare(
     Ok((rep, siso, model))
 }
 
-/// Formats bands for the text report.
+/// Most bands printed on the terminal; `--json` lists them all.
+pub const MAX_BANDS_SHOWN: usize = 3;
+
+/// Formats bands for the text report: all of them up to [`MAX_BANDS_SHOWN`], else the
+/// bands with the largest peak misfit (in frequency order) and a count of the others, so
+/// that a badly failing model gives a readable line instead of dozens of bands.
 pub fn fmt_bands(b: &[Band]) -> String {
     if b.is_empty() {
         return "none".into();
     }
-    b.iter()
-        .map(|b| {
-            format!(
-                "{}–{} rad/s ({}–{} Hz, {} data, peak misfit {} at {} Hz)",
-                fmt_g(b.omega_lo),
-                fmt_g(b.omega_hi),
-                fmt_g(b.omega_lo / std::f64::consts::TAU),
-                fmt_g(b.omega_hi / std::f64::consts::TAU),
-                b.count,
-                fmt_g(b.peak_misfit),
-                fmt_g(b.omega_peak / std::f64::consts::TAU)
-            )
-        })
+    let one = |b: &Band| {
+        format!(
+            "{}–{} rad/s ({}–{} Hz, {} data, peak misfit {} at {} Hz)",
+            fmt_g(b.omega_lo),
+            fmt_g(b.omega_hi),
+            fmt_g(b.omega_lo / std::f64::consts::TAU),
+            fmt_g(b.omega_hi / std::f64::consts::TAU),
+            b.count,
+            fmt_g(b.peak_misfit),
+            fmt_g(b.omega_peak / std::f64::consts::TAU)
+        )
+    };
+    if b.len() <= MAX_BANDS_SHOWN {
+        return b.iter().map(one).collect::<Vec<_>>().join("; ");
+    }
+    let mut worst: Vec<usize> = (0..b.len()).collect();
+    worst.sort_by(|&x, &y| b[y].peak_misfit.total_cmp(&b[x].peak_misfit));
+    worst.truncate(MAX_BANDS_SHOWN);
+    worst.sort_unstable();
+    let shown = worst
+        .iter()
+        .map(|&k| one(&b[k]))
         .collect::<Vec<_>>()
-        .join("; ")
+        .join("; ");
+    let rest: usize = (0..b.len())
+        .filter(|k| !worst.contains(k))
+        .map(|k| b[k].count)
+        .sum();
+    format!(
+        "{} bands, {} data, {}–{} rad/s; the {MAX_BANDS_SHOWN} worst: {shown}; {} more bands ({rest} data) in `--json` (bands)",
+        b.len(),
+        b.iter().map(|x| x.count).sum::<usize>(),
+        fmt_g(b[0].omega_lo),
+        fmt_g(b[b.len() - 1].omega_hi),
+        b.len() - MAX_BANDS_SHOWN,
+    )
 }
 
 /// Runs `rshape compare`.

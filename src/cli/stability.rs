@@ -104,7 +104,14 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     }
     let outcome = stability::run(&config, &controller, &rs, a.data.as_deref())?;
     let written = match &a.out {
-        Some(out) => stability::write_outputs(out, &outcome)?,
+        Some(out) => {
+            let k = a
+                .controller
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+            let title = stability::figure_title(&config, &format!("K = {k}"));
+            stability::write_outputs(out, &outcome, &title)?
+        }
         None => Vec::new(),
     };
     let code = if outcome.robust { 0 } else { 1 };

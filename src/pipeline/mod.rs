@@ -100,7 +100,7 @@ pub fn run(
     if let Some(c) = &check {
         if !c.a1_violations.is_empty() {
             warnings.push(format!(
-                "A1 fails for the configured r at {} datum(s): |r| ≥ σ_min(M̃)",
+                "A1 fails for the configured r at {} datum(s): |r| ≥ σ_min(M̃), so r is not admissible there (verdict not_admissible)",
                 c.a1_violations.len()
             ));
         }

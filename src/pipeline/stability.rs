@@ -137,8 +137,25 @@ pub fn run(
     })
 }
 
-/// Writes `stability.svg` and `stability.json` into `out` (atomically) and returns them.
-pub fn write_outputs(out: &Path, o: &StabilityOutcome) -> Result<Vec<PathBuf>> {
+/// The title of `stability.svg`: it names the model and the controller (a figure travels
+/// without its folder), at most 80 characters.
+pub fn figure_title(config: &Config, controller: &str) -> String {
+    let name = config
+        .raw
+        .name
+        .clone()
+        .unwrap_or_else(|| config.path.display().to_string());
+    let title = format!("Theorem 1: 1/σ_max(T) vs |r| — {name}, {controller}");
+    if title.chars().count() > 80 {
+        format!("{}…", title.chars().take(79).collect::<String>())
+    } else {
+        title
+    }
+}
+
+/// Writes `stability.svg` (titled `title`, see [`figure_title`]) and `stability.json` into
+/// `out` (atomically) and returns them.
+pub fn write_outputs(out: &Path, o: &StabilityOutcome, title: &str) -> Result<Vec<PathBuf>> {
     let labelled: Vec<(String, Vec<f64>)> = o
         .labels
         .iter()
@@ -146,7 +163,7 @@ pub fn write_outputs(out: &Path, o: &StabilityOutcome) -> Result<Vec<PathBuf>> {
         .zip(o.curve.r.iter().cloned())
         .collect();
     let svg = stability_svg(&StabilityInput {
-        title: "Theorem 1: 1/σ_max(T) against |r|",
+        title,
         omega: &o.curve.omega,
         inv_t: &o.curve.inv_t,
         r: &labelled,

@@ -279,7 +279,11 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         crate::util::write_atomic(&p, text.as_bytes())?;
         written.push(p);
     }
-    written.extend(stab::write_outputs(out, &o.stability)?);
+    written.extend(stab::write_outputs(
+        out,
+        &o.stability,
+        "Theorem 1: 1/σ_max(T) vs |r| — the synthesized controller",
+    )?);
     Ok(written)
 }
 
