@@ -755,7 +755,12 @@ fn hardening_kinds() -> Vec<Kind> {
                 "{ num = [20], den = [1, 10] }",
                 "{ num = [1, 0], den = [1, -3] }",
             ),
-            &["model.toml", "[closed_loop] d_c", "stable"],
+            &[
+                "model.toml",
+                "[closed_loop] d_c[1][1]",
+                "pole at s = 3",
+                "stable",
+            ],
         ),
         kind(
             "CLI: stability --r-json with an unstable r",
