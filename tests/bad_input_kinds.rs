@@ -755,7 +755,12 @@ fn hardening_kinds() -> Vec<Kind> {
                 "{ num = [20], den = [1, 10] }",
                 "{ num = [1, 0], den = [1, -3] }",
             ),
-            &["model.toml", "[closed_loop] d_c", "stable"],
+            &[
+                "model.toml",
+                "[closed_loop] d_c[1][1]",
+                "pole at s = 3",
+                "stable",
+            ],
         ),
         kind(
             "CLI: stability --r-json with an unstable r",
@@ -777,6 +782,27 @@ fn hardening_kinds() -> Vec<Kind> {
         .data(paper_data())
         .file("k.toml", k_toml)
         .file("r.json", high_degree_r()),
+        kind(
+            "CLI: stability --r-json of degree 300",
+            2,
+            "stability {dir}/model.toml --controller {dir}/k.toml --r-json {dir}/r.json",
+            &["r.json", "degree 300", "lower order"],
+        )
+        .config(paper_config())
+        .data(paper_data())
+        .file("k.toml", k_toml)
+        .file("r.json", degree_300_r()),
+        kind(
+            "CLI: run on an unstable M̃ issues no certificate",
+            2,
+            "run {dir}/model.toml --out {dir}/out",
+            &["[model] m[1][1]", "pole at s = 1"],
+        )
+        .config(factors(
+            "{ num = [1, 2], den = [1, -1] }",
+            "{ num = [1], den = [1, 1] }",
+        ))
+        .data(siso_data("", &[])),
         siso_csv(
             "CSV: a datum of 1e308+1e308j",
             0,
@@ -968,6 +994,19 @@ fn high_degree_r() -> String {
         let z = if k == 0 { 0.5 } else { -1.0 - k as f64 / 10.0 };
         num = poly_mul(&num, &[1.0, -z]);
         den = poly_mul(&den, &[1.0, 2.0 + k as f64 / 10.0]);
+    }
+    format!("{{\"num\": {num:?}, \"den\": {den:?}}}")
+}
+
+/// A unit `r` of degree 300 (poles on the circle of radius 1, zeros on that of radius 1.5,
+/// all in the left half-plane): its coefficients reach 1e104, beyond what the root
+/// iteration resolves, and there are 602 of them to (not) quote.
+fn degree_300_r() -> String {
+    let (mut num, mut den) = (vec![1.0f64], vec![1.0f64]);
+    for k in 0..150 {
+        let c = (std::f64::consts::PI * (0.5 + (k as f64 + 0.5) / 300.0)).cos();
+        num = poly_mul(&num, &[1.0, -3.0 * c, 2.25]);
+        den = poly_mul(&den, &[1.0, -2.0 * c, 1.0]);
     }
     format!("{{\"num\": {num:?}, \"den\": {den:?}}}")
 }

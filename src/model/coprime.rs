@@ -15,10 +15,12 @@
 //! precision counts as in the half-plane) the rank of `[M̃ Ñ](z)` is tested, and at `∞` the
 //! rank of `[M̃(∞) Ñ(∞)]`.
 //!
-//! **Tolerance.**  The rank is deficient when `σ_min([M̃ Ñ](z)) ≤ 10⁻⁶·S(z)`, where `S(z)`
-//! is the Frobenius norm of the entries' evaluation scales `Σ|a_k||z|^k / |den(z)|` (the
-//! size an entry's value would have without cancellation; at a zero of `M̃` its own value
-//! is no scale).  A common zero to about six digits is therefore refused (the data could
+//! **Tolerance.**  Each entry has an evaluation scale `S_ij(z) = Σ|a_k||z|^k / |den(z)|`
+//! (the size its value would have without cancellation; at a zero of `M̃` its own value is
+//! no scale).  The rows of `[M̃ Ñ](z)` are divided by their largest scale, then the columns
+//! by theirs (a diagonal scaling on either side keeps the rank, and makes the test blind to
+//! units: an `Ñ` of gain 1e-8 is as coprime as one of gain 1).  The rank is deficient when
+//! the smallest singular value of the equilibrated matrix is `≤ 10⁻⁶`.  A common zero to about six digits is therefore refused (the data could
 //! not tell it from an exact one, and a multiple root is computed only to about `√ε`),
 //! while factors whose zeros differ by `10⁻³` relative are accepted.
 //! The right-coprimeness of a pair `(N, D)` (`K = N D⁻¹`, as in `[closed_loop]`) is the
@@ -167,15 +169,37 @@ fn candidate_zeros(m: &TfMatrix) -> Result<Vec<Complex64>, String> {
     Ok(out)
 }
 
-fn rank_drop(rows: &DMatrix<Complex64>, scale: f64) -> Option<(usize, f64)> {
-    let svd = rows.clone().svd(true, false);
+/// Row rank test of `value` with entry scales `scale` (`S_ij ≥ 0`).  Rows and columns are
+/// first equilibrated by their largest scales (`r_i`, then `c_j`): a diagonal scaling on
+/// either side keeps the rank and makes the test independent of units (an `Ñ` of gain 1e-8
+/// beside an `M̃` of gain 1 is as coprime as with gain 1).  A row whose scales are all zero
+/// vanishes identically.  `Some((row, σ_min))` when `σ_min ≤ COPRIME_TOL`.
+fn rank_drop(value: &DMatrix<Complex64>, scale: &DMatrix<f64>) -> Option<(usize, f64)> {
+    let (p, q) = value.shape();
+    let r: Vec<f64> = (0..p)
+        .map(|i| (0..q).map(|j| scale[(i, j)]).fold(0.0, f64::max))
+        .collect();
+    if let Some(i) = r.iter().position(|x| !(*x > 0.0 && x.is_finite())) {
+        return Some((i, 0.0));
+    }
+    let c: Vec<f64> = (0..q)
+        .map(|j| (0..p).map(|i| scale[(i, j)] / r[i]).fold(0.0, f64::max))
+        .collect();
+    let rows = DMatrix::from_fn(p, q, |i, j| {
+        if c[j] > 0.0 {
+            value[(i, j)] / (r[i] * c[j])
+        } else {
+            Complex64::new(0.0, 0.0)
+        }
+    });
+    let svd = rows.svd(true, false);
     let (k, smin) = svd
         .singular_values
         .iter()
         .copied()
         .enumerate()
         .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    let ratio = smin / scale.max(1e-300);
+    let ratio = smin;
     if ratio.is_finite() && ratio > COPRIME_TOL {
         return None;
     }
@@ -201,7 +225,7 @@ pub fn common_zero(m: &TfMatrix, n: &TfMatrix) -> Result<Option<CommonZero>, Str
         })
     };
     let inf = all(&|t| Complex64::new(t.at_infinity(), 0.0));
-    if let Some((row, ratio)) = rank_drop(&inf, inf.norm()) {
+    if let Some((row, ratio)) = rank_drop(&inf, &inf.map(|x| x.norm())) {
         return Ok(Some(CommonZero {
             at: None,
             row,
@@ -210,8 +234,8 @@ pub fn common_zero(m: &TfMatrix, n: &TfMatrix) -> Result<Option<CommonZero>, Str
     }
     for z in candidate_zeros(m)? {
         let value = all(&|t| t.eval(z));
-        let scale = all(&|t| Complex64::new(scale_at(t, z), 0.0)).norm();
-        if let Some((row, ratio)) = rank_drop(&value, scale) {
+        let scale = all(&|t| Complex64::new(scale_at(t, z), 0.0)).map(|x| x.re);
+        if let Some((row, ratio)) = rank_drop(&value, &scale) {
             return Ok(Some(CommonZero {
                 at: Some(z),
                 row,
@@ -280,7 +304,7 @@ fn report(z: Option<CommonZero>, table: &str, place: &str, side: &str) -> Result
     let place = place.replace("{}", &(z.row + 1).to_string());
     Err(match z.at {
         Some(s) => format!(
-            "{table}: the factors have a common zero at s = {} (Re s ≥ 0, {place}; rank test σ_min/scale = {:.1e} ≤ {COPRIME_TOL:.0e}): they are not {side} coprime; cancel the common factor",
+            "{table}: the factors have a common zero at s = {} (Re s ≥ 0, {place}; equilibrated σ_min = {:.1e} ≤ {COPRIME_TOL:.0e}): they are not {side} coprime; cancel the common factor",
             fmt_s(s),
             z.ratio
         ),
@@ -320,7 +344,7 @@ mod tests {
     fn common_rhp_zero_is_refused_and_a_near_one_by_the_tolerance() {
         assert!(near(0.0).unwrap_err().contains("common zero at s = 1"));
         assert!(near(1e-9).is_err());
-        // Cross-check by the closed form: at s = 1, σ_min = |Ñ(1)| = δ/4, scale ≈ 1.1.
+        // Closed form: at s = 1, Ñ(1) = −δ/4 with scale ≈ 1/2, so the equilibrated σ_min ≈ δ/2.
         assert!(near(1e-3).is_ok());
         assert!(near(-0.5).is_ok());
     }
@@ -338,6 +362,25 @@ mod tests {
         // Both vanish at the origin: not coprime.
         let n = one(&[1.0, 0.0], &[1.0, 2.0, 1.0]);
         assert!(check_left_coprime(&m, &n, "[model]", ("m", "n")).is_err());
+    }
+
+    #[test]
+    fn units_do_not_decide_coprimeness() {
+        // Ñ of gain 1e-8 (or 1e8) beside M̃ = (s − 1)/(s + 1): coprime whatever the units.
+        for g in [1e-8, 1e8] {
+            let m = one(&[1.0, -1.0], &[1.0, 1.0]);
+            let n = one(&[g], &[1.0, 2.0, 1.0]);
+            assert!(
+                check_left_coprime(&m, &n, "[model]", ("m", "n")).is_ok(),
+                "{g}"
+            );
+            // … and a common zero stays common at any gain.
+            let n = one(&[g, -g], &[1.0, 2.0, 1.0]);
+            assert!(
+                check_left_coprime(&m, &n, "[model]", ("m", "n")).is_err(),
+                "{g}"
+            );
+        }
     }
 
     #[test]
