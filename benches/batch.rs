@@ -65,6 +65,7 @@ fn batch_1000(bencher: divan::Bencher) {
                 combined.as_ref(),
                 batch::FinishInput {
                     config: config.path.clone(),
+                    config_digest: None,
                     r_configured: config.r.as_ref(),
                     n_total: list.len(),
                     shard: Shard::ALL,

@@ -7,7 +7,8 @@ use std::path::Path;
 
 /// Writes `contents` to `path` atomically: a temporary file in the same directory is written,
 /// flushed and renamed over `path`, so a reader never sees a half-written file and a failed
-/// run leaves no output behind.
+/// run leaves no output behind.  The file's mode is 0666 less the umask, as for any file a
+/// program creates.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     write_via_temp(path, contents, true)
 }
@@ -49,7 +50,16 @@ impl AtomicFile {
             path: dir.to_path_buf(),
             source,
         })?;
-        let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|source| Error::Io {
+        // Created with mode 0666 less the umask, as `File::create` would (0644 under umask
+        // 022); tempfile's default 0600 would survive the rename and hide results from
+        // colleagues and web servers.
+        let mut builder = tempfile::Builder::new();
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o666));
+        }
+        let tmp = builder.tempfile_in(dir).map_err(|source| Error::Io {
             path: path.to_path_buf(),
             source,
         })?;
@@ -108,7 +118,11 @@ fn record(path: &Path) {
 /// A run that fails or is killed thus leaves complete files of its own, never stale ones,
 /// and the next run clears them.
 pub struct OutputManifest {
-    _private: (),
+    /// The manifest file.
+    list: std::path::PathBuf,
+    /// The folders `begin` created, deepest first: removed again when the run wrote
+    /// nothing (a failed run leaves no empty `out/` behind).
+    created: Vec<std::path::PathBuf>,
 }
 
 impl OutputManifest {
@@ -121,7 +135,13 @@ impl OutputManifest {
             let path = path.to_path_buf();
             move |source| Error::Io { path, source }
         };
-        std::fs::create_dir_all(dir).map_err(io(dir))?;
+        let created: Vec<std::path::PathBuf> = dir
+            .ancestors()
+            .filter(|a| !a.as_os_str().is_empty())
+            .take_while(|a| !a.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        std::fs::create_dir_all(dir).map_err(|source| create_dir_error(dir, source))?;
         let dir = std::path::absolute(dir).map_err(io(dir))?;
         let list = dir.join(Self::FILE);
         if let Ok(old) = std::fs::read_to_string(&list) {
@@ -142,7 +162,7 @@ impl OutputManifest {
         }
         let manifest = std::fs::File::create(&list).map_err(io(&list))?;
         *RECORDING.lock().unwrap_or_else(|e| e.into_inner()) = Some((dir, manifest));
-        Ok(Self { _private: () })
+        Ok(Self { list, created })
     }
 }
 
@@ -151,5 +171,122 @@ impl Drop for OutputManifest {
         if let Some((_, manifest)) = RECORDING.lock().unwrap_or_else(|e| e.into_inner()).take() {
             let _ = manifest.sync_all();
         }
+        // Nothing written (the run failed before its first output): no empty manifest and
+        // no folder of ours stays behind.  `remove_dir` only removes empty folders.
+        if std::fs::metadata(&self.list).is_ok_and(|m| m.len() == 0) {
+            let _ = std::fs::remove_file(&self.list);
+            for d in &self.created {
+                let _ = std::fs::remove_dir(d);
+            }
+        }
     }
+}
+
+/// The error of creating an output folder: `create_dir_all` reports `NotFound` where a
+/// parent is not a place for folders at all (under `/proc`, a file, …), which would read as
+/// "not found: check the path"; name what failed instead.
+fn create_dir_error(dir: &Path, source: std::io::Error) -> Error {
+    let parent_exists = dir
+        .ancestors()
+        .skip(1)
+        .find(|a| a.exists() || a.as_os_str().is_empty())
+        .is_some_and(|a| !a.as_os_str().is_empty() && a.is_dir());
+    if source.kind() == std::io::ErrorKind::NotFound && parent_exists {
+        return Error::Invalid(format!(
+            "{}: the folder cannot be created there (the file system refuses new folders): choose a writable location",
+            dir.display()
+        ));
+    }
+    Error::Io {
+        path: dir.to_path_buf(),
+        source,
+    }
+}
+
+/// Opens `path` for reading, refusing anything but a regular file (after symlinks): a FIFO
+/// without a writer would block forever, and `/dev/zero` or `/dev/urandom` never end.
+pub fn open_regular(path: &Path) -> Result<std::fs::File> {
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(io(std::io::Error::from(std::io::ErrorKind::IsADirectory)));
+    }
+    if !meta.is_file() {
+        return Err(Error::Invalid(format!(
+            "{}: not a regular file ({}): give a file on disk",
+            path.display(),
+            file_kind(&meta)
+        )));
+    }
+    std::fs::File::open(path).map_err(io)
+}
+
+/// Reads a whole regular file ([`open_regular`]) of at most `cap` bytes.
+pub fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let file = open_regular(path)?;
+    let mut bytes = Vec::new();
+    file.take(cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|source| Error::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    if bytes.len() as u64 > cap {
+        return Err(Error::Invalid(format!(
+            "{}: larger than {} MB: is this the right file?",
+            path.display(),
+            cap >> 20
+        )));
+    }
+    Ok(bytes)
+}
+
+/// Largest config, controller or `r.json` read whole.
+pub const MAX_TEXT_FILE: u64 = 64 << 20;
+
+/// Largest data file read whole (closed-loop data, noise std files, envelope files; the
+/// FRF files of `envelope` are streamed and have no such cap).
+pub const MAX_DATA_FILE: u64 = 1 << 30;
+
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_fifo() {
+            return "a named pipe (FIFO)";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    let _ = meta;
+    "not a file"
+}
+
+/// Input text quoted in a message: at most [`ECHO_CHARS`] characters, `…` marking a cut,
+/// so a huge field never becomes a huge message.
+pub fn echo(s: &str) -> String {
+    match s.char_indices().nth(ECHO_CHARS) {
+        Some((k, _)) => format!("{}…", &s[..k]),
+        None => s.to_string(),
+    }
+}
+
+/// Characters of input quoted in a message ([`echo`]).
+pub const ECHO_CHARS: usize = 40;
+
+/// A whole UTF-8 text file (a regular file of at most [`MAX_TEXT_FILE`] bytes).
+pub fn read_text_file(path: &Path) -> Result<String> {
+    String::from_utf8(read_regular(path, MAX_TEXT_FILE)?).map_err(|_| Error::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::from(std::io::ErrorKind::InvalidData),
+    })
 }

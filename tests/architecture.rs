@@ -47,3 +47,63 @@ fn no_library_module_imports_the_cli() {
         offenders.join("\n")
     );
 }
+
+/// The library does not depend on the CLI's crates: clap, indicatif and anyhow are optional
+/// dependencies enabled only by the `cli` feature (which the binary requires), and no library
+/// source names them.
+#[test]
+fn the_library_does_not_depend_on_clap_indicatif_or_anyhow() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let manifest: toml::Value = std::fs::read_to_string(root.join("Cargo.toml"))
+        .expect("Cargo.toml")
+        .parse()
+        .expect("Cargo.toml parses");
+    let cli_crates = ["clap", "indicatif", "anyhow"];
+    for name in cli_crates {
+        let dep = &manifest["dependencies"][name];
+        assert_eq!(
+            dep.get("optional").and_then(|v| v.as_bool()),
+            Some(true),
+            "{name} must be an optional dependency (feature `cli`)"
+        );
+    }
+    let cli_feature: Vec<&str> = manifest["features"]["cli"]
+        .as_array()
+        .expect("feature cli")
+        .iter()
+        .filter_map(|v| v.as_str())
+        .collect();
+    for name in cli_crates {
+        assert!(cli_feature.contains(&format!("dep:{name}").as_str()));
+    }
+    let bins = manifest["bin"].as_array().expect("[[bin]]");
+    assert!(bins.iter().all(|b| b["required-features"]
+        .as_array()
+        .is_some_and(|f| f.iter().any(|x| x.as_str() == Some("cli")))));
+
+    let src = root.join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let cli_dir = src.join("cli");
+    let mut offenders = Vec::new();
+    for f in files {
+        if f.starts_with(&cli_dir) || f.ends_with("main.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).expect("source is UTF-8");
+        for (i, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if cli_crates
+                .iter()
+                .any(|c| code.contains(&format!("{c}::")) || code.contains(&format!("use {c}")))
+            {
+                offenders.push(format!("{}:{}: {}", f.display(), i + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "library modules use CLI crates:\n{}",
+        offenders.join("\n")
+    );
+}

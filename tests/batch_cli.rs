@@ -78,10 +78,19 @@ fn corrupt_dataset_exit_3_others_complete() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    // Piped: no progress bar (no control characters), but plain progress lines that end
+    // with every dataset done, and a line before the fit.
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!e.contains('\r') && !e.contains('\u{1b}'), "{e}");
     assert!(
-        o.stderr.is_empty(),
-        "no progress bar when piped: {}",
-        String::from_utf8_lossy(&o.stderr)
+        e.lines()
+            .all(|l| l.starts_with("batch: ") || l.starts_with("fitting one r")),
+        "{e}"
+    );
+    assert!(e.contains("batch: 4/4 datasets done"), "{e}");
+    assert!(
+        e.contains("fitting one r above the combined envelope"),
+        "{e}"
     );
     let r = rows(out.path());
     let names: Vec<&str> = r.iter().map(|r| r[1].as_str()).collect();

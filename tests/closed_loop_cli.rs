@@ -107,6 +107,13 @@ fn run_writes_the_closed_loop_report_and_figures() {
     assert!(t.contains("Closed loop") && t.contains("Thm 2"), "{t}");
     assert!(svg_text(&out.join("mu.svg")).contains("μ_Δs"));
     assert!(!t.contains("A1 limit"));
+    // The closed-loop Bode figure names the measured response Φ, never G.
+    let b = svg_text(&out.join("bode.svg"));
+    assert!(
+        b.contains("|Φ(jω)|") && b.contains("nominal model Φ(jω)"),
+        "{b}"
+    );
+    assert!(!b.contains("G(jω)"), "{b}");
     // The figures and the summary say V and |Δ̄| (the closed-loop names), never r or ‖Δ‖.
     let m = svg_text(&out.join("mu.svg"));
     for want in [
@@ -382,6 +389,7 @@ fn figure_symbols_follow_the_kind_of_data() {
                 r_min: &r_min,
                 r_min_label: "per datum",
                 failing: &failing,
+                a1_failing: &[],
                 r_configured: Some(&r),
                 r_fitted: Some(&r),
                 grid: &grid,
@@ -395,6 +403,7 @@ fn figure_symbols_follow_the_kind_of_data() {
                 title: "t",
                 omega: &omega,
                 mu: &[3.0, 0.5, 1.2, 2.0],
+                a1_failing: &[],
             },
             sym,
         )

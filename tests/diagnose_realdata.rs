@@ -104,10 +104,13 @@ fn per_revision(revs: &[&str], ch: (usize, usize), est: &str, val: &str) -> [Vec
     ]
 }
 
-/// The numbers of the README tables (3 significant digits).
+/// The numbers of the tables in docs/guide/discovery.md (3 significant digits).
 fn matches_readme(got: &[f64], readme: &[f64]) {
     for (g, r) in got.iter().zip(readme) {
-        assert!((g / r - 1.0).abs() < 6e-3, "{got:?} vs README {readme:?}");
+        assert!(
+            (g / r - 1.0).abs() < 6e-3,
+            "{got:?} vs docs/guide/discovery.md {readme:?}"
+        );
     }
 }
 
@@ -198,7 +201,10 @@ fn motor_bench_experiments_disagree_beyond_their_noise() {
         let r = data_vs_data(&sa, &sb).unwrap();
         println!("{ch:?}: {r:?}");
         assert_eq!(r.n_common, 60);
-        assert_eq!(r.verdict, "disagree");
+        assert_eq!(
+            r.verdict,
+            rshape::diagnose::agreement::AgreementVerdict::Disagree
+        );
         assert!(r.disagree_fraction > 0.3 && r.distance_rms > 2.0, "{r:?}");
     }
 }

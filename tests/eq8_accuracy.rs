@@ -1519,3 +1519,37 @@ const CASES: &[Case] = &[
         r_min: 1.7320508075688772932,
     },
 ];
+
+/// Data at the edge of f64 (issue 23: `1e308 + 1e308j` gave NaN).  SISO closed form:
+/// `r_min = |Ñ − M̃φ|/√(1 + |φ|²)`, evaluated here with `φ` factored out
+/// (`|Ñ/φ − M̃|/√(1/|φ|² + 1)`), so it never overflows: an independent route.
+#[test]
+fn eq8_at_the_edge_of_f64_matches_the_scalar_closed_form() {
+    let m = Complex64::new(1.2, -0.4);
+    let n = Complex64::new(0.3, 0.7);
+    for phi in [
+        Complex64::new(1e308, 1e308),
+        Complex64::new(-1.7e308, 3.0),
+        Complex64::new(0.0, 1e300),
+        Complex64::new(1e154, -1e154),
+        Complex64::new(2.5, -1e-300),
+    ] {
+        let f = FactorsAt::new(
+            DMatrix::identity(1, 1),
+            DMatrix::from_element(1, 1, m),
+            DMatrix::from_element(1, 1, n),
+            vec![Complex64::new(1.0, 0.0)],
+        );
+        let r = r_min_standard(&f, &DMatrix::from_element(1, 1, phi)).unwrap();
+        let a = phi.norm();
+        let want = if a > 1.0 {
+            (n / phi - m).norm() / (1.0 / (a * a) + 1.0).sqrt()
+        } else {
+            (n - m * phi).norm() / (1.0 + a * a).sqrt()
+        };
+        assert!(
+            r.is_finite() && (r - want).abs() <= 1e-14 * want,
+            "φ = {phi}: r_min {r} vs closed form {want}"
+        );
+    }
+}

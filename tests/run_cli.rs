@@ -107,14 +107,24 @@ fn paper_mimo_report_and_figures() {
         assert!(t.contains(label), "r_vs_delta.svg lacks `{label}`");
     }
     let t = svg_text(&out.path().join("bode.svg"));
+    // One panel per channel (2×3 grid): each named, with its own magnitude and phase axes;
+    // G21 is identically zero in the paper's model.
     for label in [
-        "magnitude |G(jω)| (absolute)",
-        "phase ∠G(jω) (degrees)",
-        "G11: nominal model (line), data (markers)",
-        "G23: nominal model (line), data (markers)",
+        "G11: output 1, input 1",
+        "G23: output 2, input 3",
+        "G21: output 2, input 1 (model ≡ 0)",
+        "|G12(jω)|",
+        "∠G22(jω) (degrees)",
+        "nominal model G(jω) (line)",
+        "measured data (markers)",
     ] {
         assert!(t.contains(label), "bode.svg lacks `{label}`");
     }
+    assert_eq!(
+        t.matches("frequency ω (rad/s)").count(),
+        6,
+        "one phase axis per channel"
+    );
     assert!(
         !t.contains("noise disk"),
         "no error bars for noise-free data"
@@ -161,25 +171,35 @@ fn robot_noisy_run() {
     assert!(t.contains("noise disk"));
     assert!(certified(&rep["r_fitted"]));
     if rep["method"] == "theorem4_mu" {
-        // The configured r = (5e-4 s + 75)/(s + 1) explains the synthetic data with L_a = 0.06
-        // (μ_Γ > 1 at every datum, Theorem 4), though it breaks A1 (see robot.toml).
-        assert_eq!(rep["consistent"], true);
+        // The configured r = (5e-4 s + 75)/(s + 1) has μ_Γ > 1 at every datum (Theorem 4 with
+        // L_a = 0.06) but breaks A1 at 205 of the 211 data (see robot.toml): r is not
+        // admissible there, so the verdict is `not_admissible`, never "consistent".
+        assert_eq!(rep["verdict"], "not_admissible");
+        assert_eq!(rep["consistent"], false);
         assert_eq!(rep["failing_omegas"], serde_json::json!([]));
         let pts = rep["data_points"].as_array().unwrap();
         assert!(pts.iter().all(|d| d["mu"].as_f64().unwrap() > 1.0));
-        assert!(!rep["a1_violations"].as_array().unwrap().is_empty());
+        assert_eq!(rep["a1_violations"].as_array().unwrap().len(), 205);
+        assert_eq!(
+            pts.iter().filter(|d| d["a1_ok"] == false).count(),
+            205,
+            "per-datum a1_ok agrees with a1_violations"
+        );
         let mu = out.path().join("mu.svg");
         let t = svg_text(&mu);
         for label in [
             "μ = 1",
-            "μ_Γ per datum, configured r (consistent)",
             "μ_Γ (dimensionless)",
+            "μ_Γ > 1 but A1 fails (205 data): configured r NOT ADMISSIBLE",
+            // the 6 data above 57 rad/s, where A1 holds
+            "μ_Γ per datum, configured r (consistent)",
         ] {
             assert!(t.contains(label), "mu.svg lacks `{label}`");
         }
         assert!(!t.contains("FAILING"));
         let t = svg_text(&out.path().join("r_vs_delta.svg"));
         assert!(t.contains("μ bisection (Thm 4)"));
+        assert!(t.contains("NOT ADMISSIBLE, configured |r(jω)| ≥ σ_min(M̃) (A1 fails)"));
         for f in ["r.m", "r.py", "r.jl"] {
             assert!(out.path().join(f).is_file(), "{f} missing");
         }
@@ -214,6 +234,7 @@ fn mu_figure_has_the_line_and_failing_data() {
         title: "t",
         omega: &omega,
         mu: &mu,
+        a1_failing: &[],
     })
     .unwrap();
     let dir = tempfile::tempdir().unwrap();

@@ -62,7 +62,9 @@ pub fn from_dir(dir: &Path) -> Result<Vec<Dataset>> {
     })?;
     let mut paths: Vec<PathBuf> = rd
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.is_file() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
+        // Every *.csv entry but folders: a FIFO or a device named *.csv becomes a failed
+        // dataset (the reader refuses it), never a silently smaller batch.
+        .filter(|p| !p.is_dir() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
         .collect();
     paths.sort();
     if paths.is_empty() {

@@ -12,10 +12,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 fn read(path: &Path) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    crate::util::read_text_file(path)
 }
 
 /// What a merge found besides the report.
@@ -61,6 +58,21 @@ pub fn merge_then(
             Error::Invalid(format!("{}: not a batch.json of rshape: {e}", bj.display()))
         })?;
         if let Some(f) = &first {
+            // Shards of different configs would mix two models' envelopes under one r.
+            let differ = match (&f.config_digest, &rep.config_digest) {
+                (Some(a), Some(b)) => a != b,
+                _ => f.config != rep.config,
+            } || f.closed_loop != rep.closed_loop;
+            if differ {
+                return Err(Error::Invalid(format!(
+                    "{}: this shard was made from the config {} ({}), the first one from {} ({}): merge only the shards of one batch (same config)",
+                    dir.display(),
+                    rep.config.display(),
+                    rep.config_digest.as_deref().unwrap_or("no digest"),
+                    f.config.display(),
+                    f.config_digest.as_deref().unwrap_or("no digest")
+                )));
+            }
             if f.n_total != rep.n_total {
                 return Err(Error::Invalid(format!(
                     "{}: this shard comes from a batch of {} datasets, the first one from a batch of {}",
@@ -105,6 +117,7 @@ pub fn merge_then(
         combined.as_ref(),
         FinishInput {
             config: first.config.clone(),
+            config_digest: first.config_digest.clone(),
             r_configured: r.as_ref(),
             n_total: first.n_total,
             shard: Shard::ALL,

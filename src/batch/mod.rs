@@ -44,6 +44,10 @@ pub struct BatchReport {
     pub rshape_version: String,
     /// The config file.
     pub config: PathBuf,
+    /// FNV-1a digest of the config file's bytes (`merge` refuses shards of different
+    /// configs); absent in outputs of older versions.
+    #[serde(default)]
+    pub config_digest: Option<String>,
     /// The configured `r`, if any.
     pub r_configured: Option<CoeffsOwned>,
     /// Datasets in the full (unsharded) list.
@@ -62,7 +66,8 @@ pub struct BatchReport {
     pub n_frequencies: usize,
     /// Largest finite `r_min` of the combined envelope.
     pub max_r_min: Option<f64>,
-    /// True when the configured `r` explains every datum of every successful dataset.
+    /// True when the configured `r` explains every datum of every successful dataset and A1
+    /// holds at each (false when `r` is not admissible somewhere).
     pub consistent_all: Option<bool>,
     /// The `r` fitted above the combined envelope, as in `r.json`.
     pub r_fitted: Option<Value>,
@@ -105,6 +110,8 @@ impl From<&TransferFunction> for CoeffsOwned {
 pub struct FinishInput<'a> {
     /// The config file.
     pub config: PathBuf,
+    /// Digest of the config file ([`config_digest`]).
+    pub config_digest: Option<String>,
     /// The configured `r`.
     pub r_configured: Option<&'a TransferFunction>,
     /// Datasets in the full list.
@@ -121,6 +128,16 @@ pub struct FinishInput<'a> {
     pub factorization: Option<&'a crate::model::Factorization>,
     /// Closed-loop data (the weight is `V`).
     pub closed_loop: bool,
+}
+
+/// A 64-bit FNV-1a digest (hex) of the config file's bytes: shards whose configs differ in
+/// any byte are not merged.  `None` when the file cannot be read.
+pub fn config_digest(path: &Path) -> Option<String> {
+    let bytes = std::fs::read(path).ok()?;
+    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    Some(format!("{h:016x}"))
 }
 
 /// The batch-wide stage, shared by `batch` and `merge`: fits one `r` above the combined
@@ -154,6 +171,7 @@ pub fn finish(
     let report = BatchReport {
         rshape_version: env!("CARGO_PKG_VERSION").to_string(),
         config: inp.config,
+        config_digest: inp.config_digest,
         r_configured: inp.r_configured.map(CoeffsOwned::from),
         n_total: inp.n_total,
         shard: inp.shard,

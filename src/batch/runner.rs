@@ -2,12 +2,14 @@
 //! noisy data) and the check of the configured `r`, each written to
 //! `OUT/datasets/NAME/`.  A failing dataset becomes a failed row; the others complete.
 //! Results come back in dataset order whatever the scheduling (rayon's indexed collect).
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::discover::Dataset;
 use crate::consistency::{check, Envelope};
 use crate::error::{Error, Result};
 use crate::model::Config;
-use crate::pipeline::integration;
 use crate::report::envelope_csv;
 use crate::util::write_atomic_nosync;
 use rayon::prelude::*;
@@ -29,8 +31,10 @@ pub struct DatasetResult {
     pub n_data: usize,
     /// Largest `r_min` (`inf` when a datum has no admissible `r`).
     pub max_r_min: Option<f64>,
-    /// True when the configured `r` explains every datum.
+    /// True when the configured `r` explains every datum and A1 holds at each.
     pub consistent: Option<bool>,
+    /// Verdict on the configured `r` (`not_admissible` when A1 fails at some datum).
+    pub verdict: Option<crate::consistency::Verdict>,
     /// Frequencies (rad/s) the configured `r` does not explain.
     pub failing_omegas: Vec<f64>,
     /// Warnings (e.g. a fallback envelope).
@@ -66,6 +70,7 @@ pub fn run_one(config: &Config, d: &Dataset, opts: &RunOptions, out: &Path) -> D
         n_data: 0,
         max_r_min: None,
         consistent: None,
+        verdict: None,
         failing_omegas: Vec::new(),
         warnings: Vec::new(),
         envelope: None,
@@ -84,7 +89,7 @@ fn fill(
     out: &Path,
     res: &mut DatasetResult,
 ) -> Result<()> {
-    let data = crate::pipeline::closed_loop::read_data(config, &d.path)?;
+    let data = crate::pipeline::envelope::load_data(config, &d.path)?;
     if data.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no data rows",
@@ -92,14 +97,15 @@ fn fill(
         )));
     }
     res.n_data = data.len();
-    let radii = integration::noise_radii(config, &data, d.noise_radius.or(opts.noise_radius))?;
-    let (env, warnings, _) =
-        crate::pipeline::closed_loop::envelope(config, &data, radii.as_deref())?;
-    res.warnings = warnings;
+    let outcome =
+        crate::pipeline::envelope::envelope(config, &data, d.noise_radius.or(opts.noise_radius))?;
+    let env = outcome.envelope;
+    res.warnings = outcome.warnings;
     res.max_r_min = env.r_min.iter().copied().reduce(f64::max);
     if let Some(r) = &config.r {
         let c = check(r, &env);
         res.consistent = Some(c.consistent);
+        res.verdict = Some(c.verdict);
         res.failing_omegas = c.failing_omegas;
     }
     if opts.per_dataset_files {

@@ -15,6 +15,9 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// Seconds between the progress lines of a batch whose stderr is not a terminal.
+pub const PROGRESS_EVERY: f64 = 5.0;
+
 /// Arguments of `rshape batch`.
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("source").required(true).args(["data_dir", "manifest"])))]
@@ -36,9 +39,9 @@ pub struct BatchArgs {
     /// Process every N-th dataset starting at K (0-based), e.g. --shard $SLURM_ARRAY_TASK_ID/8.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    pub jobs: Option<usize>,
+    /// Worker threads (default: all cores; at most 1024, and never more than datasets).
+    #[arg(long, allow_negative_numbers = true)]
+    pub jobs: Option<i64>,
     /// Order of the r fitted above the combined envelope, or `auto` (sweep 0..8).
     #[arg(long, default_value = "auto", allow_negative_numbers = true)]
     pub order: crate::fit::OrderChoice,
@@ -47,9 +50,19 @@ pub struct BatchArgs {
     pub no_dataset_files: bool,
 }
 
+/// Largest `--jobs`: beyond this, threads cost memory and start-up time and buy nothing.
+pub const MAX_JOBS: i64 = 1024;
+
 /// Runs `rshape batch`.
 pub fn run(a: &BatchArgs) -> Result<i32> {
     let t0 = Instant::now();
+    if let Some(j) = a.jobs {
+        if !(1..=MAX_JOBS).contains(&j) {
+            return Err(anyhow!(
+                "--jobs {j}: give a number of worker threads from 1 to {MAX_JOBS} (default: all cores)"
+            ));
+        }
+    }
     let config = Config::load(&a.config)?;
     if let Some(x) = a.noise_radius {
         if !(x.is_finite() && x >= 0.0) {
@@ -99,10 +112,31 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     };
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
-    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &|| bar.inc(1));
+    // Off a terminal (a log file, a pipe, a cluster job) the bar is hidden: a line on
+    // stderr every PROGRESS_EVERY seconds, and at the end, says how far the batch is.
+    let periodic = !std::io::stderr().is_terminal();
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let last = std::sync::Mutex::new(Instant::now());
+    let n_sets = datasets.len();
+    let tick = || {
+        bar.inc(1);
+        let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if periodic {
+            let mut l = last.lock().unwrap_or_else(|e| e.into_inner());
+            if k == n_sets || l.elapsed().as_secs_f64() >= PROGRESS_EVERY {
+                *l = Instant::now();
+                eprintln!(
+                    "batch: {k}/{n_sets} datasets done ({:.0} s)",
+                    t.elapsed().as_secs_f64()
+                );
+            }
+        }
+    };
+    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &tick);
     let results = match a.jobs {
+        // More threads than datasets only cost memory (each has its own stack).
         Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
+            .num_threads((n as usize).min(datasets.len()).max(1))
             .build()?
             .install(work),
         None => work(),
@@ -115,7 +149,8 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     let combined = combine(results.iter().filter_map(|r| r.envelope.as_ref()));
     timings.insert("combine".to_string(), t.elapsed().as_secs_f64() * 1e3);
     let rows: Vec<SummaryRow> = results.iter().map(SummaryRow::from).collect();
-    if let (true, Some(c)) = (std::io::stderr().is_terminal(), &combined) {
+    if let Some(c) = &combined {
+        // The fit may take seconds: say so on a terminal and in a log alike.
         eprintln!(
             "fitting one {} above the combined envelope ({} frequencies)…",
             crate::plot::Symbols::of(config.closed_loop.is_some()).weight,
@@ -128,6 +163,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
         combined.as_ref(),
         FinishInput {
             config: config.path.clone(),
+            config_digest: batch::config_digest(&config.path),
             r_configured: config.r.as_ref(),
             n_total: all.len(),
             shard,
@@ -198,8 +234,14 @@ pub fn print_summary(
             rep.n_failed - 10
         );
     }
-    outln!(
-        "  wrote {}/summary.csv, batch.json, combined_envelope.csv, r.json",
-        out.display()
-    );
+    // Name only what exists: no combined envelope without a successful dataset, no r.json
+    // when the fit failed.
+    let mut files = vec!["summary.csv", "batch.json"];
+    if rep.n_frequencies > 0 {
+        files.push("combined_envelope.csv");
+    }
+    if rep.r_fitted.is_some() {
+        files.push("r.json");
+    }
+    outln!("  wrote {}/{}", out.display(), files.join(", "));
 }

@@ -1,7 +1,8 @@
-//! `rshape check CONFIG [--r-num a,b,.. --r-den c,d,..]`: exit 0 when consistent, 1 when not.
+//! `rshape check CONFIG [--r-num a,b,.. --r-den c,d,..]`: exit 0 when consistent, 1 when
+//! inconsistent or when `r` is not admissible (A1 fails at some datum), 2 on an error.
 
 use super::common::{fmt_g, fmt_omegas, InputArgs};
-use crate::consistency::check;
+use crate::consistency::{check, Verdict};
 use crate::system::TransferFunction;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -46,28 +47,14 @@ pub fn resolve_r(
         })?,
         _ => return Err(anyhow!("give both --r-num and --r-den")),
     };
-    if !r.is_unit() {
+    if let Some(why) = r.unit_violation() {
         let source = match num {
             Some(_) => "--r-num/--r-den".to_string(),
             None => format!("{}: [r]", config.path.display()),
         };
-        let why = if !r.is_biproper() {
-            format!(
-                "it is not biproper (numerator degree {}, denominator degree {})",
-                r.num.degree(),
-                r.den.degree()
-            )
-        } else if let Some(p) = r.poles().into_iter().find(|p| p.re >= 0.0) {
-            format!("it is not stable (pole at {p})")
-        } else if let Some(z) = r.zeros().into_iter().find(|z| z.re >= 0.0) {
-            format!("it is not minimum phase (zero at {z})")
-        } else {
-            "its poles or zeros are not in the open left half-plane".to_string()
-        };
         return Err(anyhow!(
-            "{source}: r = ({:?})/({:?}) is not a unit of RH∞: {why}; give equal degrees and poles and zeros in the open left half-plane",
-            r.num.coeffs(),
-            r.den.coeffs()
+            "{source}: r = {} is not a unit of RH∞: {why}; give equal degrees and poles and zeros in the open left half-plane",
+            r.brief()
         ));
     }
     Ok(r)
@@ -94,36 +81,44 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
                 fmt_g(row.ratio),
                 row.a1_limit.map_or("-".into(), fmt_g),
                 if row.a1_ok { "ok" } else { "FAIL" },
-                if row.consistent {
-                    ""
-                } else {
-                    "  <- inconsistent"
+                match (row.covers, row.a1_ok) {
+                    (true, true) => "",
+                    (false, _) => "  <- inconsistent",
+                    (true, false) => "  <- not admissible (A1)",
                 }
             );
         }
         let list = |v: &[f64]| fmt_omegas(&env.omega, v);
-        if !rep.a1_violations.is_empty() {
-            println!(
-                "A1 violated (|r| >= sigma_min(M~)) at {} datum(s): omega = {} rad/s; the perturbed plants need not all be stable there",
-                rep.a1_violations.len(),
-                list(&rep.a1_violations)
-            );
-        }
         // Closed-loop configs check the weight V of [v] (Crowder & de Callafon, eq. (2)).
         let w = if inputs.config.closed_loop.is_some() {
             "V"
         } else {
             "r"
         };
-        if rep.consistent {
-            println!("consistent: {w} explains all {} data", rep.rows.len());
-        } else {
+        if rep.verdict == Verdict::NotAdmissible && !rep.failing_omegas.is_empty() {
             println!(
-                "inconsistent at {} of {} data: omega = {} rad/s",
+                "|{w}| <= r_min at {} of {} data: omega = {} rad/s",
                 rep.failing_omegas.len(),
                 rep.rows.len(),
                 list(&rep.failing_omegas)
             );
+        }
+        match rep.verdict {
+            Verdict::Consistent => {
+                println!("consistent: {w} explains all {} data", rep.rows.len())
+            }
+            Verdict::Inconsistent => println!(
+                "inconsistent at {} of {} data: omega = {} rad/s",
+                rep.failing_omegas.len(),
+                rep.rows.len(),
+                list(&rep.failing_omegas)
+            ),
+            Verdict::NotAdmissible => println!(
+                "not admissible: A1 fails (|{w}| >= sigma_min(M~)) at {} of {} data: omega = {} rad/s; the perturbed family then holds unstable plants and Theorems 2-4 give no verdict: make |{w}| smaller there",
+                rep.a1_violations.len(),
+                rep.rows.len(),
+                list(&rep.a1_violations)
+            ),
         }
     }
     Ok(if rep.consistent { 0 } else { 1 })

@@ -1,11 +1,7 @@
 //! Arguments and loading shared by the subcommands that read a model and data.
 
-use crate::consistency::noisy::BisectionSettings;
-use crate::consistency::stream::noise_free_envelope_rows;
-use crate::consistency::{noise_free_envelope, noisy_envelope, Envelope};
-use crate::data::reader::FrfRows;
+use crate::consistency::Envelope;
 use crate::data::FrfData;
-use crate::model::noise::noise_radii;
 use crate::model::Config;
 use crate::util::OutputManifest;
 use anyhow::{anyhow, Result};
@@ -47,19 +43,7 @@ impl InputArgs {
     pub fn load(&self) -> Result<Inputs> {
         let config = Config::load(&self.config)?;
         let path = self.data_path(&config)?;
-        let mut data = crate::pipeline::closed_loop::read_data(&config, &path)?;
-        let f = &config.factorization;
-        if let Some(ch) = config.raw.channel {
-            let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
-            if !fits
-                && ch.output >= 1
-                && ch.input >= 1
-                && ch.output <= data.outputs()
-                && ch.input <= data.inputs()
-            {
-                data = data.channel(ch.output - 1, ch.input - 1);
-            }
-        }
+        let data = crate::pipeline::envelope::load_data(&config, &path)?;
         self.check_noise_radius()?;
         Ok(Inputs { config, data })
     }
@@ -86,77 +70,26 @@ impl InputArgs {
         }
     }
 
-    /// The envelope alone, as [`envelope`](Self::envelope) computes it, but with the data
-    /// streamed when the noise-free theorems apply (no noise model, or all radii 0): then
-    /// memory stays at about 56 bytes per datum whatever the file size.
+    /// The envelope alone, streamed when the noise-free theorems apply
+    /// ([`crate::pipeline::envelope::envelope_of_file`]).
     pub fn envelope_only(&self) -> Result<Envelope> {
         let config = Config::load(&self.config)?;
         self.check_noise_radius()?;
-        if config.closed_loop.is_some() {
-            return Ok(self.envelope()?.1);
-        }
-        let rows = FrfRows::open(&self.data_path(&config)?)?;
-        let sec = &config.raw.noise;
-        sec.validate()
-            .map_err(|e| anyhow!("{}: {e}", self.config.display()))?;
-        // The precedence of `model::noise::resolve_noise`: flag > config > data column.
-        let noise_free = match (self.noise_radius, sec.radius) {
-            (Some(x), _) | (None, Some(x)) => x == 0.0,
-            (None, None) => {
-                sec.output_bound.is_none() && config.noise_std.is_none() && !rows.has_noise_column()
-            }
-        };
-        if !noise_free {
-            return Ok(self.envelope()?.1);
-        }
-        let channel = config.raw.channel.map(|c| (c.output, c.input));
-        Ok(noise_free_envelope_rows(
-            &config.factorization,
-            rows,
-            channel,
+        let path = self.data_path(&config)?;
+        Ok(crate::pipeline::envelope::envelope_of_file(
+            &config,
+            &path,
+            self.noise_radius,
         )?)
     }
 
-    /// Loads inputs and computes the envelope that fits them: noise-free (Theorem 2 or 3),
-    /// or noisy SISO (Theorem 4) when a nonzero noise radius is known (`--noise-radius`,
-    /// else the config's `[noise]`, else the data's `noise_radius` column).
+    /// Loads inputs and computes their envelope ([`crate::pipeline::envelope::envelope`]).
     pub fn envelope(&self) -> Result<(Inputs, Envelope)> {
         let inputs = self.load()?;
-        let env = envelope_for(&inputs, self.noise_radius)?;
+        let env =
+            crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, self.noise_radius)?
+                .envelope;
         Ok((inputs, env))
-    }
-}
-
-/// The envelope of loaded inputs: Theorem 4 (μ bisection) when the resolved noise radii are
-/// not all zero, else Theorem 2 or 3.  Noisy MIMO data are an error: the paper's noisy test
-/// is SISO; select a channel (`[channel]`) or drop the noise (`--noise-radius 0`).
-pub fn envelope_for(inputs: &Inputs, cli_noise: Option<f64>) -> Result<Envelope> {
-    let f = &inputs.config.factorization;
-    let data = &inputs.data;
-    if inputs.config.closed_loop.is_some() {
-        let radii = crate::pipeline::integration::noise_radii(&inputs.config, data, cli_noise)?;
-        let (env, _, _) =
-            crate::pipeline::closed_loop::envelope(&inputs.config, data, radii.as_deref())?;
-        return Ok(env);
-    }
-    match noise_radii(cli_noise, Some(&inputs.config), data)? {
-        Some(radii) if radii.iter().any(|r| *r > 0.0) => {
-            if data.outputs() != 1 || data.inputs() != 1 {
-                return Err(anyhow!(
-                    "{}: noisy consistency (Theorem 4) is for SISO data, these are {}×{}; select a channel with [channel] or pass --noise-radius 0",
-                    data.path.display(),
-                    data.outputs(),
-                    data.inputs()
-                ));
-            }
-            Ok(noisy_envelope(
-                f,
-                data,
-                &radii,
-                &BisectionSettings::default(),
-            )?)
-        }
-        _ => Ok(noise_free_envelope(f, data)?),
     }
 }
 

@@ -1,8 +1,8 @@
 //! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
 
 use super::common::{fmt_g, InputArgs};
-use crate::diagnose::agreement::data_vs_data;
-use crate::diagnose::compare::{compare, prepare, Band, CompareReport, PlantModel};
+use crate::diagnose::agreement::{data_vs_data, AgreementVerdict};
+use crate::diagnose::compare::{compare, prepare, Band, CompareReport, CompareVerdict, PlantModel};
 use crate::diagnose::figures::bode_overlay;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -59,26 +59,52 @@ pub fn run_compare(
     Ok((rep, siso, model))
 }
 
-/// Formats bands for the text report.
+/// Most bands printed on the terminal; `--json` lists them all.
+pub const MAX_BANDS_SHOWN: usize = 3;
+
+/// Formats bands for the text report: all of them up to [`MAX_BANDS_SHOWN`], else the
+/// bands with the largest peak misfit (in frequency order) and a count of the others, so
+/// that a badly failing model gives a readable line instead of dozens of bands.
 pub fn fmt_bands(b: &[Band]) -> String {
     if b.is_empty() {
         return "none".into();
     }
-    b.iter()
-        .map(|b| {
-            format!(
-                "{}–{} rad/s ({}–{} Hz, {} data, peak misfit {} at {} Hz)",
-                fmt_g(b.omega_lo),
-                fmt_g(b.omega_hi),
-                fmt_g(b.omega_lo / std::f64::consts::TAU),
-                fmt_g(b.omega_hi / std::f64::consts::TAU),
-                b.count,
-                fmt_g(b.peak_misfit),
-                fmt_g(b.omega_peak / std::f64::consts::TAU)
-            )
-        })
+    let one = |b: &Band| {
+        format!(
+            "{}–{} rad/s ({}–{} Hz, {} data, peak misfit {} at {} Hz)",
+            fmt_g(b.omega_lo),
+            fmt_g(b.omega_hi),
+            fmt_g(b.omega_lo / std::f64::consts::TAU),
+            fmt_g(b.omega_hi / std::f64::consts::TAU),
+            b.count,
+            fmt_g(b.peak_misfit),
+            fmt_g(b.omega_peak / std::f64::consts::TAU)
+        )
+    };
+    if b.len() <= MAX_BANDS_SHOWN {
+        return b.iter().map(one).collect::<Vec<_>>().join("; ");
+    }
+    let mut worst: Vec<usize> = (0..b.len()).collect();
+    worst.sort_by(|&x, &y| b[y].peak_misfit.total_cmp(&b[x].peak_misfit));
+    worst.truncate(MAX_BANDS_SHOWN);
+    worst.sort_unstable();
+    let shown = worst
+        .iter()
+        .map(|&k| one(&b[k]))
         .collect::<Vec<_>>()
-        .join("; ")
+        .join("; ");
+    let rest: usize = (0..b.len())
+        .filter(|k| !worst.contains(k))
+        .map(|k| b[k].count)
+        .sum();
+    format!(
+        "{} bands, {} data, {}–{} rad/s; the {MAX_BANDS_SHOWN} worst: {shown}; {} more bands ({rest} data) in `--json` (bands)",
+        b.len(),
+        b.iter().map(|x| x.count).sum::<usize>(),
+        fmt_g(b[0].omega_lo),
+        fmt_g(b[b.len() - 1].omega_hi),
+        b.len() - MAX_BANDS_SHOWN,
+    )
 }
 
 /// Runs `rshape compare`.
@@ -164,10 +190,10 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     println!(
         "verdict: {}{}",
         rep.verdict,
-        match rep.verdict.as_str() {
-            "consistent" => " (invalid_fraction ≤ 5 % and misfit_rms ≤ 1: the data are explained within the noise)",
-            "inconsistent" => " (run `rshape diagnose` to find the missing effect)",
-            _ => " (no noise radius: give --noise-radius, a noise_radius column or [noise])",
+        match rep.verdict {
+            CompareVerdict::Consistent => " (invalid_fraction ≤ 5 % and misfit_rms ≤ 1: the data are explained within the noise)",
+            CompareVerdict::Inconsistent => " (run `rshape diagnose` to find the missing effect)",
+            CompareVerdict::UnknownNoise => " (no noise radius: give --noise-radius, a noise_radius column or [noise])",
         }
     );
     if let Some(f) = &rep.figure {
@@ -182,7 +208,7 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
             fmt_g(ag.distance_rms),
             crate::report::fmt::fmt_pct(ag.disagree_fraction),
             fmt_bands(&ag.bands),
-            if ag.verdict == "agree" {
+            if ag.verdict == AgreementVerdict::Agree {
                 ": the two experiments agree within their noise"
             } else {
                 ": the two experiments disagree by more than their noise, so no model can reach the noise on both"

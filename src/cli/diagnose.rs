@@ -24,15 +24,15 @@ pub struct DiagnoseArgs {
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
     /// Most effects to add.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub max_effects: usize,
     /// Effect sets kept per level of the search.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub beam: usize,
     /// Write a revised config (with --write): `K` adds the K-th ranked candidate (1-based;
     /// a candidate the tool rejected is refused unless --force), `chosen` the chosen effect
     /// set, jointly refit, in one revision.
-    #[arg(long, requires = "write", value_parser = parse_apply, value_name = "K|chosen")]
+    #[arg(long, requires = "write", value_parser = parse_apply, value_name = "K|chosen", allow_negative_numbers = true)]
     pub apply: Option<Apply>,
     /// With --apply K: write the candidate even though the tool rejected it.
     #[arg(long, requires = "apply")]

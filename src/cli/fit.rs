@@ -40,7 +40,7 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value = "minimax")]
     pub objective: ObjectiveArg,
     /// Relative margin: |r| ≥ (1 + margin)·r_min at every datum.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub margin: f64,
     /// Output directory for r.json, r.m, r.py, r.jl.
     #[arg(long)]
@@ -51,7 +51,7 @@ pub struct FitArgs {
 pub fn run(a: &FitArgs) -> Result<i32> {
     if !(a.margin.is_finite() && a.margin >= 0.0) {
         return Err(anyhow!(
-            "--margin {}: must be a finite number ≥ 0",
+            "--margin {}: must be a finite number ≥ 0 (|r| ≥ (1 + margin)·r_min; a negative margin would let r fall below r_min, where it no longer explains the data)",
             a.margin
         ));
     }

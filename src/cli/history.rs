@@ -19,7 +19,7 @@ pub struct HistoryArgs {
     #[arg(long)]
     pub data: Option<PathBuf>,
     /// Global noise radius overriding the configs'.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub noise_radius: Option<f64>,
     /// SISO channel `OUT,IN`.
     #[arg(long, value_delimiter = ',')]
@@ -46,7 +46,7 @@ pub struct Revision {
     /// `r_env_max`.
     pub r_env_max: Option<f64>,
     /// Verdict.
-    pub verdict: String,
+    pub verdict: crate::diagnose::compare::CompareVerdict,
 }
 
 /// Runs `rshape history`.

@@ -3,6 +3,7 @@
 //! `DIR/report.json` and a summary on the terminal.
 
 use super::common::{fmt_g, InputArgs};
+use crate::consistency::Verdict;
 use crate::pipeline::{self, outputs::write_outputs};
 use anyhow::Result;
 use clap::Args;
@@ -55,7 +56,7 @@ fn list(v: &[f64]) -> String {
 }
 
 /// Runs `rshape run`: exit 0 when the pipeline completed (whatever the verdict; see
-/// `consistent` in report.json, or use `rshape check` to gate on it), 2 on an error.
+/// `verdict` in report.json, or use `rshape check` to gate on it), 2 on an error.
 pub fn run(a: &RunArgs) -> Result<i32> {
     let t = Instant::now();
     let inputs = a.input.load()?;
@@ -93,16 +94,22 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             list(&rep.beyond_a1)
         );
     }
-    match rep.consistent {
-        Some(true) => outln!(
+    match rep.verdict {
+        Some(Verdict::Consistent) => outln!(
             "  check     CONSISTENT: the configured {w} explains all {} data",
             rep.n_data
         ),
-        Some(false) => outln!(
+        Some(Verdict::Inconsistent) => outln!(
             "  check     INCONSISTENT at {} of {} data: omega = {} rad/s",
             rep.failing_omegas.len(),
             rep.n_data,
             list(&rep.failing_omegas)
+        ),
+        Some(Verdict::NotAdmissible) => outln!(
+            "  check     NOT ADMISSIBLE: A1 fails for the configured {w} (|{w}| ≥ σ_min(M̃)) at {} of {} data: omega = {} rad/s; no verdict on consistency there",
+            rep.a1_violations.len(),
+            rep.n_data,
+            list(&rep.a1_violations)
         ),
         None => outln!(
             "  check     no [{}] in the config: nothing to check",

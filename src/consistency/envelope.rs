@@ -1,5 +1,8 @@
 //! The lower envelope: per datum, the smallest `|r(jω_i)|` consistent with it, with the A1
 //! limit `σ_min(M̃(jω_i))` beside it.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::noise_free::{r_min_special, r_min_standard};
 use crate::data::FrfData;
@@ -103,6 +106,16 @@ pub fn noise_free_envelope(f: &Factorization, data: &FrfData) -> Result<Envelope
             omega: *omega,
             msg: format!("{} ({})", e.message(), data.path.display()),
         })?;
+        if r.is_nan() {
+            // Never a NaN in an output with exit 0 (an overflow that prescaling missed).
+            return Err(Error::Assumption {
+                omega: *omega,
+                msg: format!(
+                    "the smallest consistent |r| is not a number (the datum overflows the arithmetic); rescale the data ({})",
+                    data.path.display()
+                ),
+            });
+        }
         r_min.push(r);
         a1.push(at.a1_limit());
     }

@@ -6,7 +6,7 @@ pub mod noise_free;
 pub mod noisy;
 pub mod stream;
 
-pub use check::{check, CheckReport, CheckRow};
+pub use check::{check, CheckReport, CheckRow, Verdict};
 pub use envelope::{noise_free_envelope, Envelope, EnvelopeMethod};
 pub use noisy::{
     noisy_envelope, noisy_envelope_report, BisectionSettings, NoisyDatum, NoisyReport,

@@ -32,7 +32,7 @@ impl AssumptionFailure {
     /// A one-line explanation with what to do.
     pub fn message(&self) -> &'static str {
         match self {
-            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the [model] entries",
+            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the model ([model] entries, or the [physical] parameters)",
             Self::DatumSingular => "assumption A2 fails: the datum Φ is singular; remove this datum or check its columns",
             Self::JSingular => "J(jω) has a zero on its diagonal: choose an input matrix J without zeros on the jω-axis",
             Self::A5 => "assumption A5 fails: Φ̂ − C·M̃⁻¹·Ñ is singular (the datum equals the nominal model in some direction); the datum needs no perturbation there, remove it or add noise",
@@ -81,12 +81,23 @@ pub fn r_min_standard(f: &FactorsAt, phi: &DMatrix<Complex64>) -> Result<f64, As
 /// A non-finite datum gives a non-finite `Z` (never a panic).
 fn qr_z(f: &FactorsAt, phi: &DMatrix<Complex64>) -> (DMatrix<Complex64>, DMatrix<Complex64>) {
     let (p, m_in) = phi.shape();
-    let u = &f.n - &f.m * phi;
+    // Prescale by c, the power of two at or below max(1, max|Φ_ij|): W/c = Q·(R/c) and
+    // (R/c)^{-*}(U/c)ᴴ = R^{-*}Uᴴ, so Z is unchanged while no Householder norm or product
+    // M̃Φ overflows (a datum of 1e308 gave NaN).  A power of two scales without rounding,
+    // so the accuracy up to cond(W) ≈ 1e12 is kept.  Moduli use hypot (finite to f64::MAX).
+    let big = phi.iter().map(|z| z.norm()).fold(1.0, f64::max);
+    let c = if big.is_finite() {
+        2f64.powi(big.log2().floor() as i32)
+    } else {
+        1.0
+    };
+    let phi_c = phi.map(|z| z / c);
+    let u = f.n.map(|z| z / c) - &f.m * &phi_c;
     let mut w = DMatrix::<Complex64>::zeros(m_in + p, m_in);
     for k in 0..m_in {
-        w[(k, k)] = Complex64::new(-1.0, 0.0);
+        w[(k, k)] = Complex64::new(-1.0 / c, 0.0);
     }
-    w.view_mut((m_in, 0), (p, m_in)).copy_from(&(-phi));
+    w.view_mut((m_in, 0), (p, m_in)).copy_from(&(-phi_c));
     let qr = w.qr();
     let (q, r) = (qr.q(), qr.r());
     let zh = r

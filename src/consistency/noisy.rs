@@ -37,7 +37,7 @@ impl NoisyFailure {
     pub fn message(&self) -> &'static str {
         match self {
             Self::NotSiso => "the noisy test (Theorem 4) is for SISO data and models; select a channel",
-            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the [model] entries",
+            Self::MSingular => "M̃(jω) is singular: the factorization is not valid at this frequency; check the model ([model] entries, or the [physical] parameters)",
             Self::JSingular => "J(jω) = 0: choose an input factor J without zeros on the jω-axis",
             Self::A6 => "assumption A6 fails: the datum φ is zero or not finite; remove this datum",
             Self::A7 => "assumption A7 fails: φ − C·M̃⁻¹·Ñ·J = 0 (the datum equals the nominal model); remove this datum",
@@ -152,6 +152,17 @@ pub struct BisectionSettings {
     pub max_iter: usize,
     /// Settings of each `μ` computation.
     pub mu: MuSettings,
+}
+
+impl BisectionSettings {
+    /// Checks every field, the μ settings included; the error names the first bad one.
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("BisectionSettings")
+            .fraction("rel_tol", self.rel_tol)
+            .at_least("max_iter", self.max_iter, 1, "must be at least 1")
+            .finish()?;
+        self.mu.validate()
+    }
 }
 
 impl Default for BisectionSettings {
@@ -320,6 +331,9 @@ pub fn noisy_envelope_report(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<NoisyReport> {
+    settings
+        .validate()
+        .map_err(|e| Error::Invalid(e.to_string()))?;
     check_sizes(f, data)?;
     if data.outputs() != 1 || data.inputs() != 1 {
         return Err(Error::Invalid(format!(

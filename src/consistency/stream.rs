@@ -20,6 +20,11 @@ pub fn noise_free_envelope_rows(
 ) -> Result<Envelope> {
     let path = rows.path().to_path_buf();
     let (p, m) = rows.size();
+    if let Some((o, i)) = channel {
+        if (p, m) != (f.outputs(), f.inputs()) {
+            crate::data::check_channel(&path, (o, i), (p, m))?;
+        }
+    }
     let select = channel.filter(|&(o, i)| {
         (p, m) != (f.outputs(), f.inputs()) && (1..=p).contains(&o) && (1..=m).contains(&i)
     });

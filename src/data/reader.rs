@@ -49,6 +49,10 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
 
 const HEADER: &str = "freq_hz,re_1_1,im_1_1";
 
+/// Largest output or input index of a column name (`re_i_j`): far beyond any measured FRF,
+/// small enough that `p·m` can never overflow.
+pub const MAX_CHANNEL: usize = 10_000;
+
 /// One row of an FRF file: `(omega, Φ, noise radius, line)`.
 pub type Datum = (f64, DMatrix<Complex64>, Option<f64>, usize);
 
@@ -112,13 +116,17 @@ impl FrfRows<'_> {
             let (name, field) = (&t.names[col], t.field(col));
             let v: f64 = field.parse().map_err(|_| {
                 err(format!(
-                    "column `{name}`: `{field}` is not a number{}",
+                    "column `{}`: `{}` is not a number{}",
+                    crate::util::echo(name),
+                    crate::util::echo(field),
                     super::table::decimal_hint(field)
                 ))
             })?;
             if !v.is_finite() {
                 return Err(err(format!(
-                    "column `{name}`: value `{field}` is not finite"
+                    "column `{}`: value `{}` is not finite",
+                    crate::util::echo(name),
+                    crate::util::echo(field)
                 )));
             }
             Ok(v)
@@ -132,6 +140,11 @@ impl FrfRows<'_> {
         } else {
             f
         };
+        if !omega.is_finite() {
+            return Err(err(format!(
+                "frequency {f:e} Hz overflows in rad/s (2π·f is beyond the largest number): is the column in Hz?"
+            )));
+        }
         let mut phi = DMatrix::zeros(l.p, l.m);
         for i in 0..l.p {
             for j in 0..l.m {
@@ -228,10 +241,13 @@ impl Layout {
                 continue;
             }
             let parsed = parse_column(name).ok_or_else(|| {
-                err(format!("unknown column `{name}`: expected re_i_j, im_i_j, mag_i_j, phase_deg_i_j or noise_radius"))
+                err(format!("unknown column `{}`: expected re_i_j, im_i_j, mag_i_j, phase_deg_i_j or noise_radius (i, j ≤ {MAX_CHANNEL})", crate::util::echo(name)))
             })?;
             if cells.insert(parsed, col).is_some() {
-                return Err(err(format!("column `{name}` appears twice")));
+                return Err(err(format!(
+                    "column `{}` appears twice",
+                    crate::util::echo(name)
+                )));
             }
             p = p.max(parsed.0);
             m = m.max(parsed.1);
@@ -242,13 +258,16 @@ impl Layout {
             ));
         }
         // Every (i, j) needs one complete representation.
-        let mut entries = vec![(Part::Re, 0usize, 0usize); p * m];
+        // Sized by the columns present, never by the indices named: a header naming
+        // re_100000_100000 fails at its first missing column below, which comes within
+        // `cells.len() + 1` entries.
+        let mut entries = Vec::with_capacity((p * m).min(cells.len()));
         for i in 1..=p {
             for j in 1..=m {
                 let get = |part| cells.get(&(i, j, part));
                 let re = (get(Part::Re), get(Part::Im));
                 let mp = (get(Part::Mag), get(Part::PhaseDeg));
-                entries[(i - 1) * m + (j - 1)] = match (re, mp) {
+                entries.push(match (re, mp) {
                     ((Some(a), Some(b)), (None, None)) => (Part::Re, *a, *b),
                     ((None, None), (Some(a), Some(b))) => (Part::Mag, *a, *b),
                     ((Some(_), None), _) => return Err(err(format!("missing column im_{i}_{j}"))),
@@ -267,7 +286,7 @@ impl Layout {
                             "entry ({i},{j}) is given both as re/im and as mag/phase: keep one"
                         )))
                     }
-                };
+                });
             }
         }
         Ok(Self {
@@ -294,5 +313,5 @@ fn parse_column(name: &str) -> Option<(usize, usize, Part)> {
     };
     let (i, j) = rest.split_once('_')?;
     let (i, j): (usize, usize) = (i.parse().ok()?, j.parse().ok()?);
-    (i >= 1 && j >= 1).then_some((i, j, part))
+    ((1..=MAX_CHANNEL).contains(&i) && (1..=MAX_CHANNEL).contains(&j)).then_some((i, j, part))
 }

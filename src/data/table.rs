@@ -95,7 +95,7 @@ fn first_column_is_hz<S: AsRef<str>>(path: &Path, line: usize, names: &[S]) -> R
             line,
             msg: format!(
                 "first column is `{}`: it must be `omega_rad_s` or `freq_hz`",
-                other.unwrap_or("")
+                crate::util::echo(other.unwrap_or(""))
             ),
         }),
     }
@@ -113,10 +113,7 @@ pub fn decimal_hint(field: &str) -> &'static str {
 /// Reads a whole text file as UTF-8 (a UTF-8 byte-order mark is dropped, UTF-16 with a
 /// byte-order mark is decoded).  Text that is not UTF-8 is an error naming its line.
 pub fn read_text(path: &Path) -> Result<String> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = crate::util::read_regular(path, crate::util::MAX_DATA_FILE)?;
     let bytes = decode_utf16(bytes, path)?;
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     match std::str::from_utf8(bytes) {
@@ -193,10 +190,7 @@ pub struct TableReader<'r> {
 impl<'r> TableReader<'r> {
     /// Opens `path` and reads its header.
     pub fn open(path: &Path, expected_header: &str) -> Result<TableReader<'static>> {
-        let file = std::fs::File::open(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let file = crate::util::open_regular(path)?;
         TableReader::new(file, path, expected_header)
     }
 
@@ -268,9 +262,24 @@ impl<'r> TableReader<'r> {
                 .position(|c| !matches!(c, b' ' | b'\t'))
                 .is_some_and(|k| matches!(buf[k], b'\n' | b'\r' | b'#'));
             if b == b'#' || blank {
-                let mut skipped = Vec::new();
-                (self.input.read_until(b'\n', &mut skipped)).map_err(|e| io_err(&self.path, e))?;
-                self.line += skipped.ends_with(b"\n") as usize;
+                // Consumed piecewise: a comment line of any length costs no memory.
+                loop {
+                    let buf = self.input.fill_buf().map_err(|e| io_err(&self.path, e))?;
+                    if buf.is_empty() {
+                        break;
+                    }
+                    match buf.iter().position(|c| *c == b'\n') {
+                        Some(k) => {
+                            self.input.consume(k + 1);
+                            self.line += 1;
+                            break;
+                        }
+                        None => {
+                            let n = buf.len();
+                            self.input.consume(n);
+                        }
+                    }
+                }
             } else if b == b'\n' || b == b'\r' {
                 self.input.consume(1);
                 self.line += (b == b'\n') as usize;
@@ -300,7 +309,21 @@ impl<'r> TableReader<'r> {
                 nend += e;
                 match res {
                     R::InputEmpty => {}
+                    R::OutputFull if self.bytes.len() >= MAX_RECORD_BYTES => {
+                        return Err(self.err(
+                            start,
+                            format!(
+                                "a line longer than {} MB: is this a CSV file of numbers?",
+                                MAX_RECORD_BYTES >> 20
+                            ),
+                        ));
+                    }
                     R::OutputFull => self.bytes.resize(2 * self.bytes.len(), 0),
+                    R::OutputEndsFull if self.ends_buf.len() >= MAX_RECORD_FIELDS => {
+                        return Err(self.err(start, format!(
+                            "more than {MAX_RECORD_FIELDS} fields on one line: is this a CSV file of numbers?"
+                        )));
+                    }
                     R::OutputEndsFull => self.ends_buf.resize(2 * self.ends_buf.len(), 0),
                     R::Record => break true,
                     R::End => break false,
@@ -409,6 +432,13 @@ impl<'r> TableReader<'r> {
         &self.path
     }
 }
+
+/// Longest record (a line, or lines joined by quotes) read: a file without line ends is not
+/// read whole, and no message quotes more than a few dozen characters of it.
+pub const MAX_RECORD_BYTES: usize = 1 << 20;
+
+/// Most fields on one line (far beyond any FRF's `2·p·m + 2` columns).
+pub const MAX_RECORD_FIELDS: usize = 1 << 16;
 
 fn io_err(path: &Path, source: std::io::Error) -> Error {
     Error::Io {

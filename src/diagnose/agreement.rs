@@ -26,7 +26,17 @@ pub struct DataAgreement {
     /// Bands where they disagree.
     pub bands: Vec<Band>,
     /// `agree` (disagree_fraction ≤ 5 % and distance_rms ≤ 1) or `disagree`.
-    pub verdict: String,
+    pub verdict: AgreementVerdict,
+}
+
+/// Whether two experiments agree within their noise (serialized `agree` / `disagree`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AgreementVerdict {
+    /// `disagree_fraction ≤ 5 %` and `distance_rms ≤ 1`.
+    Agree,
+    /// The two data sets differ by more than their noise.
+    Disagree,
 }
 
 /// Compares two SISO data sets at their common frequencies (relative tolerance 1e-6).
@@ -72,9 +82,9 @@ pub fn data_vs_data(a: &Siso, b: &Siso) -> Result<DataAgreement> {
         disagree_fraction: frac,
         bands: bands(&omega, &d, &flags),
         verdict: if frac <= MAX_INVALID_FRACTION && rms <= MAX_MISFIT_RMS {
-            "agree".into()
+            AgreementVerdict::Agree
         } else {
-            "disagree".into()
+            AgreementVerdict::Disagree
         },
     })
 }
@@ -107,7 +117,7 @@ mod tests {
         assert_eq!(r.n_common, 2);
         assert!((r.distance_max - 1.05).abs() < 1e-12);
         assert_eq!(r.disagree_fraction, 0.5);
-        assert_eq!(r.verdict, "disagree");
+        assert_eq!(r.verdict, AgreementVerdict::Disagree);
         assert_eq!(r.bands.len(), 1);
         assert_eq!(r.bands[0].omega_lo, 3.0);
     }

@@ -5,7 +5,7 @@
 //! additive dynamics times the product of the path effects).  A candidate either multiplies
 //! `path` (delay, lag, gain, sign, ZOH, NMP zero: on every channel, on one output or on one
 //! input, [`Sel`]) or changes `core` (added mode, shifted or re-damped mode, integrator or
-//! rigid body, feedthrough).  An added mode is the modal model of effects.md: one `ω_n`
+//! rigid body, feedthrough).  An added mode is the modal model of docs/design/effects.md: one `ω_n`
 //! and `ζ` shared by every channel and a residue per channel.  Positive parameters are fitted
 //! in logarithms.
 
@@ -179,7 +179,7 @@ impl Cand {
     }
 
     /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`
-    /// (effects.md step 3): an added mode resonates inside the band (an out-of-band one is a
+    /// (docs/design/effects.md step 3): an added mode resonates inside the band (an out-of-band one is a
     /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [1e-4, 0.7]`,
     /// corners and zeros within two decades of the band, a delay below 100/ω_min.
     pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {

@@ -20,6 +20,9 @@
 //!   with `r_min = 0` never fails). With the noise-free fallback the test is conservative:
 //!   a datum fails when neither the noise disk alone (`c_k > 1`) nor `r` alone
 //!   (`r_min > |r(jω)|`) explains it. `with_r_exact` says which test was used.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::consistency::{noise_free_envelope, noisy_envelope, BisectionSettings};
 use crate::data::FrfData;
@@ -262,6 +265,36 @@ pub struct CompareRow {
     pub invalid_with_r: Option<bool>,
 }
 
+/// The verdict of `compare` (serialized in snake_case: `consistent`, `inconsistent`,
+/// `unknown_noise`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CompareVerdict {
+    /// `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`: explained within the noise.
+    Consistent,
+    /// The model misses the data by more than the noise.
+    Inconsistent,
+    /// No noise radius is known: the misfit cannot be judged.
+    UnknownNoise,
+}
+
+impl CompareVerdict {
+    /// The snake_case name (as in the JSON).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Consistent => "consistent",
+            Self::Inconsistent => "inconsistent",
+            Self::UnknownNoise => "unknown_noise",
+        }
+    }
+}
+
+impl std::fmt::Display for CompareVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// The error measures of one model against one data set.
 #[derive(Debug, Clone, Serialize)]
 pub struct CompareReport {
@@ -298,7 +331,7 @@ pub struct CompareReport {
     /// Bands where the model with the configured r fails.
     pub bands_with_r: Option<Vec<Band>>,
     /// Verdict: `consistent` when `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`.
-    pub verdict: String,
+    pub verdict: CompareVerdict,
     /// Per-datum rows.
     pub rows: Vec<CompareRow>,
     /// The Bode overlay, when written.
@@ -461,11 +494,11 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
         bands: bands(&siso.omega, &c, &invalid),
         bands_with_r: with_r.as_ref().map(|w| bands(&siso.omega, &c, w)),
         verdict: if siso.radius.is_none() {
-            "unknown_noise".into()
+            CompareVerdict::UnknownNoise
         } else if consistent {
-            "consistent".into()
+            CompareVerdict::Consistent
         } else {
-            "inconsistent".into()
+            CompareVerdict::Inconsistent
         },
         rows,
         figure: None,

@@ -1,12 +1,25 @@
 //! Model discovery: compare a model with the data, diagnose the missing physical effects,
-//! add them, and watch the error fall.
+//! add them, and watch the error fall.  The effects and their signatures are those of the
+//! catalogue `docs/design/effects.md`.
 //!
+//! What is here, in the order of a `diagnose` run:
+//! * [`channels`]: the data channels, each with its noise radius and model entry;
+//!   [`plant_form`], [`factor_form`]: `[plant]` and factor-form configs converted to
+//!   `[physical]`;
 //! * [`compare`]: per-frequency misfit normalized by the noise radius, failing bands, error
 //!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); [`agreement`]: two data sets
 //!   against each other;
-//! * [`retune`], [`search`], [`engine`]: refit the configured model, search effect sets,
-//!   report;
-//! * [`figures`]: Bode overlay and error-vs-revision SVGs.
+//! * [`problem`]: the least-squares problem (base model, candidate effects, cost `V`);
+//!   [`fit`]: Levenberg–Marquardt; `slots` (private): the parameters `retune` refits;
+//! * [`retune`]: the joint refit of the configured model's own parameters;
+//! * [`candidates`]: the catalogue of effects and how each modifies the model; `starts`
+//!   (private): their starting points; [`rank`]: screening and physical plausibility;
+//! * [`search`]: the beam search over effect sets with joint refits; [`polish`]: the
+//!   consistency polish; [`ties`]: sets the data cannot tell apart; [`holdout`]: the
+//!   final set checked on held-out data;
+//! * [`engine`]: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
+//!   [`apply_candidate`]); [`report`]: what it reports; [`figures`]: Bode overlay and
+//!   error-vs-revision SVGs.
 pub mod compare;
 pub mod figures;
 

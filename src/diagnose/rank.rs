@@ -91,7 +91,7 @@ pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
     v
 }
 
-/// Physical plausibility of fitted parameters (effects.md step 3): `(flags, no_fit)`.
+/// Physical plausibility of fitted parameters (docs/design/effects.md step 3): `(flags, no_fit)`.
 /// `no_fit` is the reason the fit is unusable (non-finite, or a frequency more than
 /// [`MAX_BAND_FACTOR`] outside the band); a flag names a parameter at its bound (not
 /// identified) or a mode outside the band (a compliance or mass line, another effect).

@@ -1,5 +1,5 @@
 //! `retune`: the joint refit of a physical model's own parameters on one or several data
-//! channels (effects.md step 5, and the "retune first" candidate of `diagnose`).
+//! channels (docs/design/effects.md step 5, and the "retune first" candidate of `diagnose`).
 //!
 //! The model is linear in its output gains and feedthrough once the poles, the input gains
 //! and the path effects are fixed: `G_{oi} = path_{oi}·(Σ_t c_{t,o} b_{t,i} shape_t + D_{oi})`

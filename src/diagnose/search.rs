@@ -42,6 +42,16 @@ pub struct Settings {
     pub beam: usize,
 }
 
+impl Settings {
+    /// Checks every field; the error names the first bad one ([`crate::settings`]).
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("diagnose Settings")
+            .at_least("max_effects", self.max_effects, 1, "must be at least 1")
+            .at_least("beam", self.beam, 1, "must be at least 1")
+            .finish()
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Self {
@@ -148,6 +158,8 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
 
 /// Runs the beam search from the roots (the first one's screen is the first level).
 pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchResult> {
+    s.validate()
+        .map_err(|e| crate::error::Error::Invalid(e.to_string()))?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut level: Vec<usize> = (0..roots.len()).collect();
     // The configured model: the anchor of every refit's boxes.

@@ -1,6 +1,6 @@
 //! Starting points of each candidate's new parameters: closed-form estimates (linear least
 //! squares on the residual, one residue per channel), the best points of a 1-D grid, and for
-//! an added mode the peaks of the noise-normalized misfit (effects.md, step 3).
+//! an added mode the peaks of the noise-normalized misfit (docs/design/effects.md, step 3).
 
 use super::candidates::{Cand, Sel};
 use super::problem::{Mods, Problem};

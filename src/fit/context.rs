@@ -53,14 +53,8 @@ pub(crate) fn prepare<'a>(
             )));
         }
     }
-    let ok_margin = set.margin >= 0.0 && set.margin.is_finite();
-    let ok_floor = set.floor_rel > 0.0 && set.floor_rel < 1.0;
-    if !ok_margin || !ok_floor || set.grid_per_decade < 50 || set.cert_per_decade < 50 {
-        return Err(FitError::Invalid(
-            "settings: margin must be ≥ 0, floor_rel in (0, 1), grid densities ≥ 50 per decade"
-                .into(),
-        ));
-    }
+    set.validate()
+        .map_err(|e| FitError::Invalid(e.to_string()))?;
     let inadmissible: Vec<f64> = (0..n)
         .filter(|i| env.r_min[*i].is_infinite())
         .map(|i| env.omega[i])

@@ -14,7 +14,11 @@
 //! * [`certificate`]: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
 //! * [`realization`]: a balanced cascade state-space realization of `r` for the exports;
 //! * [`order`]: the order sweep and the automatic order choice;
-//! * [`run`]: fit + certificate + exports, for the CLI.
+//! * [`run`]: fit + certificate + exports, for the CLI;
+//! * private: `levelsearch` (the minimax level search of one order in the partial-fraction
+//!   basis), `polyfit` with `polyrows` and `chebseries` (the second parametrization: the full
+//!   numerator and denominator of `|r̂|²` as Chebyshev series in the disk variable, with an
+//!   exact positivity test), `settings_check` ([`FitSettings::validate`]).
 //!
 //! Comparisons are written `!(x > y)` on purpose throughout: a NaN must fail a check.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -32,12 +36,14 @@ mod polyrows;
 pub mod problem;
 pub mod realization;
 pub mod run;
+mod settings_check;
 pub mod spectral;
 
 pub use certificate::Certificate;
 pub use order::{fit_auto, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
 pub use run::{run_fit, FitOutcome, OrderChoice};
+pub use settings_check::MAX_ORDER;
 pub use spectral::Zpk;
 
 use crate::consistency::Envelope;

@@ -27,7 +27,7 @@ impl std::str::FromStr for OrderChoice {
         }
         s.parse::<usize>()
             .ok()
-            .filter(|n| *n <= 20)
+            .filter(|n| *n <= super::MAX_ORDER)
             .map(Self::Fixed)
             .ok_or_else(|| format!("--order `{s}`: expected `auto` or an integer 0..=20"))
     }

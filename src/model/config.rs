@@ -233,10 +233,7 @@ fn tf_rows(
 impl Config {
     /// Reads and validates a config file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::util::read_text_file(path)?;
         Self::parse(&text, path)
     }
 
@@ -363,6 +360,12 @@ impl Config {
         };
         let nn = crate::system::TfMatrix::from_rows(tf_rows(&m.n, "n")?)
             .ok_or("[model] n is not a rectangular matrix")?;
+        if mm.rows() == mm.cols() && nn.rows() == mm.rows() {
+            // Stable entries and left coprimeness (the theory's premises); sizes are
+            // reported by the constructors below.
+            let mk = if m.m_diag.is_some() { "m_diag" } else { "m" };
+            super::coprime::check_left_coprime(&mm, &nn, "[model]", (mk, "n"))?;
+        }
         match m.factorization {
             Standard => {
                 if m.c.is_some() || m.j.is_some() {
@@ -390,6 +393,8 @@ impl Config {
                         .collect::<std::result::Result<_, _>>()?,
                     None => vec![TransferFunction::gain(1.0); nn.cols()],
                 };
+                let jm = crate::system::TfMatrix::diagonal(j.clone());
+                super::coprime::check_stable(&jm, &|i, _| format!("[model] j[{}]", i + 1), "J")?;
                 Factorization::special(c, mm, nn, j).map_err(|e| format!("[model]: {e}"))
             }
         }

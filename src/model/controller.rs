@@ -89,10 +89,7 @@ impl Controller {
 
     /// Reads a controller file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::util::read_text_file(path)?;
         let err = |msg: String| Error::Config {
             path: path.to_path_buf(),
             msg,

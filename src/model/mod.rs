@@ -2,6 +2,7 @@
 pub mod closed_loop;
 pub mod config;
 pub mod controller;
+pub mod coprime;
 pub mod factorization;
 pub mod noise;
 pub mod physical;

@@ -117,6 +117,50 @@ pub fn radii_from_output_bound(
         .collect()
 }
 
+/// The source of the noise radii under the precedence CLI flag > config > data column (see
+/// the module documentation), decided without reading the data: `data_has_column` says
+/// whether the data file has a `noise_radius` column.  `None`: no noise model.  This is the
+/// one place the precedence is written; [`resolve_noise`] computes the radii of the source
+/// it names, and the streamed envelope uses it to decide whether the data are noise-free.
+pub fn noise_source(
+    cli_radius: Option<f64>,
+    config: Option<&Config>,
+    data_has_column: bool,
+) -> Option<NoiseSource> {
+    if cli_radius.is_some() {
+        return Some(NoiseSource::CliFlag);
+    }
+    if let Some(cfg) = config {
+        let sec = &cfg.raw.noise;
+        if sec.radius.is_some() {
+            return Some(NoiseSource::ConfigRadius);
+        }
+        if sec.output_bound.is_some() {
+            return Some(NoiseSource::ConfigOutputBound);
+        }
+        if cfg.noise_std.is_some() {
+            return Some(NoiseSource::ConfigStdFile);
+        }
+    }
+    data_has_column.then_some(NoiseSource::DataColumn)
+}
+
+/// Whether the noise the precedence selects is known to be zero without reading the data:
+/// no source, or a global radius (flag or `[noise] radius`) of exactly 0.  Per-datum sources
+/// (output bound, std file, data column) count as noisy.
+pub fn is_noise_free(
+    cli_radius: Option<f64>,
+    config: Option<&Config>,
+    data_has_column: bool,
+) -> bool {
+    match noise_source(cli_radius, config, data_has_column) {
+        None => true,
+        Some(NoiseSource::CliFlag) => cli_radius == Some(0.0),
+        Some(NoiseSource::ConfigRadius) => config.and_then(|c| c.raw.noise.radius) == Some(0.0),
+        Some(_) => false,
+    }
+}
+
 /// Resolves the noise model with precedence CLI flag > config > data column (see the module
 /// documentation).  `Ok(None)` when no noise is given anywhere.
 ///
@@ -145,85 +189,105 @@ pub fn resolve_noise_for_channel(
     (out, inp): (usize, usize),
 ) -> Result<Option<ResolvedNoise>> {
     let all = |r: f64| vec![r; data.len()];
-    if let Some(r) = cli_radius {
-        if !(r.is_finite() && r >= 0.0) {
-            return Err(Error::Invalid(format!(
-                "--noise-radius {r}: must be a finite number ≥ 0"
-            )));
-        }
-        return Ok(Some(ResolvedNoise {
-            radii: all(r),
-            source: NoiseSource::CliFlag,
-            description: format!("--noise-radius {r}"),
-        }));
+    if let (None, Some(cfg)) = (cli_radius, config) {
+        cfg.raw.noise.validate().map_err(Error::Invalid)?;
     }
-    if let Some(cfg) = config {
-        let sec = &cfg.raw.noise;
-        sec.validate().map_err(Error::Invalid)?;
-        if let Some(r) = sec.radius {
-            return Ok(Some(ResolvedNoise {
+    let Some(source) = noise_source(cli_radius, config, data.noise_radius.is_some()) else {
+        return Ok(None);
+    };
+    let resolved = match (source, config) {
+        (NoiseSource::CliFlag, _) => {
+            let r = cli_radius.unwrap_or_default();
+            if !(r.is_finite() && r >= 0.0) {
+                return Err(Error::Invalid(format!(
+                    "--noise-radius {r}: must be a finite number ≥ 0"
+                )));
+            }
+            ResolvedNoise {
                 radii: all(r),
-                source: NoiseSource::ConfigRadius,
+                source,
+                description: format!("--noise-radius {r}"),
+            }
+        }
+        (NoiseSource::ConfigRadius, Some(cfg)) => {
+            let r = cfg.raw.noise.radius.unwrap_or_default();
+            ResolvedNoise {
+                radii: all(r),
+                source,
                 description: format!("[noise] radius = {r}"),
-            }));
+            }
         }
-        if let Some(m) = sec.output_bound {
+        (NoiseSource::ConfigOutputBound, Some(cfg)) => {
+            let sec = &cfg.raw.noise;
+            let m = sec.output_bound.unwrap_or_default();
             let u = sec.input_amplitude.unwrap_or(1.0);
-            return Ok(Some(ResolvedNoise {
+            ResolvedNoise {
                 radii: radii_from_output_bound(m, u, data)?,
-                source: NoiseSource::ConfigOutputBound,
+                source,
                 description: format!("[noise] output_bound = {m} (Sec. III: L_a = M)"),
-            }));
+            }
         }
-        if let Some((file, k)) = &cfg.noise_std {
-            let own = cfg.data.as_ref().is_some_and(|d| {
-                d == &data.path
-                    || d.canonicalize()
-                        .ok()
-                        .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
-            });
-            let file = if own {
-                file.clone()
-            } else {
-                let stem = data
-                    .path
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().to_string())
-                    .unwrap_or_default();
-                let sib = data.path.with_file_name(format!("{stem}_std.csv"));
-                if !sib.exists() {
-                    return Err(Error::Invalid(format!(
-                        "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
-                        data.path.display(),
-                        sib.display()
-                    )));
-                }
-                sib
-            };
-            let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
-            return Ok(Some(ResolvedNoise {
-                description: format!("{k} × std_{out}_{inp} of {}", file.display()),
-                radii,
-                source: NoiseSource::ConfigStdFile,
-            }));
+        (NoiseSource::ConfigStdFile, Some(cfg)) => std_file_noise(cfg, data, (out, inp))?,
+        _ => {
+            let col = data.noise_radius.clone().unwrap_or_default();
+            if col.len() != data.len() {
+                return Err(Error::Invalid(format!(
+                    "{}: {} noise radii for {} data",
+                    data.path.display(),
+                    col.len(),
+                    data.len()
+                )));
+            }
+            ResolvedNoise {
+                radii: col,
+                source: NoiseSource::DataColumn,
+                description: "noise_radius column of the data".into(),
+            }
         }
-    }
-    if let Some(col) = &data.noise_radius {
-        if col.len() != data.len() {
+    };
+    Ok(Some(resolved))
+}
+
+/// The radii of a config's `[noise] std_file` for the data: the file belongs to the config's
+/// own data; for other data (`--data`) `<data stem>_std.csv` beside them is used.
+fn std_file_noise(
+    cfg: &Config,
+    data: &FrfData,
+    (out, inp): (usize, usize),
+) -> Result<ResolvedNoise> {
+    let Some((file, k)) = &cfg.noise_std else {
+        return Err(Error::Invalid("no [noise] std_file in the config".into()));
+    };
+    let own = cfg.data.as_ref().is_some_and(|d| {
+        d == &data.path
+            || d.canonicalize()
+                .ok()
+                .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
+    });
+    let file = if own {
+        file.clone()
+    } else {
+        let stem = data
+            .path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let sib = data.path.with_file_name(format!("{stem}_std.csv"));
+        if !sib.exists() {
             return Err(Error::Invalid(format!(
-                "{}: {} noise radii for {} data",
+                "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
                 data.path.display(),
-                col.len(),
-                data.len()
+                sib.display()
             )));
         }
-        return Ok(Some(ResolvedNoise {
-            radii: col.clone(),
-            source: NoiseSource::DataColumn,
-            description: "noise_radius column of the data".into(),
-        }));
-    }
-    Ok(None)
+        sib
+    };
+    let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
+    Ok(ResolvedNoise {
+        description: format!("{k} × std_{out}_{inp} of {}", file.display()),
+        radii,
+        source: NoiseSource::ConfigStdFile,
+    })
 }
 
 /// The per-datum radii only (see [`resolve_noise`]): CLI flag > config > data column;
@@ -234,4 +298,48 @@ pub fn noise_radii(
     data: &FrfData,
 ) -> Result<Option<Vec<f64>>> {
     Ok(resolve_noise(cli_radius, config, data)?.map(|r| r.radii))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn config(noise: &str) -> Config {
+        let text = format!("[plant]\ntf = [[{{ num = [1], den = [1, 1] }}]]\n{noise}\n");
+        Config::parse(&text, Path::new("c.toml")).expect("valid config")
+    }
+
+    /// The precedence CLI flag > config > data column, and zero radii as noise-free.
+    #[test]
+    fn precedence_and_noise_free_decision() {
+        let none = config("");
+        let radius = config("[noise]\nradius = 0.1");
+        let zero = config("[noise]\nradius = 0");
+        let bound = config("[noise]\noutput_bound = 0.01");
+        assert_eq!(noise_source(None, Some(&none), false), None);
+        assert_eq!(
+            noise_source(None, Some(&none), true),
+            Some(NoiseSource::DataColumn)
+        );
+        assert_eq!(
+            noise_source(Some(0.0), Some(&radius), true),
+            Some(NoiseSource::CliFlag)
+        );
+        assert_eq!(
+            noise_source(None, Some(&radius), true),
+            Some(NoiseSource::ConfigRadius)
+        );
+        assert_eq!(
+            noise_source(None, Some(&bound), true),
+            Some(NoiseSource::ConfigOutputBound)
+        );
+        assert!(is_noise_free(None, Some(&none), false));
+        assert!(!is_noise_free(None, Some(&none), true));
+        assert!(is_noise_free(Some(0.0), Some(&radius), true));
+        assert!(!is_noise_free(Some(0.2), Some(&zero), false));
+        assert!(is_noise_free(None, Some(&zero), true));
+        assert!(!is_noise_free(None, Some(&radius), false));
+        assert!(!is_noise_free(None, Some(&bound), false));
+    }
 }

@@ -165,8 +165,8 @@ impl PlantSection {
             }
         } else {
             let path = base.join(self.file.as_ref().expect("checked"));
-            let text = std::fs::read_to_string(&path)
-                .map_err(|e| format!("[plant] file {}: {e}", path.display()))?;
+            let text =
+                crate::util::read_text_file(&path).map_err(|e| format!("[plant] file {e}"))?;
             let f: SsFile = serde_json::from_str(&text).map_err(|e| {
                 format!(
                     "[plant] file {}: {e}; expected {{\"A\": [[..]], \"B\": [[..]], \"C\": [[..]], \"D\": [[..]]}}",

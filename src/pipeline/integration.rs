@@ -2,6 +2,9 @@
 //! [`crate::model::noise`], [`crate::consistency::noisy`], [`crate::mu`]) and the fit of `r`
 //! ([`crate::fit`], [`crate::report::export`]).  Everything that depends on those modules
 //! goes through the functions here.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::consistency::noisy::{gamma_lft, noisy_envelope, BisectionSettings};
 use crate::consistency::{noise_free_envelope, Envelope};

@@ -2,8 +2,11 @@
 //! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
 //! writes; neither prints.
 pub mod closed_loop;
+pub mod envelope;
 pub mod integration;
 pub mod outputs;
+pub mod stability;
+pub mod synthesize;
 
 use crate::consistency::{check, CheckReport, Envelope};
 use crate::data::FrfData;
@@ -60,9 +63,13 @@ pub fn run(
 ) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
-    let radii = integration::noise_radii(config, data, noise_radius)?;
-    let (envelope, mut warnings, closed_loop) = timings.time("envelope", || {
-        closed_loop::envelope(config, data, radii.as_deref())
+    let envelope::EnvelopeOutcome {
+        envelope,
+        noise_radii: radii,
+        mut warnings,
+        closed_loop,
+    } = timings.time("envelope", || {
+        envelope::envelope(config, data, noise_radius)
     })?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
@@ -93,7 +100,7 @@ pub fn run(
     if let Some(c) = &check {
         if !c.a1_violations.is_empty() {
             warnings.push(format!(
-                "A1 fails for the configured r at {} datum(s): |r| ≥ σ_min(M̃)",
+                "A1 fails for the configured r at {} datum(s): |r| ≥ σ_min(M̃), so r is not admissible there (verdict not_admissible)",
                 c.a1_violations.len()
             ));
         }

@@ -86,8 +86,12 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
     let a1: Option<Vec<f64>> = super::closed_loop::a1_factorization(config)
         .map(|f| grid.iter().map(|w| f.a1_limit(*w)).collect());
     let failing: Vec<bool> = match &out.check {
-        Some(c) => c.rows.iter().map(|r| !r.consistent).collect(),
+        Some(c) => c.rows.iter().map(|r| !r.covers).collect(),
         None => vec![false; env.len()],
+    };
+    let a1_failing: Vec<bool> = match &out.check {
+        Some(c) => c.rows.iter().map(|r| !r.a1_ok).collect(),
+        None => Vec::new(),
     };
     let name = config
         .raw
@@ -116,6 +120,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
                 r_min: &env.r_min,
                 r_min_label: r_min_label(env.method),
                 failing: &failing,
+                a1_failing: &a1_failing,
                 r_configured: config.r.as_ref(),
                 r_fitted: out.fit.as_ref().ok().map(|f| &f.r),
                 grid: &grid,
@@ -142,6 +147,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
             noise_radius: out.noise_radii.as_deref(),
             grid: &grid,
             model: &model,
+            symbol: if cl { "Φ" } else { "G" },
         })?,
     ));
     if let Some(mu) = &out.mu {
@@ -157,6 +163,7 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
                     title: &title,
                     omega: &env.omega,
                     mu,
+                    a1_failing: &a1_failing,
                 },
                 &Symbols::of(cl),
             )?,

@@ -8,6 +8,9 @@
 //! - [`bode`]: the data (with noise-disk error bars, eq. (5)) against the nominal model,
 //!   as in Fig. 7;
 //! - [`mu`]: `μ_Γ` per datum with the line `μ = 1` (Fig. 8).
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 pub mod bode;
 pub mod mu;
 pub mod r_vs_delta;

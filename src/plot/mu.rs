@@ -1,6 +1,9 @@
 //! `mu.svg`: the structured singular value `μ_Γ{F_L[V(jω_i), φ_i⁻¹]}` per datum for the
 //! configured `r`, with the line `μ = 1` (the analogue of Fig. 8).  By Lemma 5 / Theorem 4
 //! a datum is consistent with the model, `r` and the noise level iff `μ_Γ > 1` there.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::style::*;
 use super::symbols::Symbols;
@@ -15,6 +18,9 @@ pub struct MuInput<'a> {
     pub omega: &'a [f64],
     /// `μ_Γ` per datum (`inf` allowed, drawn at the top).
     pub mu: &'a [f64],
+    /// Per datum: true when the configured `r` breaks A1 there (Theorem 4 then gives no
+    /// verdict, whatever `μ`); empty when unknown.
+    pub a1_failing: &'a [bool],
 }
 
 /// Renders `mu.svg` on log-log axes with the open-loop symbols (`μ_Γ`, `r`); data with
@@ -51,12 +57,14 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
             .map_err(plot_err)?
             .label("μ = 1: consistent above, inconsistent at or below")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
-        let pts: Vec<(f64, f64, bool)> = inp
-            .omega
-            .iter()
-            .zip(inp.mu)
-            .filter(|(_, m)| !m.is_nan())
-            .map(|(w, m)| (*w, clamp(*m, ylo, yhi), *m > 1.0))
+        let a1_fails = |i: usize| inp.a1_failing.get(i).copied().unwrap_or(false);
+        // (ω, μ clamped, μ > 1, A1 holds)
+        let pts: Vec<(f64, f64, bool, bool)> = (0..inp.omega.len())
+            .filter(|&i| !inp.mu[i].is_nan())
+            .map(|i| {
+                let m = inp.mu[i];
+                (inp.omega[i], clamp(m, ylo, yhi), m > 1.0, !a1_fails(i))
+            })
             .collect();
         // A thin line through the data guides the eye; the markers carry the verdict.
         chart
@@ -65,15 +73,34 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                 C_BLUE.mix(0.35).stroke_width(1),
             ))
             .map_err(plot_err)?;
-        chart
-            .draw_series(
-                pts.iter()
-                    .filter(|p| p.2)
-                    .map(|p| Circle::new((p.0, p.1), 3, C_BLUE.filled())),
-            )
-            .map_err(plot_err)?
-            .label(format!("{mu_name} per datum, configured {w} (consistent)"))
-            .legend(|(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()));
+        if pts.iter().any(|p| p.2 && p.3) {
+            chart
+                .draw_series(
+                    pts.iter()
+                        .filter(|p| p.2 && p.3)
+                        .map(|p| Circle::new((p.0, p.1), 3, C_BLUE.filled())),
+                )
+                .map_err(plot_err)?
+                .label(format!("{mu_name} per datum, configured {w} (consistent)"))
+                .legend(|(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()));
+        }
+        let n_inadmissible = pts.iter().filter(|p| p.2 && !p.3).count();
+        if n_inadmissible > 0 {
+            let sq = |(x, y): (i32, i32)| [(x - 4, y - 4), (x + 4, y + 4)];
+            chart
+                .draw_series(
+                    pts.iter()
+                        .filter(|p| p.2 && !p.3)
+                        .map(|p| EmptyElement::at((p.0, p.1)) + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))),
+                )
+                .map_err(plot_err)?
+                .label(format!(
+                    "{mu_name} > 1 but A1 fails ({n_inadmissible} data): configured {w} NOT ADMISSIBLE, no verdict"
+                ))
+                .legend(move |(x, y)| {
+                    EmptyElement::at((x + 12, y)) + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
+                });
+        }
         if pts.iter().any(|p| !p.2) {
             chart
                 .draw_series(pts.iter().filter(|p| !p.2).map(|p| {

@@ -27,28 +27,43 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
         .chain(inp.r.iter().flat_map(|(_, v)| v.iter()))
         .filter(|v| v.is_finite() && **v > 0.0);
     let (ylo, yhi) = log_range(all, 2.0).unwrap_or((0.01, 100.0));
-    let (ylo, yhi) = reserve_bottom(ylo, yhi, legend_fraction(inp.r.len() + 1, SIZE.1));
+    let rows = inp.r.len() + 1;
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        let mut chart = loglog_chart(&root, inp.title, (xlo, xhi), (ylo, yhi), "magnitude")?;
-        let s = C_BLUE.stroke_width(3);
+        let (plot, below) = root.split_vertically(SIZE.1);
+        let mut leg = Legend::default();
+        let mut chart = loglog_chart(&plot, inp.title, (xlo, xhi), (ylo, yhi), "magnitude")?;
+        // Limits are purple and dashed, as the A1 limit of r_vs_delta.svg; the configured r
+        // is blue and the fitted r orange in every figure.
+        let s = C_PURPLE.stroke_width(3);
         chart
-            .draw_series(LineSeries::new(
+            .draw_series(DashedLineSeries::new(
                 inp.omega
                     .iter()
                     .zip(inp.inv_t)
                     .filter(|(_, v)| v.is_finite() && **v > 0.0)
                     .map(|(w, v)| (*w, clamp(*v, ylo, yhi))),
+                8,
+                5,
                 s,
             ))
-            .map_err(plot_err)?
-            .label("1/σ_max(T(jω)): largest |r| proven robust (Theorem 1)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
-        let colors = [C_ORANGE, C_GREEN, C_RED, C_GREY];
+            .map_err(plot_err)?;
+        leg.add(
+            "1/σ_max(T(jω)): largest |r| proven robust (Theorem 1)",
+            move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+        );
+        let others = [C_GREEN, C_RED, C_GREY];
         for (k, (label, r)) in inp.r.iter().enumerate() {
-            let c = colors[k % colors.len()].stroke_width(2);
+            let c = if label.starts_with("configured") {
+                C_BLUE
+            } else if label.starts_with("fitted") {
+                C_ORANGE
+            } else {
+                others[k % others.len()]
+            }
+            .stroke_width(3);
             chart
                 .draw_series(LineSeries::new(
                     inp.omega
@@ -57,11 +72,12 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
                         .map(|(w, v)| (*w, clamp(*v, ylo, yhi))),
                     c,
                 ))
-                .map_err(plot_err)?
-                .label(format!("|r(jω)|, {label}"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], c));
+                .map_err(plot_err)?;
+            leg.add(format!("|r(jω)|, {label}"), move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], c)
+            });
         }
-        legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
+        leg.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
     Ok(svg)

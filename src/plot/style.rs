@@ -2,8 +2,13 @@
 
 use crate::error::{Error, Result};
 use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
+use plotters::element::{Drawable, PointCollection};
 use plotters::prelude::*;
 use plotters::style::RGBColor;
+
+/// A pixel position (plotters' backend coordinate).
+type BackendCoord = (i32, i32);
 
 /// Width and height of every figure in pixels.
 pub const SIZE: (u32, u32) = (960, 620);
@@ -95,6 +100,88 @@ pub fn legend<'a, 'b, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTransla
         .draw()
         .map_err(plot_err)
 }
+
+/// Height in pixels of a legend of `rows` entries drawn below the plot (see [`Legend`]):
+/// the figure grows by this much instead of the axes giving up decades to the legend.
+pub fn legend_height(rows: usize) -> u32 {
+    rows as u32 * 20 + 24
+}
+
+/// The size of a figure with a legend of `rows` entries below the plot.
+pub fn size_with_legend(rows: usize) -> (u32, u32) {
+    (SIZE.0, SIZE.1 + legend_height(rows))
+}
+
+/// The chart of the legend strip.
+type LegendChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// One entry: registers its label and sample on the legend chart.
+type Entry<'a, DB> = Box<dyn FnOnce(&mut LegendChart<'a, DB>) -> Result<()> + 'a>;
+
+/// A legend collected while the series are drawn, then drawn in its own strip below the
+/// plot, where it hides no data and costs no axis range.
+pub struct Legend<'a, DB: DrawingBackend> {
+    entries: Vec<Entry<'a, DB>>,
+}
+
+impl<'a, DB: DrawingBackend + 'a> Default for Legend<'a, DB> {
+    fn default() -> Self {
+        Self {
+            entries: Vec::new(),
+        }
+    }
+}
+
+impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
+    /// Adds an entry: its label and the function drawing its sample at a pixel position.
+    pub fn add<E, F>(&mut self, label: impl Into<String>, mark: F)
+    where
+        E: Drawable<DB> + 'a,
+        for<'b> &'b E: PointCollection<'b, BackendCoord>,
+        F: Fn(BackendCoord) -> E + 'a,
+    {
+        let label = label.into();
+        self.entries
+            .push(Box::new(move |chart: &mut LegendChart<'a, DB>| {
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                    .map_err(plot_err)?
+                    .label(label)
+                    .legend(mark);
+                Ok(())
+            }));
+    }
+
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    /// True without entries.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Draws the legend in `area` (the strip below the plot), aligned with the plot's left
+    /// edge.
+    pub fn draw(self, area: &'a DrawingArea<DB, plotters::coord::Shift>) -> Result<()> {
+        if self.entries.is_empty() {
+            return Ok(());
+        }
+        let mut chart = ChartBuilder::on(area)
+            .margin_left(14 + Y_LABEL_AREA)
+            .margin_right(14)
+            .build_cartesian_2d(0f64..1f64, 0f64..1f64)
+            .map_err(plot_err)?;
+        for entry in self.entries {
+            entry(&mut chart)?;
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+/// Width of the y tick labels and axis description left of a plot.
+pub const Y_LABEL_AREA: u32 = 78;
 
 /// Formats a tick label of a log axis: plain numbers from 0.01 to 9999 (`0.05`, `200`),
 /// else `1e-3`, `2e5`.  Only ticks with mantissa 1, 2 or 5 are labelled (the others stay as
@@ -205,7 +292,7 @@ pub fn loglog_chart<'a, 'b>(
         .caption(title, (FONT, CAPTION))
         .margin(14)
         .x_label_area_size(52)
-        .y_label_area_size(78)
+        .y_label_area_size(Y_LABEL_AREA)
         .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
         .map_err(plot_err)?;
     loglog_mesh(&mut chart, y_desc)?;

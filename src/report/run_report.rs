@@ -1,6 +1,9 @@
 //! `report.json` of `rshape run`: the verdict of the check of the configured `r`, the
 //! per-datum envelope, the fitted `r` (as in `r.json`) with its certificate, and the time
 //! per stage.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::data::FrfData;
 use crate::model::Config;
@@ -23,8 +26,10 @@ pub struct ReportDatum {
     pub noise_radius: Option<f64>,
     /// `|r(jω)|` of the configured `r`.
     pub r_configured_abs: Option<f64>,
-    /// True when the configured `r` explains the datum.
+    /// True when the configured `r` explains the datum and A1 holds there.
     pub consistent: Option<bool>,
+    /// True when A1 holds for the configured `r` at this datum (`|r| < σ_min(M̃)`).
+    pub a1_ok: Option<bool>,
     /// `μ_Γ` for the configured `r` (noisy data, when computed).
     pub mu: Option<f64>,
 }
@@ -57,9 +62,12 @@ pub struct RunReport {
     pub method: crate::consistency::EnvelopeMethod,
     /// True when noise radii were given.
     pub noisy: bool,
-    /// True when the configured `r` explains every datum (`null` without a configured `r`).
+    /// Verdict on the configured `r`: `consistent`, `inconsistent` or `not_admissible` (A1
+    /// fails at some datum, so the theorems give no verdict); `null` without a configured `r`.
+    pub verdict: Option<crate::consistency::Verdict>,
+    /// True when the verdict is `consistent` (`null` without a configured `r`).
     pub consistent: Option<bool>,
-    /// Frequencies (rad/s) of the data the configured `r` does not explain.
+    /// Frequencies (rad/s) of the data where `|r| ≤ r_min` for the configured `r`.
     pub failing_omegas: Vec<f64>,
     /// Frequencies (rad/s) where the configured `r` violates A1.
     pub a1_violations: Vec<f64>,
@@ -123,6 +131,7 @@ impl RunReport {
                     noise_radius: out.noise_radii.as_ref().map(|r| r[i]),
                     r_configured_abs: row.map(|r| r.r_abs),
                     consistent: row.map(|r| r.consistent),
+                    a1_ok: row.map(|r| r.a1_ok),
                     mu: out.mu.as_ref().map(|m| m[i]),
                 }
             })
@@ -142,6 +151,7 @@ impl RunReport {
             size: [data.outputs(), data.inputs()],
             method: env.method,
             noisy: out.noise_radii.is_some(),
+            verdict: out.check.as_ref().map(|c| c.verdict),
             consistent: out.check.as_ref().map(|c| c.consistent),
             failing_omegas: out
                 .check

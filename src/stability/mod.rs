@@ -21,4 +21,4 @@ pub mod factor_loop;
 pub mod theorem1;
 
 pub use factor_loop::{gang_of_four, modal_system, plant_system, t_sigma_max, theorem1_system};
-pub use theorem1::{analyze, GridCurve, MarginRow, RobustStability};
+pub use theorem1::{analyze, decide, GridCurve, MarginRow, RobustStability, Verdict};

@@ -1,4 +1,7 @@
 //! The Theorem 1 test: closed-loop poles, exact margins, grid curves (see the module above).
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::factor_loop::{gang_of_four, t_sigma_max, theorem1_system};
 use crate::error::{Error, Result};
@@ -10,6 +13,23 @@ use crate::system::hinf::{hinf_norm, HinfNorm};
 use crate::system::{StateSpace, TransferFunction};
 use num_complex::Complex64;
 use serde::Serialize;
+
+/// Relative tolerance of the in-program cross-checks of `α*` (the grid bound and `b/|r|`).
+pub const CROSS_CHECK_RTOL: f64 = 1e-6;
+
+/// The Theorem 1 verdict for one bound `r`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    /// Proven: the certified margin `α*_lower = 1/upper(‖r·T‖∞)` is at least 1 and the
+    /// cross-checks agree.
+    Robust,
+    /// Not robust: the certified margin is below 1 (cross-checks agreeing), or a grid
+    /// frequency already violates `|r|·σ_max(T) ≤ 1`.
+    NotRobust,
+    /// The exact margin and its cross-checks disagree: no verdict (see `check`).
+    Withheld,
+}
 
 /// The margin of one bound `r`.
 #[derive(Debug, Clone, Serialize)]
@@ -25,8 +45,49 @@ pub struct MarginRow {
     pub omega: f64,
     /// The same margin on the grid: `min_ω 1/(|r|·σ_max(T))`.
     pub alpha_grid: f64,
-    /// Whether Theorem 1 proves robust stability (`α* ≥ 1`).
+    /// The certified lower bound `1/upper(‖r·T‖∞)` on the margin (`alpha` is within
+    /// relative `2ε` above it); the verdict uses this one.
+    pub alpha_lower: f64,
+    /// The verdict.
+    pub verdict: Verdict,
+    /// Whether Theorem 1 proves robust stability (`verdict == Robust`).
     pub robust: bool,
+    /// Why the verdict is withheld (the cross-check that failed), when it is.
+    pub check: Option<String>,
+}
+
+/// The verdict of one row: the exact margin `alpha` (certified lower bound `alpha_lower`)
+/// must not exceed the grid margin `alpha_grid` (every grid point bounds `α*` from above),
+/// and must equal `b_over_r` when given (normalized factors, constant `r`: `α* = b(G,K)/|r|`);
+/// otherwise the verdict is withheld unless the grid alone proves the loop not robust.
+pub fn decide(
+    alpha: f64,
+    alpha_lower: f64,
+    alpha_grid: f64,
+    b_over_r: Option<f64>,
+) -> (Verdict, Option<String>) {
+    let mut failed = None;
+    if !(alpha.is_finite() && alpha_lower.is_finite()) {
+        failed = Some(format!("the margin {alpha} is not finite"));
+    } else if alpha > alpha_grid * (1.0 + CROSS_CHECK_RTOL) {
+        failed = Some(format!(
+            "the exact margin {alpha:.9} exceeds the grid margin {alpha_grid:.9}, an upper bound"
+        ));
+    } else if let Some(br) = b_over_r {
+        if (alpha - br).abs() > CROSS_CHECK_RTOL * br {
+            failed = Some(format!(
+                "the exact margin {alpha:.9} differs from b(G,K)/|r| = {br:.9} (normalized factors, constant r)"
+            ));
+        }
+    }
+    if alpha_grid < 1.0 {
+        return (Verdict::NotRobust, failed);
+    }
+    match failed {
+        Some(why) => (Verdict::Withheld, Some(why)),
+        None if alpha_lower >= 1.0 => (Verdict::Robust, None),
+        None => (Verdict::NotRobust, None),
+    }
 }
 
 /// Grid curves for the figure.
@@ -134,18 +195,27 @@ pub fn analyze(
         let rt = t.times_scalar(&StateSpace::from_tf(r));
         let h = hinf_norm(&rt).map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?;
         let alpha = 1.0 / h.gamma;
+        let alpha_lower = 1.0 / h.upper;
+        // A grid point where T could not be evaluated (0 in the figure's curve) bounds nothing.
         let alpha_grid = inv_t
             .iter()
             .zip(rc)
+            .filter(|(i, _)| **i > 0.0)
             .map(|(i, r)| i / r)
             .fold(f64::INFINITY, f64::min);
+        let constant_r = r.num.degree() == 0 && r.den.degree() == 0;
+        let b_over_r = (normalized && constant_r).then(|| b_gk / r.at_infinity().abs());
+        let (verdict, check) = decide(alpha, alpha_lower, alpha_grid, b_over_r);
         margins.push(MarginRow {
             label: label.clone(),
             r: r.clone(),
             alpha,
             omega: h.omega,
             alpha_grid,
-            robust: alpha >= 1.0,
+            alpha_lower,
+            verdict,
+            robust: verdict == Verdict::Robust,
+            check,
         });
     }
     Ok((

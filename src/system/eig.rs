@@ -1,5 +1,5 @@
 //! Eigenvalues of real matrices through the real Schur form, always with an iteration cap
-//! (nalgebra's uncapped `schur()` can hang; see the design notes).
+//! (nalgebra's uncapped `schur()` can hang; docs/design/lessons.md, crate notes).
 
 use crate::error::{Error, Result};
 use nalgebra::DMatrix;

@@ -17,6 +17,9 @@
 //! divided by `|r|`, and the factors exist for unstable plants (rigid-body modes,
 //! integrators) as long as `(A, C)` is detectable and `(A, B)` has no uncontrollable mode
 //! on the imaginary axis.
+//!
+//! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
+//! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use super::freq_eval::FreqEvaluator;
 use super::riccati::{care, CareSolution};

@@ -106,6 +106,55 @@ impl TransferFunction {
         self.num.roots().roots
     }
 
+    /// Why the transfer function is not a unit of RH∞ (`None` when it is one): not
+    /// biproper, a pole or a zero in `Re s ≥ 0` (the first one named), or roots that the
+    /// capped iteration could not compute.
+    pub fn unit_violation(&self) -> Option<String> {
+        if !self.is_biproper() {
+            return Some(format!(
+                "it is not biproper (numerator degree {}, denominator degree {})",
+                self.num.degree(),
+                self.den.degree()
+            ));
+        }
+        let fmt = |z: Complex64| {
+            if z.im == 0.0 {
+                format!("s = {}", z.re)
+            } else {
+                format!("s = {}{:+}j", z.re, z.im)
+            }
+        };
+        let poles = self.den.roots();
+        let zeros = self.num.roots();
+        if !poles.converged || !zeros.converged {
+            return Some(format!(
+                "its poles and zeros could not be computed from the coefficients of degree {} (root iteration cap): give r of lower order",
+                self.den.degree()
+            ));
+        }
+        if let Some(p) = poles.roots.iter().find(|p| p.re >= 0.0 || p.re.is_nan()) {
+            return Some(format!("it is not stable (pole at {})", fmt(*p)));
+        }
+        if let Some(z) = zeros.roots.iter().find(|z| z.re >= 0.0 || z.re.is_nan()) {
+            return Some(format!("it is not minimum phase (zero at {})", fmt(*z)));
+        }
+        None
+    }
+
+    /// The coefficients for a message: `num/den` when short, the degrees otherwise (a
+    /// message stays one readable line whatever the order).
+    pub fn brief(&self) -> String {
+        if self.num.coeffs().len() + self.den.coeffs().len() <= 12 {
+            format!("({:?})/({:?})", self.num.coeffs(), self.den.coeffs())
+        } else {
+            format!(
+                "(degree {} / degree {})",
+                self.num.degree(),
+                self.den.degree()
+            )
+        }
+    }
+
     /// True when the transfer function is a unit of RH∞: biproper, and every pole and zero
     /// strictly in the open left half-plane.
     pub fn is_unit(&self) -> bool {

@@ -88,6 +88,9 @@ pub fn closed_loop_envelope(
     radii: Option<&[f64]>,
     settings: &VBisection,
 ) -> Result<ClosedLoopReport> {
+    settings
+        .validate()
+        .map_err(|e| Error::Invalid(e.to_string()))?;
     check_sizes(model, data)?;
     if let Some(r) = radii {
         if data.outputs() != 1 || data.inputs() != 1 {

@@ -71,6 +71,16 @@ pub struct VBisection {
     pub max_iter: usize,
 }
 
+impl VBisection {
+    /// Checks every field; the error names the first bad one ([`crate::settings`]).
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("VBisection")
+            .fraction("rel_tol", self.rel_tol)
+            .at_least("max_iter", self.max_iter, 1, "must be at least 1")
+            .finish()
+    }
+}
+
 impl Default for VBisection {
     fn default() -> Self {
         Self {

@@ -209,12 +209,16 @@ fn factors(
                 ));
             }
             for (m, k) in [(&n, kn), (&d, kd)] {
-                if !stability::is_stable(m) {
+                if m.entries().iter().any(|t| !t.is_proper()) {
                     return Err(format!(
-                        "[closed_loop] {k}: the factors must be stable and proper (every pole in Re s < 0, deg num ≤ deg den)"
+                        "[closed_loop] {k}: the factors must be proper (deg num ≤ deg den in every entry)"
                     ));
                 }
             }
+            // Stable entries (the message names the entry and its pole), then no common
+            // right-half-plane zero would otherwise surface as an "unstable
+            // loop" that blames the controller's stabilizing property.
+            crate::model::coprime::check_right_coprime(&n, &d, "[closed_loop]", (kn, kd))?;
             Ok(Some(RightFactors {
                 n,
                 d,

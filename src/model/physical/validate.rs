@@ -3,6 +3,14 @@
 use super::{EffectPath, Feedthrough, Gains, PhysicalModel};
 use crate::system::Polynomial;
 
+/// Natural frequencies accepted (rad/s): `ω_n²` and the products of the mode's
+/// polynomials stay far from overflow and underflow, and the data's frequency grid can reach
+/// the mode (an `ω_n` of 1e300 made the envelope's iterations spin).
+pub const OMEGA_N_RANGE: std::ops::RangeInclusive<f64> = 1e-8..=1e10;
+
+/// Largest damping ratio accepted.
+pub const MAX_ZETA: f64 = 1e4;
+
 impl PhysicalModel {
     /// Checks every parameter; the message names the table and the key.
     pub fn validate(&self) -> Result<(), String> {
@@ -31,10 +39,30 @@ impl PhysicalModel {
         };
         for (k, md) in self.mode.iter().enumerate() {
             let at = format!("[[physical.mode]] #{}", k + 1);
-            if !(md.omega_n.is_finite() && md.omega_n > 0.0) {
+            if !md.omega_n.is_finite() {
+                return Err(format!(
+                    "{at}: omega_n = {} is not a finite number: give the natural frequency in rad/s",
+                    md.omega_n
+                ));
+            }
+            if md.omega_n <= 0.0 {
                 return Err(format!(
                     "{at}: omega_n = {} must be positive (rad/s)",
                     md.omega_n
+                ));
+            }
+            if !OMEGA_N_RANGE.contains(&md.omega_n) {
+                return Err(format!(
+                    "{at}: omega_n = {:e} rad/s is outside {:e}…{:e} rad/s, where ω_n² and the mode's coefficients stay representable: check the units",
+                    md.omega_n,
+                    OMEGA_N_RANGE.start(),
+                    OMEGA_N_RANGE.end()
+                ));
+            }
+            if md.zeta.is_finite() && md.zeta > MAX_ZETA {
+                return Err(format!(
+                    "{at}: zeta = {:e} is above {MAX_ZETA:e}: a damping ratio is of order 1e-4…10",
+                    md.zeta
                 ));
             }
             if !(md.zeta.is_finite() && md.zeta > 0.0) {

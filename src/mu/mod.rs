@@ -73,6 +73,18 @@ pub struct MuSettings {
     pub svd_max_iter: usize,
 }
 
+impl MuSettings {
+    /// Checks every field; the error names the first bad one ([`crate::settings`]).
+    pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
+        crate::settings::Checker::new("MuSettings")
+            .fraction("rel_gap", self.rel_gap)
+            .at_least("max_evals", self.max_evals, 1, "must be at least 1")
+            .positive("log_d_range", self.log_d_range)
+            .at_least("svd_max_iter", self.svd_max_iter, 1, "must be at least 1")
+            .finish()
+    }
+}
+
 impl Default for MuSettings {
     fn default() -> Self {
         Self {
@@ -201,50 +213,11 @@ pub fn mu_full_scalar_from(
     settings: &MuSettings,
     log_d_hint: Option<f64>,
 ) -> Result<MuBounds> {
-    if s.rows == 0 || s.cols == 0 {
-        return Err(Error::Invalid(format!(
-            "μ structure: the full block must be at least 1×1, got {}×{}",
-            s.rows, s.cols
-        )));
-    }
-    if m.shape() != s.m_shape() {
-        return Err(Error::Invalid(format!(
-            "μ: M is {}×{} but the structure diag(Δ̃ {}×{}, w̃) needs {}×{}",
-            m.nrows(),
-            m.ncols(),
-            s.rows,
-            s.cols,
-            s.m_shape().0,
-            s.m_shape().1
-        )));
+    check_structure(m, s)?;
+    if m.iter().any(|v| !v.is_finite()) {
+        return Ok(Outcome::non_finite().bounds(s));
     }
     let (q, k) = (s.rows, s.cols);
-    let done = |upper: f64, lower: f64, log_d, evals, status, witness, row_share| MuBounds {
-        upper,
-        lower,
-        row_share,
-        rel_gap: if upper > 0.0 {
-            (upper - lower) / upper
-        } else {
-            0.0
-        },
-        log_d,
-        evaluations: evals,
-        status,
-        witness,
-        structure: s,
-    };
-    if m.iter().any(|v| !v.is_finite()) {
-        return Ok(done(
-            f64::NAN,
-            f64::NAN,
-            f64::NAN,
-            0,
-            MuStatus::NonFinite,
-            None,
-            f64::NAN,
-        ));
-    }
     let n12 = m.view((0, q), (k, 1)).norm();
     let n21 = m.view((k, 0), (1, q)).norm();
     let mut search = Search {
@@ -264,70 +237,157 @@ pub fn mu_full_scalar_from(
     let mut e_last = DVector::zeros(q + 1);
     e_last[q] = Complex64::new(1.0, 0.0);
     search.offer(e_last);
-    let sigma11 = |search: &mut Search| -> Option<f64> {
-        let m11 = m.view((0, 0), (k, q)).into_owned();
-        let svd =
-            SVD::try_new_unordered(m11, false, true, 5.0 * f64::EPSILON, settings.svd_max_iter)?;
-        let vt = svd.v_t.as_ref()?;
-        let (imax, &sv) = svd
-            .singular_values
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.total_cmp(b.1))?;
-        let x = DVector::from_fn(q + 1, |j, _| {
-            if j < q {
-                vt[(imax, j)].conj()
-            } else {
-                Complex64::default()
-            }
-        });
-        search.offer(x);
-        Some(sv)
+    let outcome = if n12 == 0.0 || n21 == 0.0 {
+        block_triangular(&mut search, n12)
+    } else {
+        let t0 = log_d_hint
+            .filter(|t| t.is_finite())
+            .unwrap_or(0.5 * (n12 / n21).ln());
+        scaled_search(&mut search, t0)
     };
-    if n12 == 0.0 || n21 == 0.0 {
-        // Block triangular: det(I − MΔ_s) = det(I − M₁₁Δ̃)·(1 − M₂₂w̃).
-        let Some(s11) = sigma11(&mut search) else {
-            return Ok(done(
-                f64::NAN,
-                search.lower,
-                f64::NAN,
-                1,
-                MuStatus::SvdFailed,
-                search.witness,
-                f64::NAN,
-            ));
+    Ok(outcome.bounds(s))
+}
+
+/// The sizes of `M` against the structure `diag(Δ̃ q×k, w̃)`.
+fn check_structure(m: &DMatrix<Complex64>, s: FullPlusScalar) -> Result<()> {
+    if s.rows == 0 || s.cols == 0 {
+        return Err(Error::Invalid(format!(
+            "μ structure: the full block must be at least 1×1, got {}×{}",
+            s.rows, s.cols
+        )));
+    }
+    if m.shape() != s.m_shape() {
+        return Err(Error::Invalid(format!(
+            "μ: M is {}×{} but the structure diag(Δ̃ {}×{}, w̃) needs {}×{}",
+            m.nrows(),
+            m.ncols(),
+            s.rows,
+            s.cols,
+            s.m_shape().0,
+            s.m_shape().1
+        )));
+    }
+    Ok(())
+}
+
+/// What a μ computation found, before it is tied to its structure.
+struct Outcome {
+    upper: f64,
+    lower: f64,
+    log_d: f64,
+    evals: usize,
+    status: MuStatus,
+    witness: Option<DVector<Complex64>>,
+    row_share: f64,
+}
+
+impl Outcome {
+    fn non_finite() -> Self {
+        Self {
+            upper: f64::NAN,
+            lower: f64::NAN,
+            log_d: f64::NAN,
+            evals: 0,
+            status: MuStatus::NonFinite,
+            witness: None,
+            row_share: f64::NAN,
+        }
+    }
+
+    fn bounds(self, structure: FullPlusScalar) -> MuBounds {
+        MuBounds {
+            upper: self.upper,
+            lower: self.lower,
+            row_share: self.row_share,
+            rel_gap: if self.upper > 0.0 {
+                (self.upper - self.lower) / self.upper
+            } else {
+                0.0
+            },
+            log_d: self.log_d,
+            evaluations: self.evals,
+            status: self.status,
+            witness: self.witness,
+            structure,
+        }
+    }
+}
+
+/// `σ̄(M₁₁)`, offering its top right singular vector (padded with a zero) as a witness.
+fn sigma11(search: &mut Search) -> Option<f64> {
+    let (m, q, k) = (search.m, search.q, search.k);
+    let m11 = m.view((0, 0), (k, q)).into_owned();
+    let svd = SVD::try_new_unordered(
+        m11,
+        false,
+        true,
+        5.0 * f64::EPSILON,
+        search.settings.svd_max_iter,
+    )?;
+    let vt = svd.v_t.as_ref()?;
+    let (imax, &sv) = svd
+        .singular_values
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))?;
+    let x = DVector::from_fn(q + 1, |j, _| {
+        if j < q {
+            vt[(imax, j)].conj()
+        } else {
+            Complex64::default()
+        }
+    });
+    search.offer(x);
+    Some(sv)
+}
+
+/// `M₁₂ = 0` or `M₂₁ = 0`: block triangular, `det(I − MΔ_s) = det(I − M₁₁Δ̃)·(1 − M₂₂w̃)`,
+/// so `μ = max(σ̄(M₁₁), |M₂₂|)` exactly, at `d → 0` or `d → ∞`.
+fn block_triangular(search: &mut Search, n12: f64) -> Outcome {
+    let m22 = search.m[(search.k, search.q)].norm();
+    let Some(s11) = sigma11(search) else {
+        return Outcome {
+            upper: f64::NAN,
+            lower: search.lower,
+            log_d: f64::NAN,
+            evals: 1,
+            status: MuStatus::SvdFailed,
+            witness: search.witness.take(),
+            row_share: f64::NAN,
         };
-        let upper = s11.max(m[(k, q)].norm());
-        let log_d = if n12 == 0.0 {
+    };
+    let upper = s11.max(m22);
+    Outcome {
+        upper,
+        lower: if upper > 0.0 { search.lower } else { 0.0 },
+        log_d: if n12 == 0.0 {
             f64::NEG_INFINITY
         } else {
             f64::INFINITY
-        };
-        let witness = if upper > 0.0 { search.witness } else { None };
-        let lower = if upper > 0.0 { search.lower } else { 0.0 };
+        },
+        evals: 1,
+        status: MuStatus::Converged,
+        witness: if upper > 0.0 {
+            search.witness.take()
+        } else {
+            None
+        },
         // μ = σ̄(M₁₁) scales with the rows, μ = |M₂₂| does not.
-        let share = if s11 > m[(k, q)].norm() { 1.0 } else { 0.0 };
-        return Ok(done(
-            upper,
-            lower,
-            log_d,
-            1,
-            MuStatus::Converged,
-            witness,
-            share,
-        ));
+        row_share: if s11 > m22 { 1.0 } else { 0.0 },
     }
-    let t0 = log_d_hint
-        .filter(|t| t.is_finite())
-        .unwrap_or(0.5 * (n12 / n21).ln());
-    newton_search(&mut search, t0);
+}
+
+/// The general case: the Newton search over `t = ln d` from `t0`, then the balanced and
+/// kink candidates and `σ̄(M₁₁)` while the gap is above the tolerance.
+fn scaled_search(search: &mut Search, t0: f64) -> Outcome {
+    newton_search(search, t0);
     if !search.gap_ok() && !search.svd_failed {
         search.balance_candidate();
     }
     if !search.gap_ok() && !search.svd_failed {
         search.kink_candidate();
         if !search.gap_ok() {
-            sigma11(&mut search);
+            sigma11(search);
         }
     }
     let status = if search.gap_ok() {
@@ -337,14 +397,13 @@ pub fn mu_full_scalar_from(
     } else {
         MuStatus::GapAboveTolerance
     };
-    let (upper, lower, t) = (search.upper, search.lower, search.t_upper);
-    Ok(done(
-        upper,
-        lower,
-        t,
-        search.evals,
+    Outcome {
+        upper: search.upper,
+        lower: search.lower,
+        log_d: search.t_upper,
+        evals: search.evals,
         status,
-        search.witness,
-        search.share_upper,
-    ))
+        witness: search.witness.take(),
+        row_share: search.share_upper,
+    }
 }

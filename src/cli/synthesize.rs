@@ -1,0 +1,131 @@
+//! `rshape synthesize CONFIG [--r-json r.json | --fit] [--gamma-factor F] --out DIR
+//! [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
+//! (issue 22). Exit 0 proven robust for every bound given, 1 not, 2 error.
+
+use super::common::InputArgs;
+use crate::fit::{run_fit, FitSettings, OrderChoice};
+use crate::model::Config;
+use crate::pipeline::{stability, synthesize};
+use anyhow::{anyhow, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `rshape synthesize`.
+#[derive(Debug, Args)]
+pub struct SynthesizeArgs {
+    /// The TOML config ([plant], or [model]/[physical] factors; its [r] is the configured bound).
+    pub config: PathBuf,
+    /// A fitted r (the r.json written by `rshape run` or `rshape fit`).
+    #[arg(long)]
+    pub r_json: Option<PathBuf>,
+    /// Fit r from the config's data first (as `rshape fit`; exports go to --out).
+    #[arg(long, conflicts_with = "r_json")]
+    pub fit: bool,
+    /// Data file overriding the one in the config.
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Suboptimality: the central controller at gamma = F * gamma_min (F > 1).
+    #[arg(long, default_value_t = 1.1)]
+    pub gamma_factor: f64,
+    /// Output directory (created if needed).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Print synthesis.json's content instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `rshape synthesize`.
+pub fn run(a: &SynthesizeArgs) -> Result<i32> {
+    let config = Config::load(&a.config)?;
+    synthesize::plant_factors(&config, &a.config)?;
+    if !(a.gamma_factor.is_finite() && a.gamma_factor > 1.0) {
+        return Err(anyhow!(
+            "--gamma-factor {}: must be a number > 1 (gamma = F * gamma_min; the central controller is undefined at gamma_min)",
+            a.gamma_factor
+        ));
+    }
+    if config.closed_loop.is_some() && a.fit {
+        return Err(anyhow!(
+            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
+            a.config.display()
+        ));
+    }
+    let given = a
+        .r_json
+        .as_deref()
+        .map(stability::read_r_json)
+        .transpose()?;
+    let mut rs = stability::bounds(&config, given);
+    let fit_input = if a.fit {
+        let input = InputArgs {
+            config: a.config.clone(),
+            data: a.data.clone(),
+            noise_radius: None,
+        };
+        Some(input.envelope()?)
+    } else {
+        None
+    };
+    let inputs: Vec<&Path> = [
+        Some(a.config.as_path()),
+        a.r_json.as_deref(),
+        a.data.as_deref(),
+        config.data.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    // Everything that can fail on bad input is checked before the folder is touched: the
+    // synthesis itself runs in memory first.
+    let settings = synthesize::SynthesisSettings {
+        gamma_factor: a.gamma_factor,
+    };
+    let controller_path = a.out.join("controller.toml");
+    if fit_input.is_none() {
+        synthesize::run(
+            &config,
+            &a.config,
+            &rs,
+            &settings,
+            a.data.as_deref(),
+            &controller_path,
+        )?;
+    }
+    let _manifest = super::common::prepare_out(&a.out, &inputs)?;
+    let mut fit_text = String::new();
+    if let Some((inputs, env)) = &fit_input {
+        let f = &inputs.config.factorization;
+        let a1 = |w: f64| f.a1_limit(w);
+        let outcome = run_fit(
+            env,
+            Some(&a1),
+            &FitSettings::default(),
+            OrderChoice::Auto { max: 8 },
+            &a.out,
+        )?;
+        fit_text = outcome.text;
+        rs.push(("fitted".into(), outcome.result.r.clone()));
+    }
+    let outcome = synthesize::run(
+        &config,
+        &a.config,
+        &rs,
+        &settings,
+        a.data.as_deref(),
+        &controller_path,
+    )?;
+    let written = synthesize::write_outputs(&a.out, &outcome)?;
+    let code = if outcome.robust { 0 } else { 1 };
+    if a.json {
+        let text = std::fs::read_to_string(a.out.join("synthesis.json"))?;
+        outln!("{text}");
+        return Ok(code);
+    }
+    print!("{fit_text}");
+    print!("{}", synthesize::text(&outcome));
+    for f in &written {
+        outln!("wrote {}", f.display());
+    }
+    Ok(code)
+}

@@ -1,0 +1,115 @@
+//! The envelope of a config's data, chosen in one place for every subcommand: the
+//! closed-loop envelope (Crowder & de Callafon) for a `[closed_loop]` config, otherwise
+//! Boulet & Francis 1998: Theorem 4 (the μ bisection) when the resolved noise radii are not
+//! all zero, else Theorem 2 or 3.  The noise radii follow the precedence of
+//! [`crate::model::noise::noise_source`].
+
+use super::closed_loop;
+use super::integration;
+use crate::consistency::closed_loop::ClosedLoopReport;
+use crate::consistency::stream::noise_free_envelope_rows;
+use crate::consistency::Envelope;
+use crate::data::reader::FrfRows;
+use crate::data::FrfData;
+use crate::error::{Error, Result};
+use crate::model::noise::is_noise_free;
+use crate::model::Config;
+use std::path::Path;
+
+/// An envelope with what was resolved on the way.
+#[derive(Debug, Clone)]
+pub struct EnvelopeOutcome {
+    /// Per-datum smallest consistent `|r|` (or `|V|` closed-loop) and the A1 limit.
+    pub envelope: Envelope,
+    /// Per-datum noise radii (`None`: noise-free).
+    pub noise_radii: Option<Vec<f64>>,
+    /// Warnings for the reader (data no `r` explains, uninformative closed-loop data).
+    pub warnings: Vec<String>,
+    /// Per-datum closed-loop diagnostics (closed-loop configs only).
+    pub closed_loop: Option<ClosedLoopReport>,
+}
+
+/// The envelope of loaded data for a config.  `cli_noise` is a global noise radius that
+/// overrides the config (`--noise-radius`).  Noisy open-loop MIMO data are an error naming
+/// the data file: the paper's noisy test (Theorem 4) is SISO.
+pub fn envelope(
+    config: &Config,
+    data: &FrfData,
+    cli_noise: Option<f64>,
+) -> Result<EnvelopeOutcome> {
+    let radii = integration::noise_radii(config, data, cli_noise)?;
+    if radii.is_some()
+        && config.closed_loop.is_none()
+        && (data.outputs() != 1 || data.inputs() != 1)
+    {
+        return Err(Error::Invalid(format!(
+            "{}: noisy consistency (Theorem 4) is for SISO data, these are {}×{}; select a channel with [channel] or pass --noise-radius 0",
+            data.path.display(),
+            data.outputs(),
+            data.inputs()
+        )));
+    }
+    let (envelope, warnings, closed_loop) = closed_loop::envelope(config, data, radii.as_deref())?;
+    Ok(EnvelopeOutcome {
+        envelope,
+        noise_radii: radii,
+        warnings,
+        closed_loop,
+    })
+}
+
+/// The envelope of a data file, streamed when the noise-free theorems apply (an open-loop
+/// config whose noise, by the precedence of [`crate::model::noise::noise_source`], is absent
+/// or zero): memory then stays at about 56 bytes per datum whatever the file size.
+/// Otherwise the data are read whole and [`envelope`] decides.
+pub fn envelope_of_file(
+    config: &Config,
+    data_path: &Path,
+    cli_noise: Option<f64>,
+) -> Result<Envelope> {
+    if config.closed_loop.is_none() {
+        let rows = FrfRows::open(data_path)?;
+        if cli_noise.is_none() {
+            config.raw.noise.validate().map_err(|msg| Error::Config {
+                path: config.path.clone(),
+                msg,
+            })?;
+        }
+        if is_noise_free(cli_noise, Some(config), rows.has_noise_column()) {
+            let channel = config.raw.channel.map(|c| (c.output, c.input));
+            return noise_free_envelope_rows(&config.factorization, rows, channel);
+        }
+    }
+    let data = load_data(config, data_path)?;
+    Ok(envelope(config, &data, cli_noise)?.envelope)
+}
+
+/// Reads a config's data file (closed-loop spectra or FRF) and applies its `[channel]` when
+/// the data are larger than the model.
+pub fn load_data(config: &Config, data_path: &Path) -> Result<FrfData> {
+    let mut data = closed_loop::read_data(config, data_path)?;
+    let f = &config.factorization;
+    if let Some(ch) = config.raw.channel {
+        let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());
+        if !fits {
+            crate::data::check_channel(
+                &data.path,
+                (ch.output, ch.input),
+                (data.outputs(), data.inputs()),
+            )
+            .map_err(|e| Error::Config {
+                path: config.path.clone(),
+                msg: e.to_string(),
+            })?;
+        }
+        if !fits
+            && ch.output >= 1
+            && ch.input >= 1
+            && ch.output <= data.outputs()
+            && ch.input <= data.inputs()
+        {
+            data = data.channel(ch.output - 1, ch.input - 1);
+        }
+    }
+    Ok(data)
+}

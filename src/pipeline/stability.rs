@@ -1,0 +1,297 @@
+//! The `rshape stability` pipeline: the bounds `r` to test (configured, `r.json`, fitted),
+//! the frequency grid, the Theorem 1 test ([`crate::stability::analyze`]), the report text,
+//! `stability.svg` and `stability.json`. Usable from Rust code; the CLI only parses and
+//! prints.
+
+use crate::error::{Error, Result};
+use crate::model::controller::Controller;
+use crate::model::{Config, FactorizationKind};
+use crate::plot::stability::{stability_svg, StabilityInput};
+use crate::report::fmt::fmt_g;
+use crate::stability::{analyze, GridCurve, RobustStability, Verdict};
+use crate::system::{logspace, TransferFunction};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+#[derive(serde::Deserialize)]
+struct RFile {
+    num: Vec<f64>,
+    den: Vec<f64>,
+}
+
+/// Reads the `r` of an `r.json` written by `rshape fit` or `rshape run` (keys `num`, `den`).
+pub fn read_r_json(path: &Path) -> Result<TransferFunction> {
+    let text = crate::util::read_text_file(path)?;
+    let r: RFile = serde_json::from_str(&text).map_err(|e| {
+        Error::Invalid(format!(
+            "{}: {e}; expected the r.json of `rshape fit` (keys num, den)",
+            path.display()
+        ))
+    })?;
+    if r.num.iter().chain(&r.den).any(|v| !v.is_finite()) || r.den.iter().all(|v| *v == 0.0) {
+        return Err(Error::Invalid(format!(
+            "{}: num/den must be finite, den non-zero",
+            path.display()
+        )));
+    }
+    let r = TransferFunction::new(r.num, r.den);
+    if let Some(why) = r.unit_violation() {
+        return Err(Error::Invalid(format!(
+            "{}: r = {} is not a unit of RH∞: {why}; Theorem 1 needs a stable, minimum-phase, biproper r (the r.json of `rshape fit` is one)",
+            path.display(),
+            r.brief()
+        )));
+    }
+    Ok(r)
+}
+
+/// The labelled bounds of a config: its `[r]` as `configured` (not for a `[closed_loop]`
+/// config, whose `[v]` bounds the dual-Youla perturbation, not the factor perturbation of
+/// Theorem 1), then `given` as `fitted`.
+pub fn bounds(config: &Config, given: Option<TransferFunction>) -> Vec<(String, TransferFunction)> {
+    let mut rs = Vec::new();
+    if let Some(r) = config.r.as_ref().filter(|_| config.closed_loop.is_none()) {
+        rs.push(("configured".to_string(), r.clone()));
+    }
+    if let Some(r) = given {
+        rs.push(("fitted".to_string(), r));
+    }
+    rs
+}
+
+/// The grid of the figure and of the grid margin: a decade beyond the data's range (the
+/// data file given, `data`, else the config's), else two decades beyond the closed-loop
+/// poles' magnitudes; 1000 points.
+pub fn grid(config: &Config, data: Option<&Path>, poles: &[num_complex::Complex64]) -> Vec<f64> {
+    let data_range = data
+        .or(config.data.as_deref())
+        .and_then(|p| crate::data::read_frf_csv(p).ok())
+        .filter(|d| !d.omega.is_empty())
+        .map(|d| (d.omega[0], d.omega[d.omega.len() - 1]));
+    let (lo, hi) = match data_range {
+        Some((a, b)) if a > 0.0 && b >= a => (a / 10.0, b * 10.0),
+        _ => {
+            let mags: Vec<f64> = poles
+                .iter()
+                .map(|z| z.norm())
+                .filter(|w| *w > 0.0)
+                .collect();
+            let lo = mags.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = mags.iter().copied().fold(0.0, f64::max);
+            if lo.is_finite() && hi > 0.0 {
+                (lo / 100.0, hi * 100.0)
+            } else {
+                (1e-3, 1e3)
+            }
+        }
+    };
+    logspace(lo, hi, 1000)
+}
+
+/// What the Theorem 1 test found for one controller.
+#[derive(Debug, Clone)]
+pub struct StabilityOutcome {
+    /// The report (poles, exact norms, one margin row per bound).
+    pub report: RobustStability,
+    /// The grid curves of the figure.
+    pub curve: GridCurve,
+    /// Labels of the bounds, in the order of `report.margins`.
+    pub labels: Vec<String>,
+    /// Whether every bound is proven robust (internally stable, every verdict `Robust`).
+    pub robust: bool,
+    /// The factorization's kind (for the text).
+    pub kind: FactorizationKind,
+    /// Whether the config is a `[closed_loop]` one (its `[v]` is not a bound).
+    pub closed_loop: bool,
+}
+
+/// Checks that `controller` fits the plant (size, well-posed loop) before any output is
+/// written, and returns the closed-loop poles (for the grid).
+pub fn check_controller(
+    config: &Config,
+    controller: &Controller,
+) -> Result<Vec<num_complex::Complex64>> {
+    let (rep, _) = analyze(&config.factorization, controller, &[], &[1.0])?;
+    Ok(rep.closed_loop_poles)
+}
+
+/// Runs the Theorem 1 test of `controller` on the config's factorization for every bound in
+/// `rs`, on the grid of [`grid`] (`data` overriding the config's data file).
+pub fn run(
+    config: &Config,
+    controller: &Controller,
+    rs: &[(String, TransferFunction)],
+    data: Option<&Path>,
+) -> Result<StabilityOutcome> {
+    let poles = check_controller(config, controller)?;
+    let g = grid(config, data, &poles);
+    let (report, curve) = analyze(&config.factorization, controller, rs, &g)?;
+    let robust = report.internally_stable && report.margins.iter().all(|m| m.robust);
+    Ok(StabilityOutcome {
+        report,
+        curve,
+        labels: rs.iter().map(|(l, _)| l.clone()).collect(),
+        robust,
+        kind: config.factorization.kind,
+        closed_loop: config.closed_loop.is_some(),
+    })
+}
+
+/// The title of `stability.svg`: it names the model and the controller (a figure travels
+/// without its folder), at most 80 characters.
+pub fn figure_title(config: &Config, controller: &str) -> String {
+    let name = config
+        .raw
+        .name
+        .clone()
+        .unwrap_or_else(|| config.path.display().to_string());
+    let title = format!("Theorem 1: 1/σ_max(T) vs |r| — {name}, {controller}");
+    if title.chars().count() > 80 {
+        format!("{}…", title.chars().take(79).collect::<String>())
+    } else {
+        title
+    }
+}
+
+/// Writes `stability.svg` (titled `title`, see [`figure_title`]) and `stability.json` into
+/// `out` (atomically) and returns them.
+pub fn write_outputs(out: &Path, o: &StabilityOutcome, title: &str) -> Result<Vec<PathBuf>> {
+    let labelled: Vec<(String, Vec<f64>)> = o
+        .labels
+        .iter()
+        .cloned()
+        .zip(o.curve.r.iter().cloned())
+        .collect();
+    let svg = stability_svg(&StabilityInput {
+        title,
+        omega: &o.curve.omega,
+        inv_t: &o.curve.inv_t,
+        r: &labelled,
+    })?;
+    let svg_path = out.join("stability.svg");
+    crate::util::write_atomic(&svg_path, svg.as_bytes())?;
+    let json = serde_json::json!({ "report": &o.report, "grid": &o.curve, "robust": o.robust });
+    let json_path = out.join("stability.json");
+    let text = serde_json::to_string_pretty(&json)
+        .map_err(|e| Error::Invalid(format!("stability.json: {e}")))?;
+    crate::util::write_atomic(&json_path, text.as_bytes())?;
+    Ok(vec![svg_path, json_path])
+}
+
+/// The report as the CLI prints it (answers first: stability, norms, one row per bound,
+/// failed cross-checks).
+pub fn text(o: &StabilityOutcome) -> String {
+    let rep = &o.report;
+    let mut s = String::new();
+    let n = rep.closed_loop_poles.len();
+    if !rep.internally_stable {
+        let unstable: Vec<String> = rep
+            .closed_loop_poles
+            .iter()
+            .filter(|z| z.re >= 0.0)
+            .map(|z| {
+                let sign = if z.im < 0.0 { '-' } else { '+' };
+                format!("{}{sign}{}j", fmt_g(z.re), fmt_g(z.im.abs()))
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "NOT internally stable: {} of {n} closed-loop poles in the closed right half-plane: {}",
+            unstable.len(),
+            unstable.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "Theorem 1 condition 1 fails: K does not stabilize the nominal plant."
+        );
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "internally stable: {n} closed-loop poles (the loop's and the factors' own), largest real part {}",
+        fmt_g(rep.abscissa)
+    );
+    if let Some(t) = &rep.t_norm {
+        let form = match o.kind {
+            FactorizationKind::Standard => "T = [K; I](I+GK)^-1 M~^-1",
+            FactorizationKind::Special => "T = [JKC; I](M~ + N~JKC)^-1, special factorization",
+        };
+        let _ = writeln!(
+            s,
+            "||T||_inf = {} at omega = {} rad/s ({form})",
+            fmt_g(t.gamma),
+            fmt_g(t.omega)
+        );
+    }
+    if let Some(b) = rep.b_gk {
+        let _ = writeln!(
+            s,
+            "b(G,K) = {} (normalized coprime-factor stability margin)",
+            fmt_g(b)
+        );
+        if rep.normalized {
+            if let Some(t) = &rep.t_norm {
+                let _ = writeln!(
+                    s,
+                    "cross-check (normalized factors): 1/||T||_inf = {}, b(G,K) = {}, relative difference {:.1e}",
+                    fmt_g(1.0 / t.gamma),
+                    fmt_g(b),
+                    ((1.0 / t.gamma) - b).abs() / b
+                );
+            }
+        }
+    }
+    if rep.margins.is_empty() && o.closed_loop {
+        let _ = writeln!(s, "no r given: the [v] of a [closed_loop] config is not a factor bound; give --r-json for the Theorem 1 margin");
+    } else if rep.margins.is_empty() {
+        let _ = writeln!(
+            s,
+            "no r given: add [r] to the config, --r-json or --fit for the Theorem 1 margin"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "{:<12} {:>12} {:>14} {:>12} {:>8}",
+            "r", "alpha*", "binds at w", "alpha grid", "robust"
+        );
+        for m in &rep.margins {
+            let _ = writeln!(
+                s,
+                "{:<12} {:>12} {:>14} {:>12} {:>8}",
+                m.label,
+                fmt_g(m.alpha),
+                fmt_g(m.omega),
+                fmt_g(m.alpha_grid),
+                match m.verdict {
+                    Verdict::Robust => "yes",
+                    Verdict::NotRobust => "NO",
+                    Verdict::Withheld => "withheld",
+                }
+            );
+        }
+        for m in &rep.margins {
+            if let Some(why) = &m.check {
+                let _ = writeln!(
+                    s,
+                    "{}: cross-check failed, {why}{}",
+                    m.label,
+                    if m.verdict == Verdict::Withheld {
+                        ": verdict withheld (not proven robust)"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
+        if let [c, f, ..] = rep.margins.as_slice() {
+            let _ = writeln!(
+                s,
+                "what the tighter r buys: margin {} -> {} ({:+.1}%)",
+                fmt_g(c.alpha),
+                fmt_g(f.alpha),
+                (f.alpha / c.alpha - 1.0) * 100.0
+            );
+        }
+    }
+    s
+}

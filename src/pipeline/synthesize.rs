@@ -1,0 +1,328 @@
+//! The `rshape synthesize` pipeline: the plant's normalized coprime factors → the
+//! Glover–McFarlane optimum `b_opt` and central controller ([`crate::synthesis`]) → the
+//! proof by the Theorem 1 test of the stability pipeline ([`super::stability`]) for every
+//! bound `r` → exports (`controller.toml` in the form `stability --controller` reads,
+//! `controller.json`, `.m`/`.py`/`.jl`, `synthesis.json`, `stability.svg`/`.json`), each
+//! written atomically.
+
+use super::stability::{self as stab, StabilityOutcome};
+use crate::error::{Error, Result};
+use crate::model::controller::{Controller, Feedback};
+use crate::model::Config;
+use crate::report::fmt::fmt_g;
+use crate::synthesis::{synthesize, GmController};
+use crate::system::eig::eigenvalues;
+use crate::system::ncf::NormalizedLcf;
+use crate::system::{StateSpace, TransferFunction};
+use nalgebra::DMatrix;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Settings of the synthesis.
+#[derive(Debug, Clone, Copy)]
+pub struct SynthesisSettings {
+    /// `γ = gamma_factor · γ_min` (> 1; 1.1 by default, the usual practice).
+    pub gamma_factor: f64,
+}
+
+impl Default for SynthesisSettings {
+    fn default() -> Self {
+        Self { gamma_factor: 1.1 }
+    }
+}
+
+/// The margin of the synthesized controller for one bound `r`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BoundResult {
+    /// `configured` or `fitted`.
+    pub label: String,
+    /// Whether `r` is a constant (then the Glover–McFarlane controller is the optimum).
+    pub constant: bool,
+    /// For a constant `r`: the best margin any controller attains, `b_opt/|r|`.
+    pub alpha_opt: Option<f64>,
+    /// The Theorem 1 margin `α*` of the synthesized controller (certified lower bound in
+    /// `stability.json`).
+    pub alpha: f64,
+    /// The Theorem 1 verdict for this `r`.
+    pub verdict: crate::stability::Verdict,
+}
+
+/// Everything the synthesis computed.
+#[derive(Debug, Clone)]
+pub struct SynthesisOutcome {
+    /// `b_opt`, `γ`, the controller.
+    pub gm: GmController,
+    /// The Theorem 1 test of the controller (the proof).
+    pub stability: StabilityOutcome,
+    /// One row per bound.
+    pub bounds: Vec<BoundResult>,
+    /// Poles of the controller.
+    pub controller_poles: Vec<num_complex::Complex64>,
+    /// Whether the controller is proven robust for every bound given (and stabilizing).
+    pub robust: bool,
+    /// Notes for the reader (a frequency-dependent `r`, no controller reaching `α ≥ 1`).
+    pub notes: Vec<String>,
+}
+
+/// The normalized factors the synthesis works on: those of the config's `[plant]`, else
+/// those of a minimal realization of the plant `G = C·M̃⁻¹·Ñ·J` of its factors (a `[model]`
+/// or the export of a `[physical]` model). Errors (one line) when the plant has no
+/// normalized coprime factors (an unstable mode the output does not see).
+pub fn plant_factors(config: &Config, path: &Path) -> Result<Arc<NormalizedLcf>> {
+    if let Some(ncf) = &config.factorization.realization {
+        return Ok(ncf.clone());
+    }
+    let g = crate::stability::plant_system(&config.factorization)?.minimal(1e-10);
+    NormalizedLcf::new(g)
+        .map(Arc::new)
+        .map_err(|e| Error::Invalid(format!("{}: the plant of the factors: {e}", path.display())))
+}
+
+/// Synthesizes the Glover–McFarlane controller of the config's plant and proves it with the
+/// Theorem 1 test for every bound in `rs` (`data` overrides the config's data file for the
+/// grid of the figure).
+pub fn run(
+    config: &Config,
+    config_path: &Path,
+    rs: &[(String, TransferFunction)],
+    settings: &SynthesisSettings,
+    data: Option<&Path>,
+    controller_path: &Path,
+) -> Result<SynthesisOutcome> {
+    let ncf = plant_factors(config, config_path)?;
+    for (label, r) in rs {
+        if !r.is_unit() {
+            return Err(Error::Invalid(format!(
+                "the {label} r is not a unit of RH∞ (stable, minimum phase, biproper): Theorem 1 needs one"
+            )));
+        }
+    }
+    let gm = synthesize(&ncf, settings.gamma_factor)?;
+    let controller = Controller {
+        path: controller_path.to_path_buf(),
+        k: gm.k.clone(),
+        feedback: Feedback::Negative,
+    };
+    let stability = stab::run(config, &controller, rs, data)?;
+    let mut notes = Vec::new();
+    let normalized = config.factorization.realization.is_some();
+    if !normalized {
+        notes.push(
+            "the config's factors are not the normalized ones: the controller maximizes b(G,K) of the plant they define; Theorem 1 margins are with the config's factors".to_string(),
+        );
+    }
+    let mut bounds = Vec::new();
+    for (row, (label, r)) in stability.report.margins.iter().zip(rs) {
+        let constant = r.num.degree() == 0 && r.den.degree() == 0;
+        // α* = b(G,K)/|r| holds for normalized factors only.
+        let alpha_opt = (constant && normalized).then(|| gm.b_opt / r.at_infinity().abs());
+        if let Some(a) = alpha_opt.filter(|a| *a < 1.0) {
+            notes.push(format!(
+                "{label} r: no controller reaches alpha >= 1: b_opt = {} < |r| = {} (best alpha {})",
+                fmt_g(gm.b_opt),
+                fmt_g(r.at_infinity().abs()),
+                fmt_g(a)
+            ));
+        }
+        if !constant && normalized {
+            notes.push(format!(
+                "{label} r is frequency dependent: the controller is the Glover–McFarlane optimum for a constant bound; its Theorem 1 margin with this r is {}",
+                fmt_g(row.alpha)
+            ));
+        }
+        bounds.push(BoundResult {
+            label: label.clone(),
+            constant,
+            alpha_opt,
+            alpha: row.alpha,
+            verdict: row.verdict,
+        });
+    }
+    let controller_poles = eigenvalues(&gm.k.a, "controller poles")?;
+    let robust = stability.robust;
+    Ok(SynthesisOutcome {
+        gm,
+        stability,
+        bounds,
+        controller_poles,
+        robust,
+        notes,
+    })
+}
+
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows())
+        .map(|i| m.row(i).iter().copied().collect())
+        .collect()
+}
+
+fn toml_matrix(m: &DMatrix<f64>) -> String {
+    let r: Vec<String> = rows(m)
+        .iter()
+        .map(|r| {
+            let v: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
+            format!("[{}]", v.join(", "))
+        })
+        .collect();
+    format!("[{}]", r.join(",\n     "))
+}
+
+/// `controller.toml`: the `[controller]` table (`u = −K·y`) that `stability --controller`
+/// reads.
+pub fn controller_toml(k: &StateSpace, gm: &GmController) -> String {
+    format!(
+        "# Glover–McFarlane central controller from rshape synthesize:\n# b_opt = {:?}, gamma = {:?} (gamma_min = {:?}); loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
+        gm.b_opt,
+        gm.gamma,
+        gm.gamma_min,
+        toml_matrix(&k.a),
+        toml_matrix(&k.b),
+        toml_matrix(&k.c),
+        toml_matrix(&k.d)
+    )
+}
+
+/// A matrix literal for MATLAB/Julia (`[1 2; 3 4]`) or numpy (`np.array([[1, 2], [3, 4]])`).
+fn literal(m: &DMatrix<f64>, python: bool) -> String {
+    if m.nrows() == 0 || m.ncols() == 0 {
+        return if python {
+            format!("np.zeros(({}, {}))", m.nrows(), m.ncols())
+        } else {
+            format!("zeros({}, {})", m.nrows(), m.ncols())
+        };
+    }
+    let r = rows(m);
+    if python {
+        let v: Vec<String> = r
+            .iter()
+            .map(|row| {
+                let e: Vec<String> = row.iter().map(|x| format!("{x:?}")).collect();
+                format!("[{}]", e.join(", "))
+            })
+            .collect();
+        format!("np.array([{}])", v.join(", "))
+    } else {
+        let v: Vec<String> = r
+            .iter()
+            .map(|row| {
+                let e: Vec<String> = row.iter().map(|x| format!("{x:?}")).collect();
+                e.join(" ")
+            })
+            .collect();
+        format!("[{}]", v.join("; "))
+    }
+}
+
+fn script(k: &StateSpace, comment: &str, preamble: &str, call: &str, python: bool) -> String {
+    let end = if python || comment == "#" { "" } else { ";" };
+    format!(
+        "{comment} Glover–McFarlane controller from rshape synthesize; loop u = -K y\n{preamble}A = {}{end}\nB = {}{end}\nC = {}{end}\nD = {}{end}\nK = {call}{end}\n",
+        literal(&k.a, python),
+        literal(&k.b, python),
+        literal(&k.c, python),
+        literal(&k.d, python)
+    )
+}
+
+/// Writes the controller and the reports into `out` (atomically) and returns the files.
+pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
+    let k = &o.gm.k;
+    let state_space = serde_json::json!({
+        "A": rows(&k.a), "B": rows(&k.b), "C": rows(&k.c), "D": rows(&k.d),
+        "feedback": "negative",
+    });
+    let rep = &o.stability.report;
+    let synthesis = serde_json::json!({
+        "method": "glover_mcfarlane",
+        "b_opt": o.gm.b_opt,
+        "gamma_min": o.gm.gamma_min,
+        "gamma": o.gm.gamma,
+        "gamma_factor": o.gm.gamma / o.gm.gamma_min,
+        "rho_xz": o.gm.rho,
+        "riccati_residuals": o.gm.riccati_residuals,
+        "b_gk": rep.b_gk,
+        "controller_order": k.states(),
+        "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "bounds": &o.bounds,
+        "robust": o.robust,
+        "notes": &o.notes,
+    });
+    let json = |v: &serde_json::Value| {
+        serde_json::to_string_pretty(v).map_err(|e| Error::Invalid(format!("json: {e}")))
+    };
+    let files = [
+        ("controller.toml", controller_toml(k, &o.gm)),
+        ("controller.json", json(&state_space)?),
+        ("controller.m", script(k, "%", "", "ss(A, B, C, D)", false)),
+        (
+            "controller.py",
+            script(
+                k,
+                "#",
+                "import numpy as np\nimport control as ct\n\n",
+                "ct.ss(A, B, C, D)",
+                true,
+            ),
+        ),
+        (
+            "controller.jl",
+            script(k, "#", "using ControlSystems\n\n", "ss(A, B, C, D)", false),
+        ),
+        ("synthesis.json", json(&synthesis)?),
+    ];
+    let mut written = Vec::new();
+    for (name, text) in files {
+        let p = out.join(name);
+        crate::util::write_atomic(&p, text.as_bytes())?;
+        written.push(p);
+    }
+    written.extend(stab::write_outputs(
+        out,
+        &o.stability,
+        "Theorem 1: 1/σ_max(T) vs |r| — the synthesized controller",
+    )?);
+    Ok(written)
+}
+
+/// The summary the CLI prints: the optimum, the controller, then the proof.
+pub fn text(o: &SynthesisOutcome) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "Glover–McFarlane: b_opt = {} (gamma_min = {}), central controller at gamma = {} ({} states)",
+        fmt_g(o.gm.b_opt),
+        fmt_g(o.gm.gamma_min),
+        fmt_g(o.gm.gamma),
+        o.gm.k.states()
+    );
+    for b in &o.bounds {
+        if let Some(a) = b.alpha_opt {
+            let _ = writeln!(
+                s,
+                "{} r (constant): best attainable alpha = b_opt/|r| = {}",
+                b.label,
+                fmt_g(a)
+            );
+        }
+    }
+    for n in &o.notes {
+        let _ = writeln!(s, "{n}");
+    }
+    let _ = writeln!(s, "proof (Theorem 1 on the synthesized controller):");
+    s.push_str(&stab::text(&o.stability));
+    let _ = writeln!(
+        s,
+        "{}",
+        if o.bounds.is_empty() {
+            "no r given: nothing to prove beyond internal stability".to_string()
+        } else if o.robust {
+            "PROVEN robust for every r given".to_string()
+        } else {
+            "NOT proven robust for every r given".to_string()
+        }
+    );
+    s
+}
