@@ -271,3 +271,50 @@ fn issue22_family_of_loops_matches_the_dense_grid() {
     }
     assert!(tested >= 30, "only {tested} loops stable");
 }
+
+/// The verdict is decided on the certified lower margin `1/upper`, never on `1/γ`: an α*
+/// within the norm's tolerance below 1 is not certified, and a margin above the grid margin
+/// (an upper bound) withholds the verdict.
+#[test]
+fn verdict_is_conservative_and_withheld_when_the_cross_checks_disagree() {
+    use rshape::stability::decide;
+    // 1/γ ≥ 1 but the proven upper bound of the norm leaves α* possibly below 1.
+    assert_eq!(
+        decide(1.0 + 1e-10, 1.0 - 1e-9, 1.2, None).0,
+        Verdict::NotRobust
+    );
+    assert_eq!(
+        decide(1.5, 1.5 * (1.0 - 2e-9), 1.6, None).0,
+        Verdict::Robust
+    );
+    // The issue's failure: α* above what the grid already shows → withheld.
+    let (v, why) = decide(1.00643, 1.00643, 1.0009, None);
+    assert_eq!(v, Verdict::Withheld);
+    assert!(why.unwrap().contains("grid"));
+    // α* ≠ b/|r| for normalized factors with a constant r → withheld.
+    assert_eq!(decide(1.2, 1.2, 1.3, Some(1.25)).0, Verdict::Withheld);
+    // A grid point below 1 proves "not robust" whatever the exact route says.
+    assert_eq!(decide(1.2, 1.2, 0.99, None).0, Verdict::NotRobust);
+
+    // End to end: r scaled so that 1/(r·γ) = 1 + 1e-10 on the issue's loop.
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "c.toml", ISSUE_CONFIG);
+    let ctl = write(dir.path(), "k.toml", ISSUE_CONTROLLER);
+    let config = Config::load(&cfg).unwrap();
+    let controller = Controller::load(&ctl).unwrap();
+    let grid = logspace(1e-2, 1e4, 1000);
+    let t = rshape::stability::theorem1_system(&config.factorization, &controller.k).unwrap();
+    let gamma = hinf_norm(&t).unwrap().gamma;
+    let r = rshape::system::TransferFunction::gain(1.0 / (gamma * (1.0 + 1e-10)));
+    let (rep, _) = analyze(
+        &config.factorization,
+        &controller,
+        &[("edge".into(), r)],
+        &grid,
+    )
+    .unwrap();
+    let row = &rep.margins[0];
+    assert!(row.alpha >= 1.0 && row.alpha_lower < 1.0, "{row:?}");
+    assert_eq!(row.verdict, Verdict::NotRobust);
+    assert!(!row.robust);
+}
