@@ -328,3 +328,104 @@ fn special_factorization_config_is_synthesized_for_its_plant_and_proved_with_its
     ]);
     assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
 }
+
+fn toml_rows(m: &DMatrix<f64>) -> String {
+    let rows: Vec<String> = (0..m.nrows())
+        .map(|i| {
+            let v: Vec<String> = m.row(i).iter().map(|x| format!("{x:?}")).collect();
+            format!("[{}]", v.join(", "))
+        })
+        .collect();
+    format!("[{}]", rows.join(", "))
+}
+
+/// `--reduce N`: the stable central controller is cut by balanced truncation and the proof
+/// is of the reduced controller (`stability` on the written file agrees); `--reduce 0` is
+/// bad input.
+#[test]
+fn reduced_controller_is_re_proved() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut done = 0;
+    for seed in 100..200u64 {
+        let plant = random_plant(seed);
+        if plant.states() < 4 {
+            continue;
+        }
+        let Ok(ncf) = NormalizedLcf::new(plant.clone()) else {
+            continue;
+        };
+        let gm = synthesize(&ncf, 1.1).unwrap();
+        let kp = rshape::system::eig::eigenvalues(&gm.k.a, "k").unwrap();
+        if rshape::system::eig::spectral_abscissa(&kp) >= -1e-6 {
+            continue;
+        }
+        let n = plant.states();
+        let cfg = write(
+            dir.path(),
+            &format!("p{seed}.toml"),
+            &format!(
+                "[plant]\na = {}\nb = {}\nc = {}\nd = {}\n[r]\nnum = [{:?}]\nden = [1]\n",
+                toml_rows(&plant.a),
+                toml_rows(&plant.b),
+                toml_rows(&plant.c),
+                toml_rows(&plant.d),
+                0.5 * gm.b_opt / 1.1
+            ),
+        );
+        let out = dir.path().join(format!("out{seed}"));
+        let reduce = (n - 1).to_string();
+        let o = rshape(&[
+            "synthesize",
+            cfg.to_str().unwrap(),
+            "--reduce",
+            &reduce,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let code = o.status.code();
+        assert!(
+            matches!(code, Some(0) | Some(1)),
+            "{}{}",
+            stdout(&o),
+            stderr(&o)
+        );
+        assert!(
+            stdout(&o).contains("reduced by balanced truncation"),
+            "{}",
+            stdout(&o)
+        );
+        let syn: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+                .unwrap();
+        assert_eq!(syn["controller_order"].as_u64(), Some(n as u64 - 1));
+        assert_eq!(syn["reduction"]["from"].as_u64(), Some(n as u64));
+        let s = rshape(&[
+            "stability",
+            cfg.to_str().unwrap(),
+            "--controller",
+            out.join("controller.toml").to_str().unwrap(),
+        ]);
+        assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+        if done == 0 {
+            let bad = dir.path().join("bad");
+            let o = rshape(&[
+                "synthesize",
+                cfg.to_str().unwrap(),
+                "--reduce",
+                "0",
+                "--out",
+                bad.to_str().unwrap(),
+            ]);
+            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+            assert!(!bad.exists());
+        }
+        done += 1;
+        if done == 3 {
+            break;
+        }
+    }
+    assert_eq!(
+        done, 3,
+        "fewer than 3 plants with a stable central controller"
+    );
+}

@@ -1,5 +1,5 @@
-//! `rshape synthesize CONFIG [--r-json r.json | --fit] [--gamma-factor F] --out DIR
-//! [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
+//! `rshape synthesize CONFIG [--r-json r.json | --fit] [--gamma-factor F] [--reduce N]
+//! --out DIR [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
 //! (issue 22). Exit 0 proven robust for every bound given, 1 not, 2 error.
 
 use super::common::InputArgs;
@@ -27,6 +27,10 @@ pub struct SynthesizeArgs {
     /// Suboptimality: the central controller at gamma = F * gamma_min (F > 1).
     #[arg(long, default_value_t = 1.1)]
     pub gamma_factor: f64,
+    /// Reduce the controller to N states by balanced truncation (stable controllers; the
+    /// margin is re-proved on the reduced controller).
+    #[arg(long)]
+    pub reduce: Option<usize>,
     /// Output directory (created if needed).
     #[arg(long)]
     pub out: PathBuf,
@@ -80,6 +84,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     // synthesis itself runs in memory first.
     let settings = synthesize::SynthesisSettings {
         gamma_factor: a.gamma_factor,
+        reduce: a.reduce,
     };
     let controller_path = a.out.join("controller.toml");
     if fit_input.is_none() {

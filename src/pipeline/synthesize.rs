@@ -11,7 +11,7 @@ use crate::model::controller::{Controller, Feedback};
 use crate::model::Config;
 use crate::report::fmt::fmt_g;
 use crate::synthesis::{synthesize, GmController};
-use crate::system::eig::eigenvalues;
+use crate::system::eig::{eigenvalues, spectral_abscissa};
 use crate::system::ncf::NormalizedLcf;
 use crate::system::{StateSpace, TransferFunction};
 use nalgebra::DMatrix;
@@ -25,12 +25,31 @@ use std::sync::Arc;
 pub struct SynthesisSettings {
     /// `γ = gamma_factor · γ_min` (> 1; 1.1 by default, the usual practice).
     pub gamma_factor: f64,
+    /// Reduce the controller to this many states by balanced truncation (a stable
+    /// controller only); the Theorem 1 proof is then of the reduced controller.
+    pub reduce: Option<usize>,
 }
 
 impl Default for SynthesisSettings {
     fn default() -> Self {
-        Self { gamma_factor: 1.1 }
+        Self {
+            gamma_factor: 1.1,
+            reduce: None,
+        }
     }
+}
+
+/// The order reduction of the controller.
+#[derive(Debug, Clone, Serialize)]
+pub struct Reduction {
+    /// States of the central controller.
+    pub from: usize,
+    /// States kept.
+    pub to: usize,
+    /// Hankel singular values of the central controller.
+    pub hankel_singular_values: Vec<f64>,
+    /// Glover's bound `2·Σ_{i>to} σᵢ` on `‖K − K_r‖∞`.
+    pub error_bound: f64,
 }
 
 /// The margin of the synthesized controller for one bound `r`.
@@ -64,6 +83,8 @@ pub struct SynthesisOutcome {
     pub robust: bool,
     /// Notes for the reader (a frequency-dependent `r`, no controller reaching `α ≥ 1`).
     pub notes: Vec<String>,
+    /// The order reduction, when asked for and done.
+    pub reduction: Option<Reduction>,
 }
 
 /// The normalized factors the synthesis works on: those of the config's `[plant]`, else
@@ -99,7 +120,27 @@ pub fn run(
             )));
         }
     }
-    let gm = synthesize(&ncf, settings.gamma_factor)?;
+    let mut gm = synthesize(&ncf, settings.gamma_factor)?;
+    let reduction = match settings.reduce {
+        Some(order) if order < gm.k.states() => {
+            let from = gm.k.states();
+            let abscissa = spectral_abscissa(&eigenvalues(&gm.k.a, "controller poles")?);
+            if abscissa.is_nan() || abscissa >= 0.0 {
+                return Err(Error::Invalid(format!(
+                    "--reduce {order}: the central controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce"
+                )));
+            }
+            let (kr, hsv) = gm.k.balanced_truncation(order)?;
+            gm.k = kr;
+            Some(Reduction {
+                from,
+                to: order,
+                error_bound: 2.0 * hsv[order..].iter().sum::<f64>(),
+                hankel_singular_values: hsv,
+            })
+        }
+        _ => None,
+    };
     let controller = Controller {
         path: controller_path.to_path_buf(),
         k: gm.k.clone(),
@@ -149,6 +190,7 @@ pub fn run(
         controller_poles,
         robust,
         notes,
+        reduction,
     })
 }
 
@@ -246,6 +288,7 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "controller_order": k.states(),
         "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
         "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "reduction": &o.reduction,
         "bounds": &o.bounds,
         "robust": o.robust,
         "notes": &o.notes,
@@ -294,6 +337,15 @@ pub fn text(o: &SynthesisOutcome) -> String {
         fmt_g(o.gm.gamma),
         o.gm.k.states()
     );
+    if let Some(r) = &o.reduction {
+        let _ = writeln!(
+            s,
+            "reduced by balanced truncation: {} -> {} states (||K - Kr||_inf <= {}); the proof below is of the reduced controller",
+            r.from,
+            r.to,
+            fmt_g(r.error_bound)
+        );
+    }
     for b in &o.bounds {
         if let Some(a) = b.alpha_opt {
             let _ = writeln!(
