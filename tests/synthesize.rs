@@ -429,3 +429,89 @@ fn reduced_controller_is_re_proved() {
         "fewer than 3 plants with a stable central controller"
     );
 }
+
+/// Loop shaping: a PI pre-weight `(s + 2)/s` gives the controller integral action (a pole at
+/// s = 0, |K(jω)| growing like 1/ω at low frequency) and the proof is of `K = W₁·K∞·W₂` on
+/// the plant (`stability` on the written file agrees); an improper weight or a wrong count is
+/// bad input.
+#[test]
+fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "c.toml", &CONFIG.replace("R", "0.005"));
+    let w = write(
+        dir.path(),
+        "w.toml",
+        "[weights]\nw1 = [{ num = [1, 2], den = [1, 0] }]\nw2 = [2]\n",
+    );
+    let out = dir.path().join("out");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--weights",
+        w.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let code = o.status.code();
+    assert!(
+        matches!(code, Some(0) | Some(1)),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    assert!(stdout(&o).contains("loop shaping"), "{}", stdout(&o));
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+            .unwrap();
+    let kp = syn["controller_poles"].as_array().unwrap();
+    assert!(
+        kp.iter()
+            .any(|z| z[0].as_f64().unwrap().abs() < 1e-9 && z[1].as_f64().unwrap() == 0.0),
+        "no integrator among {kp:?}"
+    );
+    assert!(syn["closed_loop_poles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|z| z[0].as_f64().unwrap() < 0.0));
+    let ctl = Controller::load(&out.join("controller.toml")).unwrap();
+    let mag = |w: f64| ctl.k.freq(w).unwrap()[(0, 0)].norm();
+    let ratio = mag(1e-4) / mag(1e-3);
+    assert!(
+        (ratio - 10.0).abs() < 0.1,
+        "|K| ratio over a decade at low frequency {ratio}"
+    );
+    let s = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        out.join("controller.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+    for (name, text) in [
+        (
+            "improper.toml",
+            "[weights]\nw1 = [{ num = [1, 0, 1], den = [1, 1] }]\n",
+        ),
+        ("count.toml", "[weights]\nw2 = [1, 2, 3]\n"),
+        (
+            "strict.toml",
+            "[weights]\nw1 = [{ num = [1], den = [1, 1] }]\n",
+        ),
+    ] {
+        let w = write(dir.path(), name, text);
+        let bad = dir.path().join("bad");
+        let o = rshape(&[
+            "synthesize",
+            cfg.to_str().unwrap(),
+            "--weights",
+            w.to_str().unwrap(),
+            "--out",
+            bad.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).contains(name), "{}", stderr(&o));
+        assert!(!bad.exists());
+    }
+}

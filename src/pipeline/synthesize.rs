@@ -21,13 +21,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Settings of the synthesis.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct SynthesisSettings {
     /// `γ = gamma_factor · γ_min` (> 1; 1.1 by default, the usual practice).
     pub gamma_factor: f64,
     /// Reduce the controller to this many states by balanced truncation (a stable
     /// controller only); the Theorem 1 proof is then of the reduced controller.
     pub reduce: Option<usize>,
+    /// Loop-shaping weights: synthesize for `W₂·G·W₁`, return `W₁·K∞·W₂`.
+    pub weights: Option<crate::synthesis::Weights>,
 }
 
 impl Default for SynthesisSettings {
@@ -35,6 +37,7 @@ impl Default for SynthesisSettings {
         Self {
             gamma_factor: 1.1,
             reduce: None,
+            weights: None,
         }
     }
 }
@@ -120,7 +123,17 @@ pub fn run(
             )));
         }
     }
-    let mut gm = synthesize(&ncf, settings.gamma_factor)?;
+    let mut gm = match &settings.weights {
+        None => synthesize(&ncf, settings.gamma_factor)?,
+        Some(w) => {
+            let shaped = NormalizedLcf::new(w.shape(&ncf.plant))
+                .map_err(|e| Error::Invalid(format!("the shaped plant W2·G·W1: {e}")))?;
+            let mut gm = synthesize(&shaped, settings.gamma_factor)?;
+            gm.k = w.controller(&gm.k);
+            gm
+        }
+    };
+    let shaped = settings.weights.is_some();
     let reduction = match settings.reduce {
         Some(order) if order < gm.k.states() => {
             let from = gm.k.states();
@@ -154,11 +167,17 @@ pub fn run(
             "the config's factors are not the normalized ones: the controller maximizes b(G,K) of the plant they define; Theorem 1 margins are with the config's factors".to_string(),
         );
     }
+    if shaped {
+        notes.push(
+            "loop shaping: b_opt and gamma are of the shaped plant W2*G*W1; the proof is of K = W1*Kinf*W2 on the plant".to_string(),
+        );
+    }
     let mut bounds = Vec::new();
     for (row, (label, r)) in stability.report.margins.iter().zip(rs) {
         let constant = r.num.degree() == 0 && r.den.degree() == 0;
         // α* = b(G,K)/|r| holds for normalized factors only.
-        let alpha_opt = (constant && normalized).then(|| gm.b_opt / r.at_infinity().abs());
+        let alpha_opt =
+            (constant && normalized && !shaped).then(|| gm.b_opt / r.at_infinity().abs());
         if let Some(a) = alpha_opt.filter(|a| *a < 1.0) {
             notes.push(format!(
                 "{label} r: no controller reaches alpha >= 1: b_opt = {} < |r| = {} (best alpha {})",
