@@ -515,3 +515,33 @@ fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
         assert!(!bad.exists());
     }
 }
+
+/// `--fit`: r is fitted from the config's data first (its exports in DIR), then the
+/// controller is proved with the configured and the fitted r; the tighter fitted r gives
+/// the larger margin.
+#[test]
+fn fit_then_synthesize_proves_both_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = common::repo("configs/plant_first.toml");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--fit",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(out.join("r.json").is_file() && out.join("controller.toml").is_file());
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+            .unwrap();
+    let bounds = syn["bounds"].as_array().unwrap();
+    assert_eq!(bounds.len(), 2);
+    assert_eq!(bounds[1]["label"], "fitted");
+    let (ac, af) = (
+        bounds[0]["alpha"].as_f64().unwrap(),
+        bounds[1]["alpha"].as_f64().unwrap(),
+    );
+    assert!(af > ac && ac >= 1.0, "configured {ac}, fitted {af}");
+}

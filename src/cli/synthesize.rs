@@ -100,16 +100,14 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         },
     };
     let controller_path = a.out.join("controller.toml");
-    if fit_input.is_none() {
-        synthesize::run(
-            &config,
-            &a.config,
-            &rs,
-            &settings,
-            a.data.as_deref(),
-            &controller_path,
-        )?;
-    }
+    synthesize::run(
+        &config,
+        &a.config,
+        &rs,
+        &settings,
+        a.data.as_deref(),
+        &controller_path,
+    )?;
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     let mut fit_text = String::new();
     if let Some((inputs, env)) = &fit_input {
