@@ -328,3 +328,220 @@ fn special_factorization_config_is_synthesized_for_its_plant_and_proved_with_its
     ]);
     assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
 }
+
+fn toml_rows(m: &DMatrix<f64>) -> String {
+    let rows: Vec<String> = (0..m.nrows())
+        .map(|i| {
+            let v: Vec<String> = m.row(i).iter().map(|x| format!("{x:?}")).collect();
+            format!("[{}]", v.join(", "))
+        })
+        .collect();
+    format!("[{}]", rows.join(", "))
+}
+
+/// `--reduce N`: the stable central controller is cut by balanced truncation and the proof
+/// is of the reduced controller (`stability` on the written file agrees); `--reduce 0` is
+/// bad input.
+#[test]
+fn reduced_controller_is_re_proved() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut done = 0;
+    for seed in 100..200u64 {
+        let plant = random_plant(seed);
+        if plant.states() < 4 {
+            continue;
+        }
+        let Ok(ncf) = NormalizedLcf::new(plant.clone()) else {
+            continue;
+        };
+        let gm = synthesize(&ncf, 1.1).unwrap();
+        let kp = rshape::system::eig::eigenvalues(&gm.k.a, "k").unwrap();
+        if rshape::system::eig::spectral_abscissa(&kp) >= -1e-6 {
+            continue;
+        }
+        let n = plant.states();
+        let cfg = write(
+            dir.path(),
+            &format!("p{seed}.toml"),
+            &format!(
+                "[plant]\na = {}\nb = {}\nc = {}\nd = {}\n[r]\nnum = [{:?}]\nden = [1]\n",
+                toml_rows(&plant.a),
+                toml_rows(&plant.b),
+                toml_rows(&plant.c),
+                toml_rows(&plant.d),
+                0.5 * gm.b_opt / 1.1
+            ),
+        );
+        let out = dir.path().join(format!("out{seed}"));
+        let reduce = (n - 1).to_string();
+        let o = rshape(&[
+            "synthesize",
+            cfg.to_str().unwrap(),
+            "--reduce",
+            &reduce,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let code = o.status.code();
+        assert!(
+            matches!(code, Some(0) | Some(1)),
+            "{}{}",
+            stdout(&o),
+            stderr(&o)
+        );
+        assert!(
+            stdout(&o).contains("reduced by balanced truncation"),
+            "{}",
+            stdout(&o)
+        );
+        let syn: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+                .unwrap();
+        assert_eq!(syn["controller_order"].as_u64(), Some(n as u64 - 1));
+        assert_eq!(syn["reduction"]["from"].as_u64(), Some(n as u64));
+        let s = rshape(&[
+            "stability",
+            cfg.to_str().unwrap(),
+            "--controller",
+            out.join("controller.toml").to_str().unwrap(),
+        ]);
+        assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+        if done == 0 {
+            let bad = dir.path().join("bad");
+            let o = rshape(&[
+                "synthesize",
+                cfg.to_str().unwrap(),
+                "--reduce",
+                "0",
+                "--out",
+                bad.to_str().unwrap(),
+            ]);
+            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+            assert!(!bad.exists());
+        }
+        done += 1;
+        if done == 3 {
+            break;
+        }
+    }
+    assert_eq!(
+        done, 3,
+        "fewer than 3 plants with a stable central controller"
+    );
+}
+
+/// Loop shaping: a PI pre-weight `(s + 2)/s` gives the controller integral action (a pole at
+/// s = 0, |K(jω)| growing like 1/ω at low frequency) and the proof is of `K = W₁·K∞·W₂` on
+/// the plant (`stability` on the written file agrees); an improper weight or a wrong count is
+/// bad input.
+#[test]
+fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "c.toml", &CONFIG.replace("R", "0.005"));
+    let w = write(
+        dir.path(),
+        "w.toml",
+        "[weights]\nw1 = [{ num = [1, 2], den = [1, 0] }]\nw2 = [2]\n",
+    );
+    let out = dir.path().join("out");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--weights",
+        w.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let code = o.status.code();
+    assert!(
+        matches!(code, Some(0) | Some(1)),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    assert!(stdout(&o).contains("loop shaping"), "{}", stdout(&o));
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+            .unwrap();
+    let kp = syn["controller_poles"].as_array().unwrap();
+    assert!(
+        kp.iter()
+            .any(|z| z[0].as_f64().unwrap().abs() < 1e-9 && z[1].as_f64().unwrap() == 0.0),
+        "no integrator among {kp:?}"
+    );
+    assert!(syn["closed_loop_poles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|z| z[0].as_f64().unwrap() < 0.0));
+    let ctl = Controller::load(&out.join("controller.toml")).unwrap();
+    let mag = |w: f64| ctl.k.freq(w).unwrap()[(0, 0)].norm();
+    let ratio = mag(1e-4) / mag(1e-3);
+    assert!(
+        (ratio - 10.0).abs() < 0.1,
+        "|K| ratio over a decade at low frequency {ratio}"
+    );
+    let s = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        out.join("controller.toml").to_str().unwrap(),
+    ]);
+    assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+    for (name, text) in [
+        (
+            "improper.toml",
+            "[weights]\nw1 = [{ num = [1, 0, 1], den = [1, 1] }]\n",
+        ),
+        ("count.toml", "[weights]\nw2 = [1, 2, 3]\n"),
+        (
+            "strict.toml",
+            "[weights]\nw1 = [{ num = [1], den = [1, 1] }]\n",
+        ),
+    ] {
+        let w = write(dir.path(), name, text);
+        let bad = dir.path().join("bad");
+        let o = rshape(&[
+            "synthesize",
+            cfg.to_str().unwrap(),
+            "--weights",
+            w.to_str().unwrap(),
+            "--out",
+            bad.to_str().unwrap(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
+        assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).contains(name), "{}", stderr(&o));
+        assert!(!bad.exists());
+    }
+}
+
+/// `--fit`: r is fitted from the config's data first (its exports in DIR), then the
+/// controller is proved with the configured and the fitted r; the tighter fitted r gives
+/// the larger margin.
+#[test]
+fn fit_then_synthesize_proves_both_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let cfg = common::repo("configs/plant_first.toml");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--fit",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(out.join("r.json").is_file() && out.join("controller.toml").is_file());
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
+            .unwrap();
+    let bounds = syn["bounds"].as_array().unwrap();
+    assert_eq!(bounds.len(), 2);
+    assert_eq!(bounds[1]["label"], "fitted");
+    let (ac, af) = (
+        bounds[0]["alpha"].as_f64().unwrap(),
+        bounds[1]["alpha"].as_f64().unwrap(),
+    );
+    assert!(af > ac && ac >= 1.0, "configured {ac}, fitted {af}");
+}

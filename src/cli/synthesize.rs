@@ -1,5 +1,5 @@
-//! `rshape synthesize CONFIG [--r-json r.json | --fit] [--gamma-factor F] --out DIR
-//! [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
+//! `rshape synthesize CONFIG [--r-json r.json | --fit] [--weights W.toml] [--gamma-factor F] [--reduce N]
+//! --out DIR [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
 //! (issue 22). Exit 0 proven robust for every bound given, 1 not, 2 error.
 
 use super::common::InputArgs;
@@ -27,6 +27,14 @@ pub struct SynthesizeArgs {
     /// Suboptimality: the central controller at gamma = F * gamma_min (F > 1).
     #[arg(long, default_value_t = 1.1)]
     pub gamma_factor: f64,
+    /// Loop-shaping weights: a TOML file with [weights] w1 = [...] (plant inputs), w2 = [...]
+    /// (plant outputs); the controller is W1*Kinf*W2 with Kinf designed for W2*G*W1.
+    #[arg(long)]
+    pub weights: Option<PathBuf>,
+    /// Reduce the controller to N states by balanced truncation (stable controllers; the
+    /// margin is re-proved on the reduced controller).
+    #[arg(long)]
+    pub reduce: Option<usize>,
     /// Output directory (created if needed).
     #[arg(long)]
     pub out: PathBuf,
@@ -70,6 +78,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     let inputs: Vec<&Path> = [
         Some(a.config.as_path()),
         a.r_json.as_deref(),
+        a.weights.as_deref(),
         a.data.as_deref(),
         config.data.as_deref(),
     ]
@@ -80,18 +89,25 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     // synthesis itself runs in memory first.
     let settings = synthesize::SynthesisSettings {
         gamma_factor: a.gamma_factor,
+        reduce: a.reduce,
+        weights: match &a.weights {
+            Some(w) => Some(crate::synthesis::Weights::load(
+                w,
+                config.factorization.inputs(),
+                config.factorization.outputs(),
+            )?),
+            None => None,
+        },
     };
     let controller_path = a.out.join("controller.toml");
-    if fit_input.is_none() {
-        synthesize::run(
-            &config,
-            &a.config,
-            &rs,
-            &settings,
-            a.data.as_deref(),
-            &controller_path,
-        )?;
-    }
+    synthesize::run(
+        &config,
+        &a.config,
+        &rs,
+        &settings,
+        a.data.as_deref(),
+        &controller_path,
+    )?;
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     let mut fit_text = String::new();
     if let Some((inputs, env)) = &fit_input {

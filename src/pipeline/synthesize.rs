@@ -11,7 +11,7 @@ use crate::model::controller::{Controller, Feedback};
 use crate::model::Config;
 use crate::report::fmt::fmt_g;
 use crate::synthesis::{synthesize, GmController};
-use crate::system::eig::eigenvalues;
+use crate::system::eig::{eigenvalues, spectral_abscissa};
 use crate::system::ncf::NormalizedLcf;
 use crate::system::{StateSpace, TransferFunction};
 use nalgebra::DMatrix;
@@ -21,16 +21,38 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Settings of the synthesis.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct SynthesisSettings {
     /// `γ = gamma_factor · γ_min` (> 1; 1.1 by default, the usual practice).
     pub gamma_factor: f64,
+    /// Reduce the controller to this many states by balanced truncation (a stable
+    /// controller only); the Theorem 1 proof is then of the reduced controller.
+    pub reduce: Option<usize>,
+    /// Loop-shaping weights: synthesize for `W₂·G·W₁`, return `W₁·K∞·W₂`.
+    pub weights: Option<crate::synthesis::Weights>,
 }
 
 impl Default for SynthesisSettings {
     fn default() -> Self {
-        Self { gamma_factor: 1.1 }
+        Self {
+            gamma_factor: 1.1,
+            reduce: None,
+            weights: None,
+        }
     }
+}
+
+/// The order reduction of the controller.
+#[derive(Debug, Clone, Serialize)]
+pub struct Reduction {
+    /// States of the central controller.
+    pub from: usize,
+    /// States kept.
+    pub to: usize,
+    /// Hankel singular values of the central controller.
+    pub hankel_singular_values: Vec<f64>,
+    /// Glover's bound `2·Σ_{i>to} σᵢ` on `‖K − K_r‖∞`.
+    pub error_bound: f64,
 }
 
 /// The margin of the synthesized controller for one bound `r`.
@@ -64,6 +86,8 @@ pub struct SynthesisOutcome {
     pub robust: bool,
     /// Notes for the reader (a frequency-dependent `r`, no controller reaching `α ≥ 1`).
     pub notes: Vec<String>,
+    /// The order reduction, when asked for and done.
+    pub reduction: Option<Reduction>,
 }
 
 /// The normalized factors the synthesis works on: those of the config's `[plant]`, else
@@ -99,7 +123,37 @@ pub fn run(
             )));
         }
     }
-    let gm = synthesize(&ncf, settings.gamma_factor)?;
+    let mut gm = match &settings.weights {
+        None => synthesize(&ncf, settings.gamma_factor)?,
+        Some(w) => {
+            let shaped = NormalizedLcf::new(w.shape(&ncf.plant))
+                .map_err(|e| Error::Invalid(format!("the shaped plant W2·G·W1: {e}")))?;
+            let mut gm = synthesize(&shaped, settings.gamma_factor)?;
+            gm.k = w.controller(&gm.k);
+            gm
+        }
+    };
+    let shaped = settings.weights.is_some();
+    let reduction = match settings.reduce {
+        Some(order) if order < gm.k.states() => {
+            let from = gm.k.states();
+            let abscissa = spectral_abscissa(&eigenvalues(&gm.k.a, "controller poles")?);
+            if abscissa.is_nan() || abscissa >= 0.0 {
+                return Err(Error::Invalid(format!(
+                    "--reduce {order}: the central controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce"
+                )));
+            }
+            let (kr, hsv) = gm.k.balanced_truncation(order)?;
+            gm.k = kr;
+            Some(Reduction {
+                from,
+                to: order,
+                error_bound: 2.0 * hsv[order..].iter().sum::<f64>(),
+                hankel_singular_values: hsv,
+            })
+        }
+        _ => None,
+    };
     let controller = Controller {
         path: controller_path.to_path_buf(),
         k: gm.k.clone(),
@@ -113,11 +167,17 @@ pub fn run(
             "the config's factors are not the normalized ones: the controller maximizes b(G,K) of the plant they define; Theorem 1 margins are with the config's factors".to_string(),
         );
     }
+    if shaped {
+        notes.push(
+            "loop shaping: b_opt and gamma are of the shaped plant W2*G*W1; the proof is of K = W1*Kinf*W2 on the plant".to_string(),
+        );
+    }
     let mut bounds = Vec::new();
     for (row, (label, r)) in stability.report.margins.iter().zip(rs) {
         let constant = r.num.degree() == 0 && r.den.degree() == 0;
         // α* = b(G,K)/|r| holds for normalized factors only.
-        let alpha_opt = (constant && normalized).then(|| gm.b_opt / r.at_infinity().abs());
+        let alpha_opt =
+            (constant && normalized && !shaped).then(|| gm.b_opt / r.at_infinity().abs());
         if let Some(a) = alpha_opt.filter(|a| *a < 1.0) {
             notes.push(format!(
                 "{label} r: no controller reaches alpha >= 1: b_opt = {} < |r| = {} (best alpha {})",
@@ -149,6 +209,7 @@ pub fn run(
         controller_poles,
         robust,
         notes,
+        reduction,
     })
 }
 
@@ -246,6 +307,7 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "controller_order": k.states(),
         "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
         "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "reduction": &o.reduction,
         "bounds": &o.bounds,
         "robust": o.robust,
         "notes": &o.notes,
@@ -298,6 +360,15 @@ pub fn text(o: &SynthesisOutcome) -> String {
         fmt_g(o.gm.gamma),
         o.gm.k.states()
     );
+    if let Some(r) = &o.reduction {
+        let _ = writeln!(
+            s,
+            "reduced by balanced truncation: {} -> {} states (||K - Kr||_inf <= {}); the proof below is of the reduced controller",
+            r.from,
+            r.to,
+            fmt_g(r.error_bound)
+        );
+    }
     for b in &o.bounds {
         if let Some(a) = b.alpha_opt {
             let _ = writeln!(

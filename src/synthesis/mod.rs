@@ -1,6 +1,9 @@
 //! Controller synthesis for the perturbed coprime-factor model of Theorem 1: the
-//! Glover–McFarlane optimum for a constant bound `r` ([`glover_mcfarlane`]). The result is
+//! Glover–McFarlane optimum for a constant bound `r` ([`glover_mcfarlane`]), optionally on
+//! a plant shaped by loop-shaping weights ([`weights`]). The result is
 //! always re-proved by the Theorem 1 test ([`crate::stability`]) before it is reported.
 pub mod glover_mcfarlane;
+pub mod weights;
 
 pub use glover_mcfarlane::{central_controller, optimum, synthesize, GmController, GmOptimum};
+pub use weights::Weights;
