@@ -160,6 +160,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             order: a.order,
             factorization: crate::pipeline::closed_loop::a1_factorization(&config),
             closed_loop: config.closed_loop.is_some(),
+            datasets: results.iter().filter_map(|r| r.envelope.as_ref()).collect(),
         },
     )?;
     print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());
@@ -223,7 +224,7 @@ pub fn print_summary(
         );
     }
     outln!(
-        "  wrote {}/summary.csv, batch.json, combined_envelope.csv, r.json",
+        "  wrote {}/summary.csv, batch.json, combined_envelope.csv, batch.svg, r.json",
         out.display()
     );
 }

@@ -88,7 +88,11 @@ pub fn fmt_bands(b: &[Band]) -> String {
     worst.sort_by(|&x, &y| b[y].peak_misfit.total_cmp(&b[x].peak_misfit));
     worst.truncate(MAX_BANDS_SHOWN);
     worst.sort_unstable();
-    let shown = worst.iter().map(|&k| one(&b[k])).collect::<Vec<_>>().join("; ");
+    let shown = worst
+        .iter()
+        .map(|&k| one(&b[k]))
+        .collect::<Vec<_>>()
+        .join("; ");
     let rest: usize = (0..b.len())
         .filter(|k| !worst.contains(k))
         .map(|k| b[k].count)
