@@ -74,6 +74,7 @@ fn batch_1000(bencher: divan::Bencher) {
                     order: rshape::fit::OrderChoice::Auto { max: 8 },
                     factorization: Some(&config.factorization),
                     closed_loop: false,
+                    datasets: res.iter().filter_map(|r| r.envelope.as_ref()).collect(),
                 },
             )
             .unwrap();

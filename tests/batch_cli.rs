@@ -115,6 +115,19 @@ fn corrupt_dataset_exit_3_others_complete() {
     assert_eq!(b["consistent_all"], false);
     assert!(b["r_fitted"]["num"].is_array());
     assert!(out.path().join("r.json").is_file());
+    // batch.svg: the 3 good datasets' envelopes, the combined one and the fitted r.
+    let svg = std::fs::read_to_string(out.path().join("batch.svg")).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let text: String = doc.descendants().filter_map(|n| n.text()).collect();
+    for want in [
+        "Batch: 3 datasets",
+        "r_min per datum of each of the 3 datasets",
+        "combined envelope",
+        "fitted r",
+        "configured r",
+    ] {
+        assert!(text.contains(want), "batch.svg lacks `{want}`: {text}");
+    }
     let env = std::fs::read_to_string(out.path().join("combined_envelope.csv")).unwrap();
     assert_eq!(env.lines().count(), 6);
 }

@@ -128,6 +128,7 @@ pub fn merge_then(
                 .as_ref()
                 .and_then(crate::pipeline::closed_loop::a1_factorization),
             closed_loop: first.closed_loop,
+            datasets: Vec::new(),
         },
     )?;
     Ok(MergeOutcome {

@@ -106,6 +106,44 @@ impl From<&TransferFunction> for CoeffsOwned {
     }
 }
 
+/// `batch.svg`: every dataset's envelope, the combined one and the configured and fitted `r`.
+fn figure(
+    config: &Path,
+    datasets: &[&Envelope],
+    combined: &Envelope,
+    r_configured: Option<&TransferFunction>,
+    r_fitted: Option<&TransferFunction>,
+    closed_loop: bool,
+) -> Result<String> {
+    let name = config
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    let title = if datasets.is_empty() {
+        format!("Batch: combined envelope and one r — {name}")
+    } else {
+        format!(
+            "Batch: {} datasets, combined envelope and one r — {name}",
+            datasets.len()
+        )
+    };
+    let per: Vec<(&[f64], &[f64])> = datasets
+        .iter()
+        .map(|e| (e.omega.as_slice(), e.r_min.as_slice()))
+        .collect();
+    let grid = crate::pipeline::outputs::dense_grid(&combined.omega);
+    crate::plot::batch_svg(
+        &crate::plot::BatchFigureInput {
+            title: &title,
+            datasets: &per,
+            combined: (&combined.omega, &combined.r_min),
+            r_configured,
+            r_fitted,
+            grid: &grid,
+        },
+        &crate::plot::Symbols::of(closed_loop),
+    )
+}
+
 /// What the batch-wide stage needs besides the rows and the combined envelope.
 pub struct FinishInput<'a> {
     /// The config file.
@@ -128,6 +166,9 @@ pub struct FinishInput<'a> {
     pub factorization: Option<&'a crate::model::Factorization>,
     /// Closed-loop data (the weight is `V`).
     pub closed_loop: bool,
+    /// Per-dataset envelopes for `batch.svg` (empty after `merge`, which has only the
+    /// combined one).
+    pub datasets: Vec<&'a Envelope>,
 }
 
 /// A 64-bit FNV-1a digest (hex) of the config file's bytes: shards whose configs differ in
@@ -166,6 +207,18 @@ pub fn finish(
         integration::export_r(f, out)?;
     }
     write_atomic(&out.join("summary.csv"), summary::render(rows).as_bytes())?;
+    if let Some(env) = combined {
+        let fitted = fit.as_ref().and_then(|f| f.as_ref().ok()).map(|f| &f.r);
+        let svg = figure(
+            &inp.config,
+            &inp.datasets,
+            env,
+            inp.r_configured,
+            fitted,
+            inp.closed_loop,
+        )?;
+        write_atomic(&out.join("batch.svg"), svg.as_bytes())?;
+    }
     timings.insert("write".into(), t.elapsed().as_secs_f64() * 1e3);
     let ok = rows.iter().filter(|r| r.ok).count();
     let report = BatchReport {

@@ -172,6 +172,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             order: a.order,
             factorization: crate::pipeline::closed_loop::a1_factorization(&config),
             closed_loop: config.closed_loop.is_some(),
+            datasets: results.iter().filter_map(|r| r.envelope.as_ref()).collect(),
         },
     )?;
     print_summary(&rep, &rows, &a.out, t0.elapsed().as_secs_f64());
@@ -239,6 +240,7 @@ pub fn print_summary(
     let mut files = vec!["summary.csv", "batch.json"];
     if rep.n_frequencies > 0 {
         files.push("combined_envelope.csv");
+        files.push("batch.svg");
     }
     if rep.r_fitted.is_some() {
         files.push("r.json");

@@ -7,10 +7,12 @@
 //!   per-datum smallest consistent `|r|` (`‖Δᵢ‖` of eq. (8), or the Theorem 4 bisection);
 //! - [`bode`]: the data (with noise-disk error bars, eq. (5)) against the nominal model,
 //!   as in Fig. 7;
-//! - [`mu`]: `μ_Γ` per datum with the line `μ = 1` (Fig. 8).
+//! - [`mu`]: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
+//! - [`batch`]: every dataset's envelope, the combined envelope and the one fitted `r`.
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
+pub mod batch;
 pub mod bode;
 pub mod mu;
 pub mod r_vs_delta;
@@ -18,6 +20,7 @@ pub mod stability;
 pub mod style;
 pub mod symbols;
 
+pub use batch::{batch_svg, BatchFigureInput};
 pub use bode::{bode_svg, BodeInput};
 pub use mu::{mu_svg, mu_svg_with, MuInput};
 pub use r_vs_delta::{r_vs_delta_svg, r_vs_delta_svg_with, RVsDeltaInput};

@@ -35,12 +35,22 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
     let (xlo, xhi) = omega_range(inp.omega);
     let (ylo, yhi) =
         log_range(inp.mu.iter().chain(std::iter::once(&1.0)), 2.5).unwrap_or((0.1, 10.0));
+    let rows =
+        1 + usize::from(
+            inp.mu
+                .iter()
+                .enumerate()
+                .any(|(i, m)| *m > 1.0 && !inp.a1_failing.get(i).copied().unwrap_or(false)),
+        ) + usize::from(inp.a1_failing.iter().any(|f| *f))
+            + usize::from(inp.mu.iter().any(|m| *m <= 1.0));
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
+        let (plot, below) = root.split_vertically(SIZE.1);
+        let mut leg = Legend::default();
         let mut chart = loglog_chart(
-            &root,
+            &plot,
             inp.title,
             (xlo, xhi),
             (ylo, yhi),
@@ -54,9 +64,11 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                 6,
                 s,
             ))
-            .map_err(plot_err)?
-            .label("μ = 1: consistent above, inconsistent at or below")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s));
+            .map_err(plot_err)?;
+        leg.add(
+            "μ = 1: consistent above, inconsistent at or below",
+            move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+        );
         let a1_fails = |i: usize| inp.a1_failing.get(i).copied().unwrap_or(false);
         // (ω, μ clamped, μ > 1, A1 holds)
         let pts: Vec<(f64, f64, bool, bool)> = (0..inp.omega.len())
@@ -80,24 +92,26 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                         .filter(|p| p.2 && p.3)
                         .map(|p| Circle::new((p.0, p.1), 3, C_BLUE.filled())),
                 )
-                .map_err(plot_err)?
-                .label(format!("{mu_name} per datum, configured {w} (consistent)"))
-                .legend(|(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()));
+                .map_err(plot_err)?;
+            leg.add(
+                format!("{mu_name} per datum, configured {w} (consistent)"),
+                |(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()),
+            );
         }
         let n_inadmissible = pts.iter().filter(|p| p.2 && !p.3).count();
         if n_inadmissible > 0 {
             let sq = |(x, y): (i32, i32)| [(x - 4, y - 4), (x + 4, y + 4)];
             chart
-                .draw_series(
-                    pts.iter()
-                        .filter(|p| p.2 && !p.3)
-                        .map(|p| EmptyElement::at((p.0, p.1)) + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))),
-                )
-                .map_err(plot_err)?
-                .label(format!(
+                .draw_series(pts.iter().filter(|p| p.2 && !p.3).map(|p| {
+                    EmptyElement::at((p.0, p.1))
+                        + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
+                }))
+                .map_err(plot_err)?;
+            leg.add(
+format!(
                     "{mu_name} > 1 but A1 fails ({n_inadmissible} data): configured {w} NOT ADMISSIBLE, no verdict"
-                ))
-                .legend(move |(x, y)| {
+                ),
+move |(x, y)| {
                     EmptyElement::at((x + 12, y)) + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
                 });
         }
@@ -108,15 +122,14 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                         + Circle::new((0, 0), 6, C_RED.stroke_width(2))
                         + Cross::new((0, 0), 4, C_RED.stroke_width(2))
                 }))
-                .map_err(plot_err)?
-                .label(format!("{mu_name} ≤ 1: FAILING datum"))
-                .legend(|(x, y)| {
-                    EmptyElement::at((x + 12, y))
-                        + Circle::new((0, 0), 6, C_RED.stroke_width(2))
-                        + Cross::new((0, 0), 4, C_RED.stroke_width(2))
-                });
+                .map_err(plot_err)?;
+            leg.add(format!("{mu_name} ≤ 1: FAILING datum"), |(x, y)| {
+                EmptyElement::at((x + 12, y))
+                    + Circle::new((0, 0), 6, C_RED.stroke_width(2))
+                    + Cross::new((0, 0), 4, C_RED.stroke_width(2))
+            });
         }
-        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        leg.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
     Ok(svg)
