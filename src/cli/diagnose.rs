@@ -6,7 +6,7 @@ use super::compare::channel_arg;
 use crate::diagnose::plant_form::physical_from_config;
 use crate::diagnose::{
     apply_candidate, apply_chosen, diagnose_channels, misfit_channels, prepare, retune_within,
-    Channels, Diagnosis, Settings,
+    Channels, DiagnoseVerdict, Diagnosis, Settings,
 };
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
@@ -276,7 +276,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         fmt_g(d.before.misfit_rms),
         fmt_pct(d.before.invalid_fraction)
     );
-    if d.verdict == "consistent" {
+    if d.verdict == DiagnoseVerdict::Consistent {
         println!("\nverdict: {}: {}", d.verdict, d.message);
         return;
     }

@@ -32,6 +32,7 @@ pub mod channels;
 pub mod engine;
 pub mod factor_form;
 pub mod final_effects;
+mod first_level;
 pub mod fit;
 pub mod holdout;
 pub mod plant_form;
@@ -46,6 +47,8 @@ mod starts;
 pub mod ties;
 
 pub use channels::{misfit_channels, Channels};
-pub use engine::{apply_candidate, apply_chosen, diagnose, diagnose_channels, Diagnosis};
+pub use engine::{
+    apply_candidate, apply_chosen, diagnose, diagnose_channels, DiagnoseVerdict, Diagnosis,
+};
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
 pub use search::Settings;

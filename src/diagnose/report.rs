@@ -197,12 +197,51 @@ pub struct SearchStats {
     pub seconds: f64,
 }
 
+/// The verdict of `diagnose` (serialized in snake_case).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiagnoseVerdict {
+    /// The configured model explains the data within the noise: nothing to do.
+    Consistent,
+    /// The refit of the configured parameters explains the data: nothing added.
+    Retuned,
+    /// A set of effects was chosen.
+    EffectsFound,
+    /// Neither the retune nor any catalogue effect explains the data.
+    NoEffectFound,
+}
+
+impl DiagnoseVerdict {
+    /// The snake_case name (as in the JSON).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Consistent => "consistent",
+            Self::Retuned => "retuned",
+            Self::EffectsFound => "effects_found",
+            Self::NoEffectFound => "no_effect_found",
+        }
+    }
+}
+
+impl std::fmt::Display for DiagnoseVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Compares with the JSON name (`verdict == "effects_found"`), for scripts and tests that
+/// read the report.
+impl PartialEq<&str> for DiagnoseVerdict {
+    fn eq(&self, other: &&str) -> bool {
+        self.as_str() == *other
+    }
+}
+
 /// The diagnosis.
 #[derive(Debug, Clone, Serialize)]
 pub struct Diagnosis {
-    /// `consistent` (nothing to do), `retuned` (the refit of the configured parameters
-    /// explains the data: nothing added), `effects_found`, or `no_effect_found`.
-    pub verdict: String,
+    /// The verdict ([`DiagnoseVerdict`]).
+    pub verdict: DiagnoseVerdict,
     /// Human summary.
     pub message: String,
     /// Number of complex data (frequencies × channels).
