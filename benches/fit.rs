@@ -3,10 +3,12 @@
 //! 0..N chained; and (issue 11) 1000- and 100,000-point jagged envelopes at orders 2, 6, 10.
 //! Target: ≤ 200 ms per fit at order ≤ 6; the 1000-point order-6 fit within 1.5× of its
 //! time before the exact certificate (jagged 190 ms, smooth 86 ms median on the 2-core CI
-//! machine).  Run: `cargo bench --bench fit -- --sample-count 5`.
+//! machine).  Run: `cargo bench --bench fit -- --sample-count 5`.  Issue 21 targets: order 6
+//! on 1000 points ≤ 200 ms (whole process), `--order auto` on 2000 points ≤ 3 s
+//! (`jagged_2000_auto`), order 6 on 100,000 points ≤ 6 s (`jagged_100000`).
 
 use rshape::consistency::{Envelope, EnvelopeMethod};
-use rshape::fit::{fit_unit, FitSettings};
+use rshape::fit::{fit_auto, fit_unit, FitSettings};
 use rshape::system::logspace;
 
 fn main() {
@@ -111,4 +113,13 @@ fn jagged_100000(bencher: divan::Bencher, order: usize) {
         ..Default::default()
     };
     bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+}
+
+/// Issue 21: `--order auto` (orders 0..=8 chained, the order table) on a jagged 2000-point
+/// envelope.  Target ≤ 3 s.
+#[divan::bench(sample_count = 3)]
+fn jagged_2000_auto(bencher: divan::Bencher) {
+    let env = envelope_n(true, 2000);
+    let set = FitSettings::default();
+    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
 }

@@ -81,7 +81,7 @@ fn steeply_rising_envelope_is_not_declared_infeasible() {
         assert!(f.certificate.max_log10_ratio <= 6.0 + 1e-6);
         // Where the level search failed, the event says what blocks it.
         for ev in &f.solver_events {
-            if ev.action.starts_with("no feasible level") {
+            if ev.kind == rshape::fit::EventKind::NoFeasibleLevel {
                 assert!(ev.action.contains("block"), "{}", ev.action);
             }
         }

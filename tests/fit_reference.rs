@@ -447,7 +447,7 @@ fn steep_rise_is_fitted_near_the_reference_at_orders_1_to_3() {
             "order {order}: rshape {ours} vs reference {reference}"
         );
         assert!(
-            !fit.origin.starts_with("constant"),
+            fit.origin != rshape::fit::Origin::Constant,
             "order {order}: {}",
             fit.origin
         );

@@ -5,6 +5,7 @@
 
 use super::common::InputArgs;
 use crate::data::read_envelope_csv;
+use crate::fit::run::{events_text, work_line};
 use crate::fit::{run_fit, FitSettings, Objective, OrderChoice};
 use anyhow::{anyhow, Result};
 use clap::{Args, ValueEnum};
@@ -45,6 +46,9 @@ pub struct FitArgs {
     /// Output directory for r.json, r.m, r.py, r.jl.
     #[arg(long)]
     pub out: PathBuf,
+    /// Also list the solver events (solves short of `Solved`, discarded candidates).
+    #[arg(long, short)]
+    pub verbose: bool,
 }
 
 /// Runs `rshape fit`.
@@ -63,11 +67,14 @@ pub fn run(a: &FitArgs) -> Result<i32> {
         margin: a.margin,
         ..Default::default()
     };
+    let view = super::progress::FitProgressView::new("fit");
+    let progress = |p| view.update(p);
+    let progress: crate::fit::ProgressFn<'_> = &progress;
     let outcome = match (&a.envelope, &a.config) {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
             let _manifest = super::common::prepare_out(&a.out, &[path])?;
-            run_fit(&env, None, &settings, a.order, &a.out)?
+            run_fit(&env, None, &settings, a.order, &a.out, Some(progress))
         }
         (None, Some(config)) => {
             let input = InputArgs {
@@ -79,10 +86,16 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
-            run_fit(&env, Some(&a1), &settings, a.order, &a.out)?
+            run_fit(&env, Some(&a1), &settings, a.order, &a.out, Some(progress))
         }
         (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),
     };
+    view.finish();
+    let outcome = outcome?;
     print!("{}", outcome.text);
+    print!("{}", work_line(&outcome.result, outcome.seconds));
+    if a.verbose {
+        print!("{}", events_text(&outcome.result));
+    }
     Ok(0)
 }

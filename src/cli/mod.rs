@@ -23,6 +23,7 @@ pub mod envelope;
 pub mod fit;
 pub mod history;
 pub mod merge;
+pub mod progress;
 pub mod run;
 pub mod stability;
 pub mod synthesize;

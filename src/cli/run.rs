@@ -65,7 +65,10 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     // Closed-loop configs shape the weight V of [v] (Crowder & de Callafon, eq. (2)).
     let sym = crate::plot::Symbols::of(config.closed_loop.is_some());
     let (w, wmin) = (sym.weight, sym.weight_min);
-    let mut out = pipeline::run(config, data, a.input.noise_radius, a.order)?;
+    let view = super::progress::FitProgressView::new("run: fit");
+    let progress = |p| view.update(p);
+    let mut out = pipeline::run(config, data, a.input.noise_radius, a.order, Some(&progress))?;
+    view.finish();
     out.timings.0.insert("load".into(), load_ms);
     let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;
     let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;

@@ -92,14 +92,18 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     if let (Some((inputs, env)), Some(out)) = (&fit_input, &a.out) {
         let f = &inputs.config.factorization;
         let a1 = |w: f64| f.a1_limit(w);
+        let view = super::progress::FitProgressView::new("stability --fit");
+        let progress = |p| view.update(p);
         let outcome = run_fit(
             env,
             Some(&a1),
             &FitSettings::default(),
             OrderChoice::Auto { max: 8 },
             out,
+            Some(&progress),
         )?;
-        fit_text = outcome.text;
+        view.finish();
+        fit_text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
         rs.push(("fitted".into(), outcome.result.r.clone()));
     }
     let outcome = stability::run(&config, &controller, &rs, a.data.as_deref())?;

@@ -113,14 +113,18 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     if let Some((inputs, env)) = &fit_input {
         let f = &inputs.config.factorization;
         let a1 = |w: f64| f.a1_limit(w);
+        let view = super::progress::FitProgressView::new("synthesize --fit");
+        let progress = |p| view.update(p);
         let outcome = run_fit(
             env,
             Some(&a1),
             &FitSettings::default(),
             OrderChoice::Auto { max: 8 },
             &a.out,
+            Some(&progress),
         )?;
-        fit_text = outcome.text;
+        view.finish();
+        fit_text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
         rs.push(("fitted".into(), outcome.result.r.clone()));
     }
     let outcome = synthesize::run(

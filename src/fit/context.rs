@@ -5,6 +5,7 @@
 
 use super::basis::{build_grid, GridSpec, Scaling};
 use super::engine::{Prepared, Scored};
+use super::provenance::Origin;
 use super::{certificate, A1Fn, FitError, FitResult, FitSettings, Objective, SolverEvent};
 use crate::consistency::Envelope;
 use crate::system::TransferFunction;
@@ -196,7 +197,7 @@ impl Context<'_> {
                 objective: set.objective,
                 objective_value,
                 certificate: cert,
-                origin: cand.origin.clone(),
+                origin: cand.origin,
                 solver_events: events.clone(),
                 lp_solves,
                 scaling: self.scaling,
@@ -204,7 +205,7 @@ impl Context<'_> {
             };
             let mut sc = cand.clone();
             sc.zpk.gain *= res.certificate.repair_factor;
-            let sc = self.prep.score(sc.zpk, &sc.origin);
+            let sc = self.prep.score(sc.zpk, sc.origin);
             (res, sc)
         };
         // The best ranked candidate, unless its certificate had to repair it (a dip between
@@ -214,7 +215,7 @@ impl Context<'_> {
         // that way) and conservatism never increases with the order.
         let carried = ranked
             .iter()
-            .position(|c| c.origin.ends_with("carried over"));
+            .position(|c| matches!(c.origin, Origin::CarriedOver { .. }));
         let order_of_trial: Vec<usize> = (0..ranked.len().min(4)).chain(carried).collect();
         let mut best: Option<(FitResult, Scored)> = None;
         let better = |a: &FitResult, b: &FitResult| {

@@ -15,6 +15,7 @@ use super::basis::{reference_poles, GridPoint, PointKind};
 use super::levelsearch::minimax_level;
 use super::polyfit;
 use super::problem::{area_fixed_poles, basis_rows, initial_points, SolverEvent, SolverStatus};
+use super::provenance::{EventKind, Origin, PoleSet};
 use super::spectral::{stable_roots, RootKind, Zpk};
 use super::{FitSettings, Objective};
 use num_complex::Complex64;
@@ -46,7 +47,7 @@ pub(crate) struct Scored {
     /// `max |r|²/U` over the data (the minimax level reached).
     pub t: f64,
     /// Where the candidate came from.
-    pub origin: String,
+    pub origin: Origin,
     /// Smallest `|r|²/lower` over the grid (≥ 1 when feasible).
     pub coverage: f64,
     /// Smallest `α/|r|²` over the grid (≥ 1 when A1 holds).
@@ -54,7 +55,7 @@ pub(crate) struct Scored {
 }
 
 impl Prepared {
-    pub fn score(&self, zpk: Zpk, origin: &str) -> Scored {
+    pub fn score(&self, zpk: Zpk, origin: Origin) -> Scored {
         let (mut sum, mut cnt, mut max, mut area) = (0.0, 0.0, f64::NEG_INFINITY, 0.0);
         for i in 0..self.w.len() {
             if self.rmin[i] > 0.0 {
@@ -85,7 +86,7 @@ impl Prepared {
             max_log: max,
             area,
             t,
-            origin: origin.into(),
+            origin,
             coverage,
             a1_ratio,
         }
@@ -121,7 +122,10 @@ pub(crate) struct OrderFit {
     pub lp_solves: usize,
 }
 
-/// Fits order `n` given the previous order's chosen candidate.
+/// Fits order `n` given the previous order's chosen candidate: the steps of the module
+/// doc, in order.  `masks` are the working sets of the level search and of the area polish,
+/// carried from order to order (the row layout depends only on the grid, and the rows that
+/// bind at order N mostly bind at order N+1).
 pub(crate) fn fit_order(
     prep: &Prepared,
     n: usize,
@@ -129,221 +133,300 @@ pub(crate) fn fit_order(
     set: &FitSettings,
     masks: &mut (Vec<bool>, Vec<bool>),
 ) -> OrderFit {
-    let q = reference_poles(n, prep.band.0, prep.band.1);
-    let mut events = Vec::new();
-    let mut lp_solves = 0;
-    let mut cands: Vec<Scored> = Vec::new();
-    let event = |stage: String, status: SolverStatus, action: &str| SolverEvent {
-        order: n,
-        stage,
-        status,
-        action: action.into(),
-    };
+    let mut o = OrderSearch::new(prep, n, prev, set);
+    let pole_sets = o.partial_fraction_minimax(&mut masks.0);
+    o.area_polish(pole_sets, &mut masks.1);
+    o.fallbacks();
+    o.global_minimax();
+    OrderFit {
+        ranked: o.rank(),
+        events: o.events,
+        lp_solves: o.lp_solves,
+    }
+}
 
-    // 1. Minimax in the partial-fraction basis ([`super::levelsearch`]).
-    let phi = basis_rows(&q, &prep.grid);
-    let init = initial_points(&prep.grid, 40);
-    // Working sets (per row) carried from order to order: the row layout depends only on
-    // the grid, and the rows that bind at order N mostly bind at order N+1.
-    let (mut mask, mut area_mask) = std::mem::take(masks);
-    let best = minimax_level(
-        &phi,
-        &prep.grid,
-        &init,
-        &mut mask,
-        prev.map(|p| p.t),
-        n,
-        set,
-        &mut events,
-        &mut lp_solves,
-    );
+/// The state of one order's search: its inputs, the candidates so far, the events.
+struct OrderSearch<'a> {
+    prep: &'a Prepared,
+    n: usize,
+    prev: Option<&'a Scored>,
+    set: &'a FitSettings,
+    /// Reference poles of the partial-fraction basis.
+    q: Vec<f64>,
+    /// Basis rows at the grid.
+    phi: Vec<Vec<f64>>,
+    /// Initial working-set points.
+    init: Vec<bool>,
+    cands: Vec<Scored>,
+    events: Vec<SolverEvent>,
+    lp_solves: usize,
+}
 
-    let mut pole_sets: Vec<(String, Vec<Complex64>)> = Vec::new();
-    if let Some((t, a, b)) = &best {
-        let poles = stable_roots(&q, b, RootKind::Pole, set.axis_tol, set.root_iter_cap);
-        let zeros = stable_roots(&q, a, RootKind::Zero, set.axis_tol, set.root_iter_cap);
-        match (poles, zeros) {
-            (Ok(p), Ok(z)) => {
-                let gain = (a[0] / b[0]).sqrt();
-                cands.push(prep.score(
-                    Zpk {
+/// Feasible to the LP accuracy on the grid.
+fn feasible(c: &Scored) -> bool {
+    c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6
+}
+
+impl<'a> OrderSearch<'a> {
+    fn new(prep: &'a Prepared, n: usize, prev: Option<&'a Scored>, set: &'a FitSettings) -> Self {
+        let q = reference_poles(n, prep.band.0, prep.band.1);
+        let phi = basis_rows(&q, &prep.grid);
+        Self {
+            prep,
+            n,
+            prev,
+            set,
+            q,
+            phi,
+            init: initial_points(&prep.grid, 40),
+            cands: Vec::new(),
+            events: Vec::new(),
+            lp_solves: 0,
+        }
+    }
+
+    fn event(&mut self, stage: String, status: SolverStatus, kind: EventKind, action: &str) {
+        self.events.push(SolverEvent {
+            order: self.n,
+            stage,
+            status,
+            kind,
+            action: action.into(),
+        });
+    }
+
+    /// Step 1: the minimax level search in the partial-fraction basis
+    /// ([`super::levelsearch`]); its fit is a candidate.  Returns the pole sets for the
+    /// area polish: the minimax poles, the previous order's plus one, the reference poles.
+    fn partial_fraction_minimax(&mut self, mask: &mut Vec<bool>) -> Vec<(PoleSet, Vec<Complex64>)> {
+        let (set, q) = (self.set, &self.q);
+        let best = minimax_level(
+            &self.phi,
+            &self.prep.grid,
+            &self.init,
+            mask,
+            self.prev.map(|p| p.t),
+            self.n,
+            set,
+            &mut self.events,
+            &mut self.lp_solves,
+        );
+        let mut pole_sets: Vec<(PoleSet, Vec<Complex64>)> = Vec::new();
+        if let Some((t, a, b)) = &best {
+            let poles = stable_roots(q, b, RootKind::Pole, set.axis_tol, set.root_iter_cap);
+            let zeros = stable_roots(q, a, RootKind::Zero, set.axis_tol, set.root_iter_cap);
+            match (poles, zeros) {
+                (Ok(p), Ok(z)) => {
+                    let gain = (a[0] / b[0]).sqrt();
+                    let zpk = Zpk {
                         gain,
                         zeros: z,
                         poles: p.clone(),
-                    },
-                    &format!("minimax (t = {t:.4e})"),
-                ));
-                pole_sets.push(("minimax poles".into(), p));
-            }
-            (Err(e), _) | (_, Err(e)) => {
-                events.push(event(
-                    "minimax spectral factorization".into(),
-                    SolverStatus::Solved,
-                    &format!("{e}; candidate discarded, others tried"),
-                ));
-                if let Ok(p) = stable_roots(&q, b, RootKind::Pole, set.axis_tol, set.root_iter_cap)
-                {
-                    pole_sets.push(("minimax poles".into(), p));
+                    };
+                    self.cands
+                        .push(self.prep.score(zpk, Origin::Minimax { t: *t }));
+                    pole_sets.push((PoleSet::Minimax, p));
+                }
+                (poles, zeros) => {
+                    let e = match (&poles, &zeros) {
+                        (Err(e), _) | (_, Err(e)) => e.to_string(),
+                        _ => String::new(),
+                    };
+                    self.event(
+                        "minimax spectral factorization".into(),
+                        SolverStatus::Solved,
+                        EventKind::CandidateDiscarded,
+                        &format!("{e}; candidate discarded, others tried"),
+                    );
+                    // The zeros failed, the poles did not: the area polish can still use them.
+                    if let Ok(p) = poles {
+                        pole_sets.push((PoleSet::Minimax, p));
+                    }
                 }
             }
         }
-    }
-    if let Some(p) = prev {
-        let mut poles = p.zpk.poles.clone();
-        if n > poles.len() {
-            poles.push(Complex64::new(-1.0, 0.0));
-        }
-        if poles.len() == n {
-            pole_sets.push(("previous poles + one".into(), poles));
-        }
-    }
-    pole_sets.push((
-        "reference poles".into(),
-        q.iter().map(|v| Complex64::new(-v, 0.0)).collect(),
-    ));
-
-    // 2. Area polish with fixed poles.
-    let t_best = cands
-        .iter()
-        .map(|c| c.t)
-        .chain(prev.map(|p| p.t))
-        .fold(f64::INFINITY, f64::min);
-    let t_cap = if t_best.is_finite() {
-        match set.objective {
-            Objective::Minimax => t_best * (1.0 + set.bisection_tol).powi(2),
-            Objective::Area => t_best * set.area_slack * set.area_slack,
-        }
-    } else {
-        1e24
-    };
-    let weights: Vec<f64> = prep
-        .grid
-        .iter()
-        .map(|g| match (g.kind, g.datum) {
-            (PointKind::Datum, Some(i)) if prep.rmin[i] > 0.0 => {
-                prep.weights[i] / (prep.rmin[i] * prep.rmin[i])
+        if let Some(p) = self.prev {
+            let mut poles = p.zpk.poles.clone();
+            if self.n > poles.len() {
+                poles.push(Complex64::new(-1.0, 0.0));
             }
-            _ => 0.0,
-        })
-        .collect();
-    for (name, poles) in pole_sets {
-        let kp = kappa(&prep.grid, &q, &poles);
-        let (st, a, _, rounds) = area_fixed_poles(
-            &phi,
-            &prep.grid,
-            &kp,
-            &weights,
-            t_cap,
-            &init,
-            &mut area_mask,
-            set.max_solver_iter,
-        );
-        lp_solves += rounds;
-        if st != SolverStatus::Solved {
-            events.push(event(
-                format!("area with {name}"),
-                st,
-                match st {
-                    s if s.has_solution() => "used the reduced-accuracy solution; verified below",
-                    SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                        "these poles cannot meet the bounds at this level; candidate skipped, others tried"
-                    }
-                    _ => "candidate discarded, others tried",
-                },
-            ));
+            if poles.len() == self.n {
+                pole_sets.push((PoleSet::PreviousPlusOne, poles));
+            }
         }
-        if !st.has_solution() {
-            continue;
-        }
-        match stable_roots(&q, &a, RootKind::Zero, set.axis_tol, set.root_iter_cap) {
-            Ok(z) => cands.push(prep.score(
-                Zpk {
-                    gain: a[0].sqrt(),
-                    zeros: z,
-                    poles,
-                },
-                &format!("area polish, {name}"),
-            )),
-            Err(e) => events.push(event(
-                format!("area with {name}: spectral factorization"),
-                st,
-                &format!("{e}; candidate discarded, others tried"),
-            )),
+        pole_sets.push((
+            PoleSet::Reference,
+            self.q.iter().map(|v| Complex64::new(-v, 0.0)).collect(),
+        ));
+        pole_sets
+    }
+
+    /// Step 2: the area objective with each pole set fixed, the level capped at the best
+    /// reached so far (minimax) or `area_slack` above it (area).
+    fn area_polish(&mut self, pole_sets: Vec<(PoleSet, Vec<Complex64>)>, mask: &mut Vec<bool>) {
+        let (prep, set) = (self.prep, self.set);
+        let t_best = self
+            .cands
+            .iter()
+            .map(|c| c.t)
+            .chain(self.prev.map(|p| p.t))
+            .fold(f64::INFINITY, f64::min);
+        let t_cap = if t_best.is_finite() {
+            match set.objective {
+                Objective::Minimax => t_best * (1.0 + set.bisection_tol).powi(2),
+                Objective::Area => t_best * set.area_slack * set.area_slack,
+            }
+        } else {
+            1e24
+        };
+        let weights: Vec<f64> = prep
+            .grid
+            .iter()
+            .map(|g| match (g.kind, g.datum) {
+                (PointKind::Datum, Some(i)) if prep.rmin[i] > 0.0 => {
+                    prep.weights[i] / (prep.rmin[i] * prep.rmin[i])
+                }
+                _ => 0.0,
+            })
+            .collect();
+        for (name, poles) in pole_sets {
+            let kp = kappa(&prep.grid, &self.q, &poles);
+            let (st, a, _, rounds) = area_fixed_poles(
+                &self.phi,
+                &prep.grid,
+                &kp,
+                &weights,
+                t_cap,
+                &self.init,
+                mask,
+                set.max_solver_iter,
+            );
+            self.lp_solves += rounds;
+            if st != SolverStatus::Solved {
+                let (kind, action) = match st {
+                    s if s.has_solution() => (
+                        EventKind::ReducedAccuracyUsed,
+                        "used the reduced-accuracy solution; verified below",
+                    ),
+                    SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => (
+                        EventKind::CandidateDiscarded,
+                        "these poles cannot meet the bounds at this level; candidate skipped, others tried",
+                    ),
+                    _ => (
+                        EventKind::CandidateDiscarded,
+                        "candidate discarded, others tried",
+                    ),
+                };
+                self.event(format!("area with {name}"), st, kind, action);
+            }
+            if !st.has_solution() {
+                continue;
+            }
+            match stable_roots(&self.q, &a, RootKind::Zero, set.axis_tol, set.root_iter_cap) {
+                Ok(z) => {
+                    let zpk = Zpk {
+                        gain: a[0].sqrt(),
+                        zeros: z,
+                        poles,
+                    };
+                    let c = prep.score(zpk, Origin::AreaPolish { poles: name });
+                    self.cands.push(c);
+                }
+                Err(e) => self.event(
+                    format!("area with {name}: spectral factorization"),
+                    st,
+                    EventKind::CandidateDiscarded,
+                    &format!("{e}; candidate discarded, others tried"),
+                ),
+            }
         }
     }
-    if let Some(p) = prev {
-        let mut c = p.clone();
-        c.origin = format!("order {} carried over", p.zpk.order());
-        cands.push(c);
-    }
-    // The constant r at the largest lower bound meets every lower bound: a candidate at
-    // every order, so a level search that fails numerically never turns a feasible order
-    // into "infeasible" (GitHub issue 11, defect 5).
-    let c2 = prep.grid.iter().map(|g| g.lower).fold(0.0f64, f64::max);
-    if c2 > 0.0 && c2.is_finite() {
-        cands.push(prep.score(
-            Zpk {
+
+    /// Step 3: the candidates that need no LP: the previous order's `r` (an order-`N−1`
+    /// unit is an order-`N` unit with a cancelling pole-zero pair) and the constant `r` at
+    /// the largest lower bound, which meets every lower bound, so a level search that fails
+    /// numerically never turns a feasible order into "infeasible" (GitHub issue 11, defect 5).
+    fn fallbacks(&mut self) {
+        if let Some(p) = self.prev {
+            let mut c = p.clone();
+            c.origin = Origin::CarriedOver {
+                from_order: p.zpk.order(),
+            };
+            self.cands.push(c);
+        }
+        let c2 = self
+            .prep
+            .grid
+            .iter()
+            .map(|g| g.lower)
+            .fold(0.0f64, f64::max);
+        if c2 > 0.0 && c2.is_finite() {
+            let zpk = Zpk {
                 gain: c2.sqrt(),
                 zeros: Vec::new(),
                 poles: Vec::new(),
-            },
-            "constant at the largest lower bound",
-        ));
-    }
-
-    // 3. The global minimax over the full numerator and denominator (quasi-convex, see
-    //    [`super::polyfit`]), searched only below the best level reached so far.
-    let ok = |c: &Scored| c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6;
-    let t_known = cands
-        .iter()
-        .filter(|c| ok(c))
-        .map(|c| c.t)
-        .fold(f64::INFINITY, f64::min);
-    if let Some(c) = polyfit::minimax(prep, n, t_known, set, &mut events, &mut lp_solves) {
-        cands.push(c);
-    }
-
-    // 4. Rank: feasible (to the LP accuracy) first; never worse than the previous order.
-    let guard = |c: &Scored| match prev {
-        Some(p) => c.mean_log <= p.mean_log + 1e-12 && c.max_log <= p.max_log + 1e-12,
-        None => true,
-    };
-    let max_tol = (1.0 + set.bisection_tol).log10();
-    let best_max = cands
-        .iter()
-        .filter(|c| ok(c) && guard(c))
-        .map(|c| c.max_log)
-        .fold(f64::INFINITY, f64::min);
-    let key = |c: &Scored| -> (u8, f64) {
-        let class = if ok(c) && guard(c) {
-            0
-        } else if ok(c) {
-            1
-        } else {
-            2
-        };
-        let v = match set.objective {
-            Objective::Minimax if c.max_log <= best_max + max_tol => c.mean_log,
-            Objective::Minimax => 1e6 + c.max_log,
-            Objective::Area => c.area,
-        };
-        (class, v)
-    };
-    cands.sort_by(|a, b| {
-        let (ka, kb) = (key(a), key(b));
-        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-    });
-    // Keep only orders that are actually n (the carried-over one has fewer poles): pad it.
-    for c in cands.iter_mut() {
-        while c.zpk.poles.len() < n {
-            c.zpk.poles.push(Complex64::new(-1.0, 0.0));
-            c.zpk.zeros.push(Complex64::new(-1.0, 0.0));
+            };
+            self.cands.push(self.prep.score(zpk, Origin::Constant));
         }
     }
-    *masks = (mask, area_mask);
-    OrderFit {
-        ranked: cands,
-        events,
-        lp_solves,
+
+    /// Step 4: the global minimax over the full numerator and denominator (quasi-convex,
+    /// see [`super::polyfit`]), searched only below the best level reached so far.
+    fn global_minimax(&mut self) {
+        let t_known = self
+            .cands
+            .iter()
+            .filter(|c| feasible(c))
+            .map(|c| c.t)
+            .fold(f64::INFINITY, f64::min);
+        let (prep, n, set) = (self.prep, self.n, self.set);
+        if let Some(c) =
+            polyfit::minimax(prep, n, t_known, set, &mut self.events, &mut self.lp_solves)
+        {
+            self.cands.push(c);
+        }
+    }
+
+    /// Step 5: rank the candidates, feasible first and never worse than the previous
+    /// order; among those within the bisection tolerance of the best maximum, the smallest
+    /// mean (minimax) or area.  Every candidate is padded to order `n` with cancelling
+    /// pole-zero pairs.
+    fn rank(&mut self) -> Vec<Scored> {
+        let (prev, set, n) = (self.prev, self.set, self.n);
+        let guard = |c: &Scored| match prev {
+            Some(p) => c.mean_log <= p.mean_log + 1e-12 && c.max_log <= p.max_log + 1e-12,
+            None => true,
+        };
+        let max_tol = (1.0 + set.bisection_tol).log10();
+        let mut cands = std::mem::take(&mut self.cands);
+        let best_max = cands
+            .iter()
+            .filter(|c| feasible(c) && guard(c))
+            .map(|c| c.max_log)
+            .fold(f64::INFINITY, f64::min);
+        let key = |c: &Scored| -> (u8, f64) {
+            let class = match (feasible(c), guard(c)) {
+                (true, true) => 0,
+                (true, false) => 1,
+                _ => 2,
+            };
+            let v = match set.objective {
+                Objective::Minimax if c.max_log <= best_max + max_tol => c.mean_log,
+                Objective::Minimax => 1e6 + c.max_log,
+                Objective::Area => c.area,
+            };
+            (class, v)
+        };
+        cands.sort_by(|a, b| {
+            let (ka, kb) = (key(a), key(b));
+            ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+        });
+        for c in cands.iter_mut() {
+            while c.zpk.poles.len() < n {
+                c.zpk.poles.push(Complex64::new(-1.0, 0.0));
+                c.zpk.zeros.push(Complex64::new(-1.0, 0.0));
+            }
+        }
+        cands
     }
 }

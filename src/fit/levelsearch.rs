@@ -8,6 +8,7 @@
 
 use super::basis::{GridPoint, PointKind};
 use super::problem::{max_slack, SolverEvent, SolverStatus};
+use super::provenance::EventKind;
 use super::FitSettings;
 
 /// The lowest feasible level found, with its numerator and denominator coefficients
@@ -26,10 +27,11 @@ pub(crate) fn minimax_level(
     events: &mut Vec<SolverEvent>,
     lp_solves: &mut usize,
 ) -> Option<(f64, Vec<f64>, Vec<f64>)> {
-    let event = |stage: String, status: SolverStatus, action: &str| SolverEvent {
+    let event = |stage: String, status: SolverStatus, kind: EventKind, action: &str| SolverEvent {
         order: n,
         stage,
         status,
+        kind,
         action: action.into(),
     };
     let solve = |t: f64,
@@ -40,15 +42,18 @@ pub(crate) fn minimax_level(
         let (st, s, a, b, rounds) = max_slack(phi, grid, t, init, mask, set.max_solver_iter);
         *lp += rounds;
         if st != SolverStatus::Solved {
-            events.push(event(
-                format!("{stage} t={t:.4e}"),
-                st,
-                if st.has_solution() {
-                    "used the reduced-accuracy solution; verified below"
-                } else {
-                    "treated the level as not feasible"
-                },
-            ));
+            let (kind, action) = if st.has_solution() {
+                (
+                    EventKind::ReducedAccuracyUsed,
+                    "used the reduced-accuracy solution; verified below",
+                )
+            } else {
+                (
+                    EventKind::LevelNotFeasible,
+                    "treated the level as not feasible",
+                )
+            };
+            events.push(event(format!("{stage} t={t:.4e}"), st, kind, action));
         }
         let s = if st.has_solution() {
             s
@@ -142,6 +147,7 @@ pub(crate) fn minimax_level(
         events.push(event(
             "minimax".into(),
             SolverStatus::PrimalInfeasible,
+            EventKind::NoFeasibleLevel,
             &format!(
                 "no feasible level up to t = 1e24; {blocking}; other candidates tried (the constant r among them)"
             ),

@@ -32,16 +32,19 @@ pub(crate) mod engine;
 mod levelsearch;
 pub mod order;
 pub(crate) mod polyfit;
+mod polylevel;
 mod polyrows;
 pub mod problem;
+pub mod provenance;
 pub mod realization;
 pub mod run;
 mod settings_check;
 pub mod spectral;
 
 pub use certificate::Certificate;
-pub use order::{fit_auto, OrderRow};
+pub use order::{fit_auto, fit_auto_observed, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
+pub use provenance::{EventKind, Origin, PoleSet};
 pub use run::{run_fit, FitOutcome, OrderChoice};
 pub use settings_check::MAX_ORDER;
 pub use spectral::Zpk;
@@ -153,8 +156,8 @@ pub struct FitResult {
     pub objective_value: f64,
     /// The certificate.
     pub certificate: Certificate,
-    /// Which candidate won (`minimax`, `area polish, …`, `order k carried over`).
-    pub origin: String,
+    /// Which candidate won.
+    pub origin: Origin,
     /// Every solver call that did not end in `Solved`, and every discarded candidate.
     pub solver_events: Vec<SolverEvent>,
     /// Number of LPs solved.
@@ -209,6 +212,20 @@ fn fmt_list(v: &[f64]) -> String {
 /// The A1 limit `σ_min(M̃(jω))` as a function of ω in rad/s.
 pub type A1Fn<'a> = &'a dyn Fn(f64) -> f64;
 
+/// What a running fit reports: the library prints nothing, a front end (the CLI) renders it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FitProgress {
+    /// The order about to be fitted.
+    pub order: usize,
+    /// The highest order of this fit.
+    pub last_order: usize,
+    /// LPs solved so far by this fit.
+    pub lp_solves: usize,
+}
+
+/// Receives a [`FitProgress`] before each order is fitted.
+pub type ProgressFn<'a> = &'a (dyn Fn(FitProgress) + Sync);
+
 /// Fits a unit `r(s)` of order `settings.order` above the envelope (see the module doc).
 ///
 /// `a1` is `ω ↦ σ_min(M̃(jω))` when the model is known (for example
@@ -221,8 +238,20 @@ pub fn fit_unit(
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
 ) -> Result<FitResult, FitError> {
+    fit_unit_observed(env, a1, settings, None)
+}
+
+/// [`fit_unit`], reporting its progress to `progress`.
+pub fn fit_unit_observed(
+    env: &Envelope,
+    a1: Option<A1Fn<'_>>,
+    settings: &FitSettings,
+    progress: Option<ProgressFn<'_>>,
+) -> Result<FitResult, FitError> {
     let ctx = prepare(env, a1, settings)?;
-    match fit_with(&ctx, settings) {
+    let fit_with =
+        |set: &FitSettings, solves_before: usize| fit_with(&ctx, set, progress, solves_before);
+    match fit_with(settings, 0) {
         Err(e) if !settings.chain && settings.order > 0 => {
             // Every candidate of the order alone failed: fit the lower orders and carry
             // them forward (the lower-order r is always a candidate), keeping the events.
@@ -230,13 +259,14 @@ pub fn fit_unit(
                 chain: true,
                 ..settings.clone()
             };
-            fit_with(&ctx, &chained).map(|mut r| {
+            fit_with(&chained, 0).map(|mut r| {
                 r.solver_events.insert(
                     0,
                     SolverEvent {
                         order: settings.order,
                         stage: "order alone".into(),
                         status: SolverStatus::NoCandidate,
+                        kind: EventKind::RefittedChained,
                         action: format!("{e}; refitted with the lower orders carried forward"),
                     },
                 );
@@ -253,7 +283,7 @@ pub fn fit_unit(
                 chain: true,
                 ..settings.clone()
             };
-            match fit_with(&ctx, &chained) {
+            match fit_with(&chained, alone.lp_solves) {
                 Ok(mut c) if c.objective_value < alone.objective_value => {
                     c.solver_events.insert(
                         0,
@@ -261,6 +291,7 @@ pub fn fit_unit(
                             order: settings.order,
                             stage: "order alone".into(),
                             status: SolverStatus::NoCandidate,
+                            kind: EventKind::RefittedChained,
                             action: format!(
                                 "level search failed numerically (best alone: {} at {:.4}); refitted with the lower orders carried forward",
                                 alone.origin, alone.objective_value
@@ -269,7 +300,12 @@ pub fn fit_unit(
                     );
                     Ok(c)
                 }
-                _ => Ok(alone),
+                // The LPs of the refit count too.
+                Ok(c) => Ok(FitResult {
+                    lp_solves: c.lp_solves,
+                    ..alone
+                }),
+                Err(_) => Ok(alone),
             }
         }
         other => other,
@@ -279,20 +315,34 @@ pub fn fit_unit(
 /// True when a fit of one order alone may have missed its optimum for numerical reasons:
 /// it ended on the constant fallback, or its level search found no feasible level at all.
 fn doubtful(r: &FitResult) -> bool {
-    r.origin.starts_with("constant")
+    r.origin == Origin::Constant
         || r.solver_events
             .iter()
-            .any(|e| e.order == r.order && e.action.starts_with("no feasible level"))
+            .any(|e| e.order == r.order && e.kind == EventKind::NoFeasibleLevel)
 }
 
-fn fit_with(ctx: &Context<'_>, settings: &FitSettings) -> Result<FitResult, FitError> {
+/// Fits the orders of `settings` (one, or `0..=order` chained); `solves_before` LPs were
+/// spent before (a refit) and are counted in the result.
+fn fit_with(
+    ctx: &Context<'_>,
+    settings: &FitSettings,
+    progress: Option<ProgressFn<'_>>,
+    solves_before: usize,
+) -> Result<FitResult, FitError> {
     let start = if settings.chain { 0 } else { settings.order };
     let mut prev: Option<Scored> = None;
     let mut masks = (Vec::new(), Vec::new());
     let mut all_events = Vec::new();
-    let mut solves = 0;
+    let mut solves = solves_before;
     let mut last = None;
     for n in start..=settings.order {
+        if let Some(p) = progress {
+            p(FitProgress {
+                order: n,
+                last_order: settings.order,
+                lp_solves: solves,
+            });
+        }
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         all_events.extend(of.events);
         solves += of.lp_solves;

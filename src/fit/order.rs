@@ -5,7 +5,7 @@
 
 use super::context::prepare;
 use super::engine::{fit_order, Scored};
-use super::{A1Fn, FitError, FitResult, FitSettings};
+use super::{A1Fn, FitError, FitProgress, FitResult, FitSettings, ProgressFn};
 use crate::consistency::Envelope;
 use serde::Serialize;
 
@@ -20,8 +20,10 @@ pub struct OrderRow {
     pub max_log10: f64,
     /// `ok`, or why the order failed.
     pub status: String,
-    /// Solver calls of this order that did not end in `Solved`.
+    /// Solver events of this order (solves short of `Solved`, discarded candidates).
     pub solver_events: usize,
+    /// LPs solved for this order (every working-set round counts as one).
+    pub lp_solves: usize,
 }
 
 /// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table.
@@ -30,6 +32,17 @@ pub fn fit_auto(
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
     n_max: usize,
+) -> Result<(FitResult, Vec<OrderRow>), FitError> {
+    fit_auto_observed(env, a1, settings, n_max, None)
+}
+
+/// [`fit_auto`], reporting its progress to `progress`.
+pub fn fit_auto_observed(
+    env: &Envelope,
+    a1: Option<A1Fn<'_>>,
+    settings: &FitSettings,
+    n_max: usize,
+    progress: Option<ProgressFn<'_>>,
 ) -> Result<(FitResult, Vec<OrderRow>), FitError> {
     let ctx = prepare(env, a1, settings)?;
     let mut prev: Option<Scored> = None;
@@ -40,8 +53,15 @@ pub fn fit_auto(
     let mut solves = 0;
     let mut last_err = None;
     for n in 0..=n_max {
+        if let Some(p) = progress {
+            p(FitProgress {
+                order: n,
+                last_order: n_max,
+                lp_solves: solves,
+            });
+        }
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
-        let ne = of.events.len();
+        let (ne, nl) = (of.events.len(), of.lp_solves);
         events.extend(of.events);
         solves += of.lp_solves;
         match ctx.certify_ranked(n, &of.ranked, events.clone(), solves, settings) {
@@ -52,6 +72,7 @@ pub fn fit_auto(
                     max_log10: res.certificate.max_log10_ratio,
                     status: "ok".into(),
                     solver_events: ne,
+                    lp_solves: nl,
                 });
                 prev = Some(sc);
                 fits.push(Some(res));
@@ -63,6 +84,7 @@ pub fn fit_auto(
                     max_log10: f64::NAN,
                     status: e.to_string(),
                     solver_events: ne,
+                    lp_solves: nl,
                 });
                 fits.push(None);
                 last_err = Some(e);
@@ -93,15 +115,16 @@ pub fn fit_auto(
 /// The order table as aligned text, with the chosen order marked.
 pub fn format_table(rows: &[OrderRow], chosen: usize, tol: f64) -> String {
     let mut s = format!(
-        "{:>5}  {:>18}  {:>14}  {}\n",
-        "order", "mean log10 r/r_min", "max log10", "status"
+        "{:>5}  {:>18}  {:>14}  {:>5}  {}\n",
+        "order", "mean log10 r/r_min", "max log10", "LPs", "status"
     );
     for r in rows {
         s.push_str(&format!(
-            "{:>5}  {:>18.5}  {:>14.5}  {}{}\n",
+            "{:>5}  {:>18.5}  {:>14.5}  {:>5}  {}{}\n",
             r.order,
             r.mean_log10,
             r.max_log10,
+            r.lp_solves,
             r.status,
             if r.order == chosen { "  <- chosen" } else { "" }
         ));

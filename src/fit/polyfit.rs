@@ -18,31 +18,19 @@
 //! below the best candidate already found: when that is infeasible the other candidates
 //! are optimal to the bisection tolerance and no more LPs are spent.
 
-use super::basis::PointKind;
-use super::chebseries::{self, cheb};
+use super::chebseries;
 use super::engine::{Prepared, Scored};
-use super::polyrows::{
-    cut_rows, disk, fixed_rows, level_rows, max_violation, relative_cuts, Rows, B_CUTS, B_CUT_GROUP,
-};
-use super::problem::{active_set_solve, initial_points, SolverEvent, SolverStatus};
+use super::polylevel::LevelLp;
+use super::polyrows::B_CUTS;
+use super::problem::{SolverEvent, SolverStatus};
+use super::provenance::{EventKind, Origin};
 use super::spectral::Zpk;
 use super::FitSettings;
-
-/// Interior-point iterations of the retry with every row after a working-set solve short
-/// of a solution.  Measured on the reference sweep of `tests/fit_reference.rs` (all
-/// fitters, cap 200): of 794 such retries every one that ended `Solved`, `AlmostSolved` or
-/// `PrimalInfeasible` took at most 87 iterations but three (122, 139, 200); 227 ran to the
-/// cap (about 0.4 s each with 1000 data at order 10) and ended as doubts all the same.  A
-/// capped retry's point is still used when it meets every row (the check in `try_level`).
-const RETRY_ITER: u32 = 100;
 
 /// Rows (summed over the retries with every row) that doubtful levels may cost one order
 /// of the global candidate before the remaining disk centres are skipped: about 140
 /// doubts at 1000 data (never reached on the reference sweep), 2 at 100,000.
 const DOUBT_BUDGET_ROWS: usize = 600_000;
-
-/// Rounds of positivity cuts per level.
-const CUT_ROUNDS: usize = 8;
 
 /// Disk-map centres tried, in scaled `x`: the band centre, then — only when the search at
 /// the previous attempt had a doubt — the two quarter points (`x₀ = ω̂_hi` and `1/ω̂_hi`)
@@ -97,6 +85,7 @@ pub(crate) fn minimax(
                 order: n,
                 stage: "polynomial minimax".into(),
                 status: SolverStatus::NoCandidate,
+                kind: EventKind::DoubtBudgetSpent,
                 action: format!(
                     "{} doubtful levels, the budget for {} grid points: other disk centres not tried (the other candidates stand)",
                     events.len() - first,
@@ -139,7 +128,8 @@ pub(crate) fn minimax(
     best
 }
 
-/// [`minimax`] with the disk map centred at `x₀`.
+/// [`minimax`] with the disk map centred at `x₀`: bracket the level, bisect it, and
+/// factor the lowest feasible solutions.
 #[allow(clippy::too_many_arguments)]
 fn minimax_at(
     prep: &Prepared,
@@ -151,173 +141,28 @@ fn minimax_at(
     lp_solves: &mut usize,
     b_cut_used: &mut bool,
 ) -> Option<Scored> {
-    let k = n + 1;
-    let nv = 2 * k;
-    let base = fixed_rows(n, &prep.grid, x0);
-    let floor = prep
-        .grid
-        .iter()
-        .filter(|g| g.kind == PointKind::Infinity)
-        .map(|g| g.lower)
-        .fold(0.0, f64::max);
-    // The data as (u, lower bound on |r̂|²), increasing in u, for the no-dip cuts.
-    let data: Vec<(f64, f64)> = if set.no_dip {
-        prep.grid
-            .iter()
-            .filter(|g| g.kind == PointKind::Datum)
-            .map(|g| (disk(g.x, x0), g.lower))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let init = initial_points(&prep.grid, 40);
-    let mut eq = vec![0.0; nv];
-    eq[k..2 * k].copy_from_slice(&cheb(n, 0.0));
-    let eqs = vec![(eq, 1.0)];
-    let cost = vec![0.0; nv];
-    let mut mask = Vec::new();
-    // Cuts found at one level stay valid at every level (they are not level rows).
-    let mut cuts = Rows {
-        rows: Vec::new(),
-        group: Vec::new(),
-        point: Vec::new(),
-    };
-    let mut try_level = |t: f64, events: &mut Vec<SolverEvent>| -> Option<Vec<f64>> {
-        for _ in 0..CUT_ROUNDS {
-            let r = level_rows(n, &prep.grid, x0, t, &base, &cuts);
-            if mask.len() != r.rows.len() {
-                mask.clear();
-            }
-            let (out, rounds) = active_set_solve(
-                nv,
-                &cost,
-                &r.rows,
-                &r.group,
-                &r.point,
-                &eqs,
-                &init,
-                &mut mask,
-                set.max_solver_iter,
-                set.max_solver_iter.min(RETRY_ITER),
-            );
-            *lp_solves += rounds;
-            // Only a full-accuracy certificate of infeasibility decides the level; a
-            // reduced-accuracy one is a doubt like any other status below.
-            if out.status == SolverStatus::PrimalInfeasible {
-                // The cuts `B ≥ b_cut` are stricter than `B > 0`: with one of them in the
-                // LP, infeasible proves nothing about the level, and another attempt
-                // (another centre or cut floor) must decide it.
-                if cuts.group.contains(&B_CUT_GROUP) {
-                    events.push(SolverEvent {
-                        order: n,
-                        stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
-                        status: out.status,
-                        action: "infeasible with the positivity cuts on B; level treated as not feasible (the other candidates stand)".into(),
-                    });
-                }
-                return None;
-            }
-            // A reduced-accuracy or capped solve still proves the level when its point
-            // meets every row to the working tolerance: the positivity cuts below and the
-            // coverage check of the candidate are exact, whatever the LP's accuracy.
-            let usable = out.status == SolverStatus::Solved
-                || (out.x.len() == nv
-                    && out.x.iter().all(|v| v.is_finite())
-                    && max_violation(&r.rows, &out.x) <= 1e-8);
-            if !usable {
-                events.push(SolverEvent {
-                    order: n,
-                    stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
-                    status: out.status,
-                    action: "level treated as not feasible (the other candidates stand)".into(),
-                });
-                return None;
-            }
-            let cut = cut_rows(n, &out.x, b_cut, floor, &data, set.root_iter_cap, &mut cuts);
-            *b_cut_used |= cuts.group.contains(&B_CUT_GROUP);
-            if !cut && !relative_cuts(n, &out.x, &prep.grid, x0, &mut cuts) {
-                return Some(out.x);
-            }
-        }
-        events.push(SolverEvent {
-            order: n,
-            stage: format!("polynomial minimax (x0 = {x0:.3e}) t={t:.4e}"),
-            status: SolverStatus::Solved,
-            action: format!(
-                "A or B still not positive on [0, inf] after {CUT_ROUNDS} rounds of cuts; level treated as not feasible"
-            ),
-        });
-        None
-    };
+    let mut lp = LevelLp::new(prep, n, x0, b_cut, set);
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let mut feasible: Vec<(f64, Vec<f64>)> = Vec::new();
-    let (mut lo, mut hi);
-    if t_known.is_finite() && t_known >= 1.0 {
-        let probe = (t_known.ln() - tol).max(0.0);
-        match try_level(probe.exp(), events) {
-            Some(x) => {
-                feasible.push((probe, x));
-                hi = probe;
-                lo = 0.0;
-            }
-            None => {
-                // No better level exists on the grid, but the candidate that reached
-                // `t_known` may dip between grid points and lose up to 0.03 decade to the
-                // certificate's repair; this fitter's solution at that level has its no-dip
-                // cuts checked exactly, so it is offered too.
-                // When that candidate does dip, the exact optimum lies above `t_known`:
-                // steps of 0.25, 2, 8, 32 tolerances (up to 0.06 decade), then bisection.
-                lo = t_known.ln();
-                hi = f64::NAN;
-                for step in [0.25, 2.0, 8.0, 32.0] {
-                    let at = t_known.ln() + step * tol;
-                    match try_level(at.exp(), events) {
-                        Some(x) => {
-                            feasible.push((at, x));
-                            hi = at;
-                            break;
-                        }
-                        None => lo = at,
-                    }
-                }
-                if hi.is_nan() {
-                    return None;
-                }
-            }
-        }
-    } else {
-        let mut t = 10.0f64;
-        lo = 0.0;
-        hi = 0.0;
-        while t < 1e25 {
-            if let Some(x) = try_level(t, events) {
-                feasible.push((t.ln(), x));
-                hi = t.ln();
-                break;
-            }
-            lo = t.ln();
-            t *= 100.0;
-        }
-        if feasible.is_empty() {
-            return None;
-        }
-    }
-    for _ in 0..40 {
-        if hi - lo <= tol {
-            break;
-        }
-        let mid = 0.5 * (lo + hi);
-        match try_level(mid.exp(), events) {
-            Some(x) => {
-                hi = mid;
-                feasible.push((mid, x));
-            }
-            None => lo = mid,
-        }
-    }
-    // The lowest feasible level first; a solution that still fails (the certificate's
-    // exact test is stricter than the grid) gives way to the next higher feasible level.
-    let mut found: Vec<(f64, Vec<f64>)> = feasible;
+    let found = lp
+        .bracket(t_known, tol, events)
+        .map(|(lo, hi, feasible)| lp.bisect(lo, hi, tol, feasible, events));
+    *lp_solves += lp.lp_solves;
+    *b_cut_used |= lp.b_cut_used;
+    factor_lowest(prep, n, x0, found?, set, events)
+}
+
+/// The candidate of the lowest feasible level whose spectral factors exist and meet the
+/// bounds on the grid; a solution that still fails (the certificate's exact test is
+/// stricter than the grid) gives way to the next higher feasible level.
+fn factor_lowest(
+    prep: &Prepared,
+    n: usize,
+    x0: f64,
+    mut found: Vec<(f64, Vec<f64>)>,
+    set: &FitSettings,
+    events: &mut Vec<SolverEvent>,
+) -> Option<Scored> {
+    let k = n + 1;
     found.sort_by(|p, q| p.0.total_cmp(&q.0));
     let mut last_err = None;
     for (lev, x) in found.into_iter().take(6) {
@@ -335,7 +180,7 @@ fn minimax_at(
                 let target = (chebseries::eval(a, 0.0) / chebseries::eval(b, 0.0)).sqrt();
                 z.gain = target / z.mag(x0.sqrt());
                 if z.gain > 0.0 && z.gain.is_finite() {
-                    let c = prep.score(z, &format!("polynomial minimax (t = {:.4e})", lev.exp()));
+                    let c = prep.score(z, Origin::PolynomialMinimax { t: lev.exp() });
                     if c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6 {
                         return Some(c);
                     }
@@ -354,6 +199,7 @@ fn minimax_at(
             order: n,
             stage: format!("polynomial minimax (x0 = {x0:.3e}) spectral factorization"),
             status: SolverStatus::Solved,
+            kind: EventKind::CandidateDiscarded,
             action: format!("{e}; candidate discarded, others tried"),
         });
     }

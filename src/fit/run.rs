@@ -1,8 +1,8 @@
 //! `rshape fit` as a library call: fit (fixed order or automatic), certificate, exports, and
 //! the text to print.  The CLI subcommand is a thin wrapper around [`run_fit`].
 
-use super::order::{fit_auto, format_table, OrderRow};
-use super::{fit_unit, A1Fn, FitError, FitResult, FitSettings};
+use super::order::{fit_auto_observed, format_table, OrderRow};
+use super::{fit_unit_observed, A1Fn, FitError, FitResult, FitSettings, ProgressFn};
 use crate::consistency::Envelope;
 use std::path::{Path, PathBuf};
 
@@ -40,8 +40,11 @@ pub struct FitOutcome {
     pub result: FitResult,
     /// The order table (auto only).
     pub table: Option<Vec<OrderRow>>,
-    /// Human-readable report: order table (auto), r, certificate, solver events.
+    /// Human-readable report: order table (auto), r, certificate, files written (the
+    /// solver events are in [`events_text`], for `--verbose`).
     pub text: String,
+    /// Wall-clock seconds of the fit and certificate (exports excluded).
+    pub seconds: f64,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -58,27 +61,31 @@ pub enum RunError {
 }
 
 /// Fits, certifies, writes `r.json`, `r.m`, `r.py`, `r.jl` into `out_dir`, and returns the
-/// printable report.  Nothing is written unless the fit is certified.
+/// printable report; `progress` hears of each order as it starts.  Nothing is written
+/// unless the fit is certified.
 pub fn run_fit(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
     order: OrderChoice,
     out_dir: &Path,
+    progress: Option<ProgressFn<'_>>,
 ) -> Result<FitOutcome, RunError> {
+    let start = std::time::Instant::now();
     let (result, table) = match order {
         OrderChoice::Fixed(n) => {
             let s = FitSettings {
                 order: n,
                 ..settings.clone()
             };
-            (fit_unit(env, a1, &s)?, None)
+            (fit_unit_observed(env, a1, &s, progress)?, None)
         }
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto(env, a1, settings, max)?;
+            let (r, t) = fit_auto_observed(env, a1, settings, max, progress)?;
             (r, Some(t))
         }
     };
+    let seconds = start.elapsed().as_secs_f64();
     let mut text = String::new();
     if let Some(t) = &table {
         text.push_str(&format_table(t, result.order, settings.auto_tolerance));
@@ -92,6 +99,7 @@ pub fn run_fit(
         result,
         table,
         text,
+        seconds,
         files,
     })
 }
@@ -152,18 +160,30 @@ pub fn summary(r: &FitResult) -> String {
             c.repair_factor
         ));
     }
-    if !r.solver_events.is_empty() {
+    s
+}
+
+/// The one line `rshape fit` prints by default about the work done: `N LPs in T s`.
+pub fn work_line(r: &FitResult, seconds: f64) -> String {
+    format!(
+        "{} LPs in {seconds:.2} s ({} solver events; --verbose lists them)\n",
+        r.lp_solves,
+        r.solver_events.len()
+    )
+}
+
+/// The solver events of a fit, one line each (internal bookkeeping: `--verbose` only).
+pub fn events_text(r: &FitResult) -> String {
+    let mut s = format!(
+        "solver events ({} events over {} LPs):\n",
+        r.solver_events.len(),
+        r.lp_solves
+    );
+    for e in &r.solver_events {
         s.push_str(&format!(
-            "solver events ({} of {} LPs did not end in Solved):\n",
-            r.solver_events.len(),
-            r.lp_solves
+            "  order {}: {}: {:?}; {}\n",
+            e.order, e.stage, e.status, e.action
         ));
-        for e in &r.solver_events {
-            s.push_str(&format!(
-                "  order {}: {}: {:?}; {}\n",
-                e.order, e.stage, e.status, e.action
-            ));
-        }
     }
     s
 }

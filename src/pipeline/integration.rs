@@ -10,7 +10,9 @@ use crate::consistency::noisy::{gamma_lft, noisy_envelope, BisectionSettings};
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
-use crate::fit::{fit_auto, fit_unit, FitResult, FitSettings, OrderChoice, OrderRow};
+use crate::fit::{
+    fit_auto_observed, fit_unit_observed, FitResult, FitSettings, OrderChoice, OrderRow, ProgressFn,
+};
 use crate::model::{Config, Factorization};
 use crate::mu::{mu_full_scalar, FullPlusScalar, MuSettings};
 use crate::system::TransferFunction;
@@ -95,15 +97,19 @@ pub struct FittedR {
 /// Fits the smallest unit `r` above the envelope with the defaults of `rshape fit`
 /// (minimax objective; `order` fixed or chosen automatically), keeping `|r| < σ_min(M̃)`
 /// (A1) when `a1` is given.
+///
+/// `progress` hears of each order as it starts (see [`crate::fit::FitProgress`]).
 pub fn fit_r(
     env: &Envelope,
     a1: Option<&dyn Fn(f64) -> f64>,
     order: OrderChoice,
+    progress: Option<ProgressFn<'_>>,
 ) -> Result<FittedR> {
     let err = |e: crate::fit::FitError| Error::Invalid(format!("fit: {e}"));
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto(env, a1, &FitSettings::default(), max).map_err(err)?;
+            let (r, t) =
+                fit_auto_observed(env, a1, &FitSettings::default(), max, progress).map_err(err)?;
             (r, Some(t))
         }
         OrderChoice::Fixed(n) => {
@@ -111,7 +117,7 @@ pub fn fit_r(
                 order: n,
                 ..FitSettings::default()
             };
-            (fit_unit(env, a1, &s).map_err(err)?, None)
+            (fit_unit_observed(env, a1, &s, progress).map_err(err)?, None)
         }
     };
     let text = crate::report::export::r_json(&result, table.as_deref());

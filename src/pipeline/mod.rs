@@ -54,12 +54,13 @@ pub struct RunOutcome {
 
 /// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
 /// sizes, a failed assumption at a datum) is an error; the fit and μ failures are kept in
-/// the outcome.
+/// the outcome.  `progress` hears of each order of the fit as it starts.
 pub fn run(
     config: &Config,
     data: &FrfData,
     noise_radius: Option<f64>,
     order: crate::fit::OrderChoice,
+    progress: Option<crate::fit::ProgressFn<'_>>,
 ) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
@@ -78,7 +79,7 @@ pub fn run(
             Some(_) => Some(&a1),
             None => None,
         };
-        integration::fit_r(&envelope, a1, order)
+        integration::fit_r(&envelope, a1, order, progress)
             .map_err(|e| crate::report::fmt::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {

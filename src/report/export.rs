@@ -30,9 +30,10 @@ struct RJson<'a> {
     objective: crate::fit::Objective,
     objective_value: f64,
     certificate: &'a crate::fit::Certificate,
-    origin: &'a str,
+    origin: String,
     floor: f64,
     solver_events: &'a [crate::fit::SolverEvent],
+    lp_solves: usize,
     order_table: Option<&'a [OrderRow]>,
 }
 
@@ -77,9 +78,10 @@ pub fn r_json(fit: &FitResult, table: Option<&[OrderRow]>) -> String {
         objective: fit.objective,
         objective_value: fit.objective_value,
         certificate: &fit.certificate,
-        origin: &fit.origin,
+        origin: fit.origin.to_string(),
         floor: fit.floor,
         solver_events: &fit.solver_events,
+        lp_solves: fit.lp_solves,
         order_table: table,
     };
     // serde_json writes non-finite numbers as null; the certificate uses them only for

@@ -1,0 +1,74 @@
+//! Progress of a long fit on stderr, rendered from the library's [`FitProgress`] reports:
+//! an indicatif bar over the orders on a terminal, otherwise (a log, CI) one line every few
+//! seconds, and nothing at all for a fit that ends within those seconds.
+
+use crate::fit::FitProgress;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// Seconds between two progress lines when stderr is not a terminal.
+const LINE_EVERY: Duration = Duration::from_secs(5);
+
+/// A progress display for one fit.
+pub struct FitProgressView {
+    bar: Option<ProgressBar>,
+    start: Instant,
+    last_line: Mutex<Instant>,
+    label: String,
+}
+
+impl FitProgressView {
+    /// A display labelled `label` (`fit`, `stability --fit`, …).
+    pub fn new(label: &str) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+            b.set_style(
+                ProgressStyle::with_template("{spinner} {msg}  {elapsed_precise}")
+                    .expect("valid template"),
+            );
+            b.enable_steady_tick(Duration::from_millis(200));
+            b
+        });
+        Self {
+            bar,
+            start: Instant::now(),
+            last_line: Mutex::new(Instant::now()),
+            label: label.into(),
+        }
+    }
+
+    /// Renders one report of the library.
+    pub fn update(&self, p: FitProgress) {
+        let msg = format!(
+            "{}: order {} of 0..{}, {} LPs so far",
+            self.label, p.order, p.last_order, p.lp_solves
+        );
+        match &self.bar {
+            Some(b) => b.set_message(msg),
+            None => {
+                let Ok(mut last) = self.last_line.lock() else {
+                    return;
+                };
+                if last.elapsed() >= LINE_EVERY {
+                    *last = Instant::now();
+                    eprintln!("{msg} ({:.0} s)", self.start.elapsed().as_secs_f64());
+                }
+            }
+        }
+    }
+
+    /// Clears the bar (the final report is printed by the caller).
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+impl Drop for FitProgressView {
+    fn drop(&mut self) {
+        self.finish();
+    }
+}
