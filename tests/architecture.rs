@@ -107,3 +107,46 @@ fn the_library_does_not_depend_on_clap_indicatif_or_anyhow() {
         offenders.join("\n")
     );
 }
+
+/// No control flow in the library is decided by matching message text: fields that hold
+/// messages (`origin`, `action`, `msg`, `message`, `reason`, `note`, `verdict`, an error's
+/// `to_string()`) are never tested with `starts_with`/`contains`/`==` on a string literal
+/// outside test code.  Decisions use enums (issue 25).
+#[test]
+fn no_decision_matches_message_text() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let fields = [
+        "origin",
+        "action",
+        "msg",
+        "message",
+        "reason",
+        "note",
+        "verdict",
+        "to_string()",
+    ];
+    let mut offenders = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).expect("source is UTF-8");
+        for (i, line) in text.lines().enumerate() {
+            if line.trim_start().starts_with("#[cfg(test)]") {
+                break;
+            }
+            let code = line.split("//").next().unwrap_or("");
+            for field in fields {
+                for op in [".starts_with(\"", ".contains(\"", " == \"", ".ends_with(\""] {
+                    if code.contains(&format!("{field}{op}")) {
+                        offenders.push(format!("{}:{}: {}", f.display(), i + 1, line.trim()));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        offenders.is_empty(),
+        "decisions on message text:\n{}",
+        offenders.join("\n")
+    );
+}
