@@ -14,8 +14,10 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-#[test]
-fn no_library_module_imports_the_cli() {
+/// Where a line of code matches: `file:line: text`, for every line of the sources under
+/// `src` outside the CLI (`src/cli`, `src/main.rs`) unless `with_cli`, up to the first
+/// `#[cfg(test)]` of each file when `code_only`, with its comment cut off.
+fn offending_lines(with_cli: bool, code_only: bool, matches: impl Fn(&str) -> bool) -> Vec<String> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
     rust_files(&src, &mut files);
@@ -27,20 +29,27 @@ fn no_library_module_imports_the_cli() {
     let cli_dir = src.join("cli");
     let mut offenders = Vec::new();
     for f in files {
-        if f.starts_with(&cli_dir) || f.ends_with("main.rs") {
+        if !with_cli && (f.starts_with(&cli_dir) || f.ends_with("main.rs")) {
             continue;
         }
         let text = std::fs::read_to_string(&f).expect("source is UTF-8");
         for (i, line) in text.lines().enumerate() {
-            let code = line.split("//").next().unwrap_or("");
-            if code.contains("crate::cli")
-                || code.contains("rshape::cli")
-                || code.contains("super::cli")
-            {
+            if code_only && line.trim_start().starts_with("#[cfg(test)]") {
+                break;
+            }
+            if matches(line.split("//").next().unwrap_or("")) {
                 offenders.push(format!("{}:{}: {}", f.display(), i + 1, line.trim()));
             }
         }
     }
+    offenders
+}
+
+#[test]
+fn no_library_module_imports_the_cli() {
+    let offenders = offending_lines(false, false, |code| {
+        code.contains("crate::cli") || code.contains("rshape::cli") || code.contains("super::cli")
+    });
     assert!(
         offenders.is_empty(),
         "library modules import the CLI:\n{}",
@@ -81,26 +90,11 @@ fn the_library_does_not_depend_on_clap_indicatif_or_anyhow() {
         .as_array()
         .is_some_and(|f| f.iter().any(|x| x.as_str() == Some("cli")))));
 
-    let src = root.join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    let cli_dir = src.join("cli");
-    let mut offenders = Vec::new();
-    for f in files {
-        if f.starts_with(&cli_dir) || f.ends_with("main.rs") {
-            continue;
-        }
-        let text = std::fs::read_to_string(&f).expect("source is UTF-8");
-        for (i, line) in text.lines().enumerate() {
-            let code = line.split("//").next().unwrap_or("");
-            if cli_crates
-                .iter()
-                .any(|c| code.contains(&format!("{c}::")) || code.contains(&format!("use {c}")))
-            {
-                offenders.push(format!("{}:{}: {}", f.display(), i + 1, line.trim()));
-            }
-        }
-    }
+    let offenders = offending_lines(false, false, |code| {
+        cli_crates
+            .iter()
+            .any(|c| code.contains(&format!("{c}::")) || code.contains(&format!("use {c}")))
+    });
     assert!(
         offenders.is_empty(),
         "library modules use CLI crates:\n{}",
@@ -114,9 +108,6 @@ fn the_library_does_not_depend_on_clap_indicatif_or_anyhow() {
 /// outside test code.  Decisions use enums (issue 25).
 #[test]
 fn no_decision_matches_message_text() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    rust_files(&src, &mut files);
     let fields = [
         "origin",
         "action",
@@ -127,23 +118,12 @@ fn no_decision_matches_message_text() {
         "verdict",
         "to_string()",
     ];
-    let mut offenders = Vec::new();
-    for f in files {
-        let text = std::fs::read_to_string(&f).expect("source is UTF-8");
-        for (i, line) in text.lines().enumerate() {
-            if line.trim_start().starts_with("#[cfg(test)]") {
-                break;
-            }
-            let code = line.split("//").next().unwrap_or("");
-            for field in fields {
-                for op in [".starts_with(\"", ".contains(\"", " == \"", ".ends_with(\""] {
-                    if code.contains(&format!("{field}{op}")) {
-                        offenders.push(format!("{}:{}: {}", f.display(), i + 1, line.trim()));
-                    }
-                }
-            }
-        }
-    }
+    let ops = [".starts_with(\"", ".contains(\"", " == \"", ".ends_with(\""];
+    let offenders = offending_lines(true, true, |code| {
+        fields
+            .iter()
+            .any(|field| ops.iter().any(|op| code.contains(&format!("{field}{op}"))))
+    });
     assert!(
         offenders.is_empty(),
         "decisions on message text:\n{}",

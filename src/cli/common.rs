@@ -158,3 +158,68 @@ pub fn check_out_file(
 pub fn config_data(config: &std::path::Path) -> Option<PathBuf> {
     crate::model::Config::load(config).ok().and_then(|c| c.data)
 }
+
+/// A bound `r` with its label (`configured`, `fitted`).
+pub type LabelledBound = (String, crate::system::TransferFunction);
+
+/// Loaded inputs with their envelope, for `--fit`.
+pub type FitInput = (Inputs, Envelope);
+
+/// The bounds a controller is judged with (`stability`, `synthesize`): the config's `[r]`,
+/// then `--r-json` as `fitted`; with `--fit`, the inputs whose envelope will be fitted,
+/// read before any output folder is touched.  A `[closed_loop]` config refuses `--fit` (it
+/// would fit its weight `V`, not a factor bound `r`).
+pub fn controller_bounds(
+    config_path: &std::path::Path,
+    config: &Config,
+    r_json: Option<&std::path::Path>,
+    fit: bool,
+    data: Option<&std::path::Path>,
+) -> Result<(Vec<LabelledBound>, Option<FitInput>)> {
+    if config.closed_loop.is_some() && fit {
+        return Err(anyhow!(
+            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
+            config_path.display()
+        ));
+    }
+    let given = r_json
+        .map(crate::pipeline::stability::read_r_json)
+        .transpose()?;
+    let rs = crate::pipeline::stability::bounds(config, given);
+    let fit_input = if fit {
+        let input = InputArgs {
+            config: config_path.to_path_buf(),
+            data: data.map(|d| d.to_path_buf()),
+            noise_radius: None,
+        };
+        Some(input.envelope()?)
+    } else {
+        None
+    };
+    Ok((rs, fit_input))
+}
+
+/// Fits `r` above the envelope of `fit_input` as `rshape fit --order auto` does (exports into
+/// `out`), with progress shown under `label`; returns the fit's text (with its work line)
+/// and the fitted `r`.
+pub fn fit_bound(
+    label: &str,
+    (inputs, env): &FitInput,
+    out: &std::path::Path,
+) -> Result<(String, crate::system::TransferFunction)> {
+    let f = &inputs.config.factorization;
+    let a1 = |w: f64| f.a1_limit(w);
+    let view = super::progress::FitProgressView::new(label);
+    let progress = |p| view.update(p);
+    let outcome = crate::fit::run_fit(
+        env,
+        Some(&a1),
+        &crate::fit::FitSettings::default(),
+        crate::fit::OrderChoice::Auto { max: 8 },
+        out,
+        Some(&progress),
+    )?;
+    view.finish();
+    let text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
+    Ok((text, outcome.result.r))
+}

@@ -4,14 +4,12 @@
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::plant_form::physical_from_config;
-use crate::diagnose::{
-    apply_candidate, apply_chosen, diagnose_channels, misfit_channels, prepare, retune_within,
-    Channels, DiagnoseVerdict, Diagnosis, Settings,
-};
+use crate::diagnose::revision::{params_text, write_revision, Apply, Revise};
+use crate::diagnose::{diagnose_channels, prepare, Channels, DiagnoseVerdict, Diagnosis, Settings};
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `rshape diagnose`.
 #[derive(Debug, Args)]
@@ -45,15 +43,6 @@ pub struct DiagnoseArgs {
     pub json: bool,
 }
 
-/// What `--apply` writes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Apply {
-    /// The K-th ranked first-level candidate (1-based).
-    Rank(usize),
-    /// The chosen effect set.
-    Chosen,
-}
-
 fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
     if s == "chosen" {
         return Ok(Apply::Chosen);
@@ -63,23 +52,6 @@ fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
         .filter(|k| *k >= 1)
         .map(Apply::Rank)
         .ok_or_else(|| format!("`{s}`: give a candidate rank (1, 2, …) or `chosen`"))
-}
-
-fn rel_to(target: &Path, from_dir: &Path) -> PathBuf {
-    let (Ok(t), Ok(f)) = (target.canonicalize(), from_dir.canonicalize()) else {
-        return target.to_path_buf();
-    };
-    let tc: Vec<_> = t.components().collect();
-    let fc: Vec<_> = f.components().collect();
-    let common = tc.iter().zip(&fc).take_while(|(a, b)| a == b).count();
-    let mut p = PathBuf::new();
-    for _ in common..fc.len() {
-        p.push("..");
-    }
-    for c in &tc[common..] {
-        p.push(c);
-    }
-    p
 }
 
 /// The data channels to diagnose: the selected one, or every channel of MIMO data.
@@ -96,13 +68,6 @@ fn channels(
     }
     let siso = prepare(config, data, chan, noise)?;
     Ok(Channels::from_siso(&siso)?)
-}
-
-fn params_text(p: &std::collections::BTreeMap<String, f64>) -> String {
-    p.iter()
-        .map(|(n, v)| format!("{n} = {}", sig(*v)))
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// Runs `rshape diagnose`.
@@ -150,7 +115,26 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     };
     let d = diagnose_channels(&base, &data, &settings)?;
     if let (Some(what), Some(out)) = (a.apply, &a.write) {
-        write_revision(a, config, &raw, &data, &d, &base, what, out)?;
+        let rev = write_revision(
+            &Revise {
+                config,
+                raw: &raw,
+                data: &data,
+                diagnosis: &d,
+                base: &base,
+                what,
+                force: a.force,
+            },
+            out,
+        )?;
+        if !a.json {
+            println!(
+                "wrote {} (--apply {}: {})",
+                out.display(),
+                rev.flag,
+                rev.label
+            );
+        }
     }
     if a.json {
         println!("{}", serde_json::to_string_pretty(&d)?);
@@ -158,102 +142,6 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     }
     print_text(config, &data, &d, a.apply.is_none());
     Ok(0)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn write_revision(
-    a: &DiagnoseArgs,
-    config: &crate::model::Config,
-    raw: &crate::model::config::RawConfig,
-    data: &Channels,
-    d: &Diagnosis,
-    base: &crate::model::physical::PhysicalModel,
-    what: Apply,
-    out: &Path,
-) -> Result<()> {
-    // What is written: the label, its parameters, the explanation and the error before.
-    let (revised, label, params, explanation, flag) = match what {
-        Apply::Rank(k) => {
-            // The candidate (already refit jointly when the search got to it), refit once more.
-            let applied = apply_candidate(base, d, k, a.force)?;
-            let c = &d.candidates[k - 1];
-            (
-                retune_within(&applied, base, data, None, false).model,
-                c.effect.clone(),
-                params_text(&c.params),
-                c.explanation.clone(),
-                format!("{k}{}", if a.force { " --force" } else { "" }),
-            )
-        }
-        Apply::Chosen => {
-            let m = apply_chosen(d)?;
-            let label = if d.chosen.is_empty() {
-                "retune".to_string()
-            } else {
-                d.chosen.join(" + ")
-            };
-            let params = d
-                .final_effects
-                .iter()
-                .map(|e| format!("{}: {}", e.effect, params_text(&e.params)))
-                .chain(
-                    (!d.retuned_in_chosen.changes.is_empty())
-                        .then(|| format!("retuned: {}", d.retuned_in_chosen.summary())),
-                )
-                .collect::<Vec<_>>()
-                .join("; ");
-            (m, label, params, d.message.clone(), "chosen".to_string())
-        }
-    };
-    let (rms_refit, inv_refit) = misfit_channels(&revised, data);
-    // The config as written (closed-loop configs keep their [closed_loop], [noise], [v]).
-    let mut raw = raw.clone();
-    raw.physical = Some(revised);
-    raw.model = None;
-    // A converted [plant] or [closed_loop] nominal is now the [physical] table.
-    raw.plant = None;
-    if let Some(cl) = &mut raw.closed_loop {
-        (cl.plant, cl.n_hat, cl.d_hat) = (None, None, None);
-    }
-    raw.name = Some(format!(
-        "{} + {}",
-        raw.name
-            .clone()
-            .unwrap_or_else(|| config.path.display().to_string()),
-        label
-    ));
-    let out_dir = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(out_dir)?;
-    let base_dir = config.path.parent().unwrap_or(Path::new("."));
-    if let Some(dp) = &raw.data {
-        raw.data = Some(rel_to(&base_dir.join(dp), out_dir));
-    }
-    if let Some(sf) = &raw.noise.std_file {
-        raw.noise.std_file = Some(rel_to(&base_dir.join(sf), out_dir));
-    }
-    let text = toml::to_string_pretty(&raw)?;
-    let header = format!(
-        "# Revised by `rshape diagnose {} --apply {flag}`: {label} ({params}), every parameter refit jointly.\n# {}\n# Error on {}: misfit_rms {} -> {}, invalid_fraction {} -> {}.\n",
-        config.path.display(),
-        explanation.replace('\n', " "),
-        data.path.display(),
-        sig(d.before.misfit_rms),
-        sig(rms_refit),
-        fmt_pct(d.before.invalid_fraction),
-        fmt_pct(inv_refit),
-    );
-    let full = format!("{header}{text}");
-    // The written file must load back.
-    crate::model::Config::parse(&full, out)
-        .map_err(|e| anyhow!("internal: the revised config does not parse: {e}"))?;
-    crate::util::write_atomic(out, full.as_bytes())?;
-    if !a.json {
-        println!("wrote {} (--apply {flag}: {label})", out.display());
-    }
-    Ok(())
 }
 
 fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hint_apply: bool) {

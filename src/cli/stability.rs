@@ -3,8 +3,6 @@
 //! Exit 0 robustly stable for every bound given, 1 not (including a controller that does
 //! not stabilize the nominal plant), 2 error.
 
-use super::common::InputArgs;
-use crate::fit::{run_fit, FitSettings, OrderChoice};
 use crate::model::controller::Controller;
 use crate::model::Config;
 use crate::pipeline::stability;
@@ -42,36 +40,21 @@ pub struct StabilityArgs {
 pub fn run(a: &StabilityArgs) -> Result<i32> {
     let config = Config::load(&a.config)?;
     let controller = Controller::load(&a.controller)?;
-    if config.closed_loop.is_some() && a.fit {
+    if a.fit && a.out.is_none() {
         return Err(anyhow!(
-            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
-            a.config.display()
+            "--fit writes r.json and its exports: give --out DIR"
         ));
     }
-    let given = a
-        .r_json
-        .as_deref()
-        .map(stability::read_r_json)
-        .transpose()?;
-    let mut rs = stability::bounds(&config, given);
     // The controller's size is checked before anything is written.
     stability::check_controller(&config, &controller)?;
     // With --fit, the data are read and the envelope computed before the folder is touched.
-    let fit_input = if a.fit {
-        if a.out.is_none() {
-            return Err(anyhow!(
-                "--fit writes r.json and its exports: give --out DIR"
-            ));
-        }
-        let input = InputArgs {
-            config: a.config.clone(),
-            data: a.data.clone(),
-            noise_radius: None,
-        };
-        Some(input.envelope()?)
-    } else {
-        None
-    };
+    let (mut rs, fit_input) = super::common::controller_bounds(
+        &a.config,
+        &config,
+        a.r_json.as_deref(),
+        a.fit,
+        a.data.as_deref(),
+    )?;
     // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
     // input's folder; the previous run's listed files are cleared.
     let inputs: Vec<&Path> = [
@@ -89,22 +72,10 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         None => None,
     };
     let mut fit_text = String::new();
-    if let (Some((inputs, env)), Some(out)) = (&fit_input, &a.out) {
-        let f = &inputs.config.factorization;
-        let a1 = |w: f64| f.a1_limit(w);
-        let view = super::progress::FitProgressView::new("stability --fit");
-        let progress = |p| view.update(p);
-        let outcome = run_fit(
-            env,
-            Some(&a1),
-            &FitSettings::default(),
-            OrderChoice::Auto { max: 8 },
-            out,
-            Some(&progress),
-        )?;
-        view.finish();
-        fit_text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
-        rs.push(("fitted".into(), outcome.result.r.clone()));
+    if let (Some(input), Some(out)) = (&fit_input, &a.out) {
+        let (text, r) = super::common::fit_bound("stability --fit", input, out)?;
+        fit_text = text;
+        rs.push(("fitted".into(), r));
     }
     let outcome = stability::run(&config, &controller, &rs, a.data.as_deref())?;
     let written = match &a.out {

@@ -2,10 +2,8 @@
 //! --out DIR [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
 //! (issue 22). Exit 0 proven robust for every bound given, 1 not, 2 error.
 
-use super::common::InputArgs;
-use crate::fit::{run_fit, FitSettings, OrderChoice};
 use crate::model::Config;
-use crate::pipeline::{stability, synthesize};
+use crate::pipeline::synthesize;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -53,28 +51,13 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
             a.gamma_factor
         ));
     }
-    if config.closed_loop.is_some() && a.fit {
-        return Err(anyhow!(
-            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
-            a.config.display()
-        ));
-    }
-    let given = a
-        .r_json
-        .as_deref()
-        .map(stability::read_r_json)
-        .transpose()?;
-    let mut rs = stability::bounds(&config, given);
-    let fit_input = if a.fit {
-        let input = InputArgs {
-            config: a.config.clone(),
-            data: a.data.clone(),
-            noise_radius: None,
-        };
-        Some(input.envelope()?)
-    } else {
-        None
-    };
+    let (mut rs, fit_input) = super::common::controller_bounds(
+        &a.config,
+        &config,
+        a.r_json.as_deref(),
+        a.fit,
+        a.data.as_deref(),
+    )?;
     let inputs: Vec<&Path> = [
         Some(a.config.as_path()),
         a.r_json.as_deref(),
@@ -110,22 +93,10 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     )?;
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     let mut fit_text = String::new();
-    if let Some((inputs, env)) = &fit_input {
-        let f = &inputs.config.factorization;
-        let a1 = |w: f64| f.a1_limit(w);
-        let view = super::progress::FitProgressView::new("synthesize --fit");
-        let progress = |p| view.update(p);
-        let outcome = run_fit(
-            env,
-            Some(&a1),
-            &FitSettings::default(),
-            OrderChoice::Auto { max: 8 },
-            &a.out,
-            Some(&progress),
-        )?;
-        view.finish();
-        fit_text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
-        rs.push(("fitted".into(), outcome.result.r.clone()));
+    if let Some(input) = &fit_input {
+        let (text, r) = super::common::fit_bound("synthesize --fit", input, &a.out)?;
+        fit_text = text;
+        rs.push(("fitted".into(), r));
     }
     let outcome = synthesize::run(
         &config,

@@ -41,6 +41,7 @@ pub mod problem;
 pub mod rank;
 pub mod report;
 pub mod retune;
+pub mod revision;
 pub mod search;
 mod slots;
 mod starts;
