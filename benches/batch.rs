@@ -47,7 +47,7 @@ fn batch_1000(bencher: divan::Bencher) {
         .bench_local_values(|out| {
             let t = std::time::Instant::now();
             let list = discover::from_dir(dir.path()).unwrap();
-            let opts = runner::RunOptions {
+            let opts = runner::BatchSettings {
                 noise_radius: None,
                 per_dataset_files: true,
             };

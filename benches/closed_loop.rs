@@ -6,7 +6,7 @@
 //!
 //! Run: `cargo bench --bench closed_loop -- --sample-count 5`.
 use rshape::consistency::closed_loop::closed_loop_envelope;
-use rshape::consistency::closed_loop::noisy::VBisection;
+use rshape::consistency::closed_loop::noisy::VBisectionSettings;
 use rshape::consistency::noisy::{noisy_envelope, BisectionSettings};
 use rshape::data::FrfData;
 use rshape::model::Config;
@@ -34,7 +34,7 @@ fn closed(bencher: divan::Bencher, name: &str, noisy: bool) {
                 &cl,
                 divan::black_box(&data),
                 if noisy { radii.as_deref() } else { None },
-                &VBisection::default(),
+                &VBisectionSettings::default(),
             )
             .unwrap()
         });

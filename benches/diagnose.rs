@@ -4,7 +4,7 @@
 //!
 //! Run: `cargo bench --bench diagnose -- --sample-count 3`.
 use num_complex::Complex64;
-use rshape::diagnose::{diagnose_channels, Channels, Settings};
+use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
 use rshape::model::physical::{
     EffectKind, EffectSpec, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
@@ -74,7 +74,7 @@ fn problem() -> (PhysicalModel, Channels) {
 fn three_effects_400_data(bencher: divan::Bencher) {
     let (base, data) = problem();
     bencher.bench(|| {
-        let d = diagnose_channels(&base, &data, &Settings::default()).unwrap();
+        let d = diagnose_channels(&base, &data, &SearchSettings::default()).unwrap();
         assert!(!d.chosen.is_empty());
         d
     });

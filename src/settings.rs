@@ -1,7 +1,8 @@
 //! Settings validation shared by every settings type of the library.
 //!
 //! Naming rule: a settings type is `<Concept>Settings` (`FitSettings`, `MuSettings`,
-//! `BisectionSettings`, …), its `Default` gives the documented defaults (each field's doc says
+//! `BisectionSettings`, `VBisectionSettings`, `SearchSettings`, `BatchSettings`,
+//! `SynthesisSettings`), its `Default` gives the documented defaults (each field's doc says
 //! its default), and its `validate()` returns an [`InvalidSetting`] naming the first field out
 //! of range, its value and the range it must be in.
 

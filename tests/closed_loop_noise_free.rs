@@ -9,7 +9,7 @@ use rshape::consistency::closed_loop::noise_free::{
     delta_bar, delta_bar_corollary1_printed, delta_bar_from_plant, lft_m, perturbed_plant,
     recover_plant, theorem1_n11, upper_lft,
 };
-use rshape::consistency::closed_loop::{closed_loop_envelope, noisy::VBisection};
+use rshape::consistency::closed_loop::{closed_loop_envelope, noisy::VBisectionSettings};
 use rshape::consistency::{check, EnvelopeMethod};
 use rshape::data::FrfData;
 use rshape::model::Config;
@@ -170,7 +170,7 @@ fn the_envelope_does_not_depend_on_the_experiment_controller() {
     let omega = logspace(0.05, 200.0, 80);
     let a = config(SISO);
     let b = config(&format!("{SISO}{RETUNED}"));
-    let s = VBisection::default();
+    let s = VBisectionSettings::default();
     let ea = closed_loop_envelope(
         a.closed_loop.as_ref().unwrap(),
         &data(&c(), &omega),
@@ -199,7 +199,7 @@ fn check_passes_at_1_01_and_fails_exactly_where_it_must() {
         cfg.closed_loop.as_ref().unwrap(),
         &data(&c_bar(), &omega),
         None,
-        &VBisection::default(),
+        &VBisectionSettings::default(),
     )
     .unwrap()
     .envelope;
@@ -351,10 +351,15 @@ fn a_datum_no_plant_of_the_set_explains_gets_inf() {
         noise_radius: None,
         lines: vec![2],
     };
-    let env = closed_loop_envelope(cl, &d, None, &VBisection::default()).unwrap();
+    let env = closed_loop_envelope(cl, &d, None, &VBisectionSettings::default()).unwrap();
     assert!(env.envelope.r_min[0].is_infinite());
     // With noise around it, some nearby Φ' is explained: finite.
-    let env =
-        closed_loop_envelope(cl, &d, Some(&[0.01 * phi.norm()]), &VBisection::default()).unwrap();
+    let env = closed_loop_envelope(
+        cl,
+        &d,
+        Some(&[0.01 * phi.norm()]),
+        &VBisectionSettings::default(),
+    )
+    .unwrap();
     assert!(env.envelope.r_min[0].is_finite());
 }

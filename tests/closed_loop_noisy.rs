@@ -6,7 +6,7 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rshape::consistency::closed_loop::noisy::{
-    mu_at, theorem2_g1, v_min_eq18, v_min_mu_bisection, v_min_noisy, NoisyRoute, VBisection,
+    mu_at, theorem2_g1, v_min_eq18, v_min_mu_bisection, v_min_noisy, NoisyRoute, VBisectionSettings,
 };
 use rshape::consistency::closed_loop::{closed_loop_envelope, mu_per_datum};
 use rshape::consistency::EnvelopeMethod;
@@ -119,7 +119,7 @@ fn mu_bisection_equals_brute_force_for_both_experiments() {
     for text in [SISO.to_string(), format!("{SISO}{RETUNED}")] {
         let mut zeros = 0;
         for (at, phi, rho) in cases(&text) {
-            let got = v_min_mu_bisection(&at, phi, rho, &VBisection::default());
+            let got = v_min_mu_bisection(&at, phi, rho, &VBisectionSettings::default());
             assert!(!got.hit_iteration_cap);
             let want = brute_force(&at, phi, rho);
             if want < 1e-12 {
@@ -144,17 +144,17 @@ fn mu_bisection_equals_brute_force_for_both_experiments() {
 fn eq18_closed_form_agrees_with_the_mu_route_when_c_bar_is_c() {
     for (at, phi, rho) in cases(SISO) {
         let closed = v_min_eq18(&at, phi, rho).unwrap();
-        let mu = v_min_mu_bisection(&at, phi, rho, &VBisection::default()).v_min;
+        let mu = v_min_mu_bisection(&at, phi, rho, &VBisectionSettings::default()).v_min;
         assert!(
             (closed - mu).abs() <= 1e-10 * closed.max(1e-300),
             "eq. (18) {closed} vs μ {mu}"
         );
-        let routed = v_min_noisy(&at, phi, rho, &VBisection::default());
+        let routed = v_min_noisy(&at, phi, rho, &VBisectionSettings::default());
         assert_eq!(routed.route, NoisyRoute::Eq18ClosedForm);
     }
     let (at, phi, rho) = cases(&format!("{SISO}{RETUNED}")).remove(5);
     assert_eq!(
-        v_min_noisy(&at, phi, rho, &VBisection::default()).route,
+        v_min_noisy(&at, phi, rho, &VBisectionSettings::default()).route,
         NoisyRoute::MuBisection
     );
 }
@@ -196,7 +196,8 @@ fn envelope_and_mu_per_datum_agree_on_the_verdict() {
         lines: (1..=36).collect(),
     };
     let radii: Vec<f64> = cs.iter().map(|c| c.2).collect();
-    let rep = closed_loop_envelope(&cl, &data, Some(&radii), &VBisection::default()).unwrap();
+    let rep =
+        closed_loop_envelope(&cl, &data, Some(&radii), &VBisectionSettings::default()).unwrap();
     assert_eq!(rep.envelope.method, EnvelopeMethod::ClosedLoopTheorem2);
     let v = TransferFunction::new(vec![0.004], vec![1.0]);
     let mu = mu_per_datum(&cl, &data, &radii, &v).unwrap();

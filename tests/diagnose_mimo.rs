@@ -6,7 +6,7 @@
 use num_complex::Complex64;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rshape::diagnose::{diagnose_channels, Channels, Settings};
+use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
 use rshape::model::physical::{Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec};
 use std::process::Command;
 
@@ -70,7 +70,7 @@ fn a_shared_missing_mode_is_found_once_with_a_residue_per_output() {
         radius: r,
         radius_source: vec!["synthetic".into(); 2],
     };
-    let d = diagnose_channels(&b, &data, &Settings::default()).unwrap();
+    let d = diagnose_channels(&b, &data, &SearchSettings::default()).unwrap();
     println!("{}: chosen {:?} {:?}", d.message, d.chosen, d.final_effects);
     let modes: Vec<_> = d
         .final_effects

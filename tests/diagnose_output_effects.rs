@@ -7,7 +7,7 @@
 use num_complex::Complex64;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rshape::diagnose::{diagnose_channels, Channels, Diagnosis, Settings};
+use rshape::diagnose::{diagnose_channels, Channels, Diagnosis, SearchSettings};
 use rshape::model::physical::{
     EffectKind, EffectPath, EffectSpec, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
@@ -82,7 +82,7 @@ fn data(truth: &PhysicalModel, seed: u64) -> Channels {
 }
 
 fn run(truth: &PhysicalModel, seed: u64) -> Diagnosis {
-    let d = diagnose_channels(&base(), &data(truth, seed), &Settings::default()).unwrap();
+    let d = diagnose_channels(&base(), &data(truth, seed), &SearchSettings::default()).unwrap();
     println!(
         "seed {seed}: {} chosen {:?} {:?}",
         d.message, d.chosen, d.final_effects

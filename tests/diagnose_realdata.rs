@@ -6,7 +6,7 @@
 use rshape::data::read_frf_csv;
 use rshape::diagnose::agreement::data_vs_data;
 use rshape::diagnose::compare::{compare, prepare, PlantModel};
-use rshape::diagnose::{diagnose_channels, Channels, Settings};
+use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
 use rshape::model::Config;
 use std::path::Path;
 use std::process::Command;
@@ -29,7 +29,7 @@ fn ballscrew_from_a_rough_rigid_body_finds_the_axial_mode_in_band() {
     let a = read_frf_csv(c.data.as_ref().unwrap()).unwrap();
     let data = Channels::all(&c, &a, None).unwrap();
     assert_eq!(data.n_ch(), 2);
-    let s = Settings {
+    let s = SearchSettings {
         max_effects: 1,
         beam: 2,
     };

@@ -53,7 +53,7 @@ impl DatasetResult {
 
 /// Options of a batch run.
 #[derive(Debug, Clone, Default)]
-pub struct RunOptions {
+pub struct BatchSettings {
     /// Noise radius for every dataset without one in the manifest.
     pub noise_radius: Option<f64>,
     /// Write `OUT/datasets/NAME/{envelope.csv,result.json}`.
@@ -61,7 +61,7 @@ pub struct RunOptions {
 }
 
 /// Processes one dataset; never panics on bad input, returns the failure as a row.
-pub fn run_one(config: &Config, d: &Dataset, opts: &RunOptions, out: &Path) -> DatasetResult {
+pub fn run_one(config: &Config, d: &Dataset, opts: &BatchSettings, out: &Path) -> DatasetResult {
     let mut res = DatasetResult {
         index: d.index,
         name: d.name.clone(),
@@ -85,7 +85,7 @@ pub fn run_one(config: &Config, d: &Dataset, opts: &RunOptions, out: &Path) -> D
 fn fill(
     config: &Config,
     d: &Dataset,
-    opts: &RunOptions,
+    opts: &BatchSettings,
     out: &Path,
     res: &mut DatasetResult,
 ) -> Result<()> {
@@ -124,7 +124,7 @@ fn fill(
 pub fn run_all(
     config: &Config,
     datasets: &[Dataset],
-    opts: &RunOptions,
+    opts: &BatchSettings,
     out: &Path,
     tick: &(dyn Fn() + Sync),
 ) -> Vec<DatasetResult> {

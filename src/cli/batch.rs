@@ -90,7 +90,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     .flatten()
     .collect();
     let _manifest = super::common::prepare_out(&a.out, &sources)?;
-    let opts = runner::RunOptions {
+    let opts = runner::BatchSettings {
         noise_radius: a.noise_radius,
         per_dataset_files: !a.no_dataset_files,
     };

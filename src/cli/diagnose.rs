@@ -5,7 +5,9 @@ use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::plant_form::physical_from_config;
 use crate::diagnose::revision::{params_text, write_revision, Apply, Revise};
-use crate::diagnose::{diagnose_channels, prepare, Channels, DiagnoseVerdict, Diagnosis, Settings};
+use crate::diagnose::{
+    diagnose_channels, prepare, Channels, DiagnoseVerdict, Diagnosis, SearchSettings,
+};
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -109,7 +111,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         }
     };
     let data = channels(a, &inputs, noise)?;
-    let settings = Settings {
+    let settings = SearchSettings {
         max_effects: a.max_effects.max(1),
         beam: a.beam.max(1),
     };

@@ -35,7 +35,7 @@ pub use super::report::{
     SearchStats, Tie,
 };
 use super::retune::retune_within;
-use super::search::{roots, search, Node, SearchResult, Settings};
+use super::search::{roots, search, Node, SearchResult, SearchSettings};
 use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
@@ -48,7 +48,7 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
     diagnose_channels(
         base,
         &data,
-        &Settings {
+        &SearchSettings {
             max_effects,
             ..Default::default()
         },
@@ -60,7 +60,11 @@ fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
 }
 
 /// Diagnoses the channels `data` jointly: retune, search, final holdout, report.
-pub fn diagnose_channels(base: &PhysicalModel, data: &Channels, s: &Settings) -> Result<Diagnosis> {
+pub fn diagnose_channels(
+    base: &PhysicalModel,
+    data: &Channels,
+    s: &SearchSettings,
+) -> Result<Diagnosis> {
     let t0 = Instant::now();
     if data.is_empty() {
         return Err(Error::Invalid(format!("{}: no data", data.path.display())));

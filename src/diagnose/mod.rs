@@ -52,4 +52,4 @@ pub use engine::{
     apply_candidate, apply_chosen, diagnose, diagnose_channels, DiagnoseVerdict, Diagnosis,
 };
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
-pub use search::Settings;
+pub use search::SearchSettings;

@@ -35,24 +35,24 @@ use crate::model::physical::PhysicalModel;
 
 /// Search settings.
 #[derive(Debug, Clone, Copy)]
-pub struct Settings {
+pub struct SearchSettings {
     /// Most effects to add.
     pub max_effects: usize,
     /// Nodes kept per level.
     pub beam: usize,
 }
 
-impl Settings {
+impl SearchSettings {
     /// Checks every field; the error names the first bad one ([`crate::settings`]).
     pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
-        crate::settings::Checker::new("diagnose Settings")
+        crate::settings::Checker::new("SearchSettings")
             .at_least("max_effects", self.max_effects, 1, "must be at least 1")
             .at_least("beam", self.beam, 1, "must be at least 1")
             .finish()
     }
 }
 
-impl Default for Settings {
+impl Default for SearchSettings {
     fn default() -> Self {
         Self {
             max_effects: 3,
@@ -157,7 +157,7 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
 }
 
 /// Runs the beam search from the roots (the first one's screen is the first level).
-pub fn search(roots: Vec<Node>, data: &Channels, s: &Settings) -> Result<SearchResult> {
+pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<SearchResult> {
     s.validate()
         .map_err(|e| crate::error::Error::Invalid(e.to_string()))?;
     let ln2f = (2.0 * data.n_data() as f64).ln();

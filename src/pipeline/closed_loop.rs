@@ -8,7 +8,7 @@
 //! none), so the check, the certified fit and the figures run unchanged.
 
 use super::integration;
-use crate::consistency::closed_loop::noisy::VBisection;
+use crate::consistency::closed_loop::noisy::VBisectionSettings;
 use crate::consistency::closed_loop::{closed_loop_envelope, mu_per_datum, ClosedLoopReport};
 use crate::consistency::Envelope;
 use crate::data::FrfData;
@@ -48,7 +48,7 @@ pub fn envelope(
         let (e, w) = integration::envelope(&config.factorization, data, radii)?;
         return Ok((e, w, None));
     };
-    let rep = closed_loop_envelope(cl, data, radii, &VBisection::default())?;
+    let rep = closed_loop_envelope(cl, data, radii, &VBisectionSettings::default())?;
     let mut warnings = Vec::new();
     let inf = rep
         .envelope

@@ -11,7 +11,7 @@ use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::closed_loop::ClosedLoopModel;
 use crate::system::TransferFunction;
-use noisy::{theorem2_g1, v_min_noisy, ClosedLoopNoisyDatum, VBisection};
+use noisy::{theorem2_g1, v_min_noisy, ClosedLoopNoisyDatum, VBisectionSettings};
 use serde::Serialize;
 
 /// Per-datum diagnostics of the closed-loop envelope.
@@ -86,7 +86,7 @@ pub fn closed_loop_envelope(
     model: &ClosedLoopModel,
     data: &FrfData,
     radii: Option<&[f64]>,
-    settings: &VBisection,
+    settings: &VBisectionSettings,
 ) -> Result<ClosedLoopReport> {
     settings
         .validate()

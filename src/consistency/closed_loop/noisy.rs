@@ -64,24 +64,24 @@ pub struct ClosedLoopNoisyDatum {
 
 /// Settings of the bisection on `|V|`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VBisection {
+pub struct VBisectionSettings {
     /// Stop when `hi − lo ≤ rel_tol·hi`.
     pub rel_tol: f64,
     /// Cap on the `μ` evaluations.
     pub max_iter: usize,
 }
 
-impl VBisection {
+impl VBisectionSettings {
     /// Checks every field; the error names the first bad one ([`crate::settings`]).
     pub fn validate(&self) -> std::result::Result<(), crate::settings::InvalidSetting> {
-        crate::settings::Checker::new("VBisection")
+        crate::settings::Checker::new("VBisectionSettings")
             .fraction("rel_tol", self.rel_tol)
             .at_least("max_iter", self.max_iter, 1, "must be at least 1")
             .finish()
     }
 }
 
-impl Default for VBisection {
+impl Default for VBisectionSettings {
     fn default() -> Self {
         Self {
             rel_tol: 1e-13,
@@ -122,7 +122,7 @@ pub fn v_min_mu_bisection(
     at: &ClosedLoopAt,
     phi: Complex64,
     rho: f64,
-    settings: &VBisection,
+    settings: &VBisectionSettings,
 ) -> ClosedLoopNoisyDatum {
     let mut out = ClosedLoopNoisyDatum {
         v_min: 0.0,
@@ -188,7 +188,7 @@ pub fn v_min_noisy(
     at: &ClosedLoopAt,
     phi: Complex64,
     rho: f64,
-    settings: &VBisection,
+    settings: &VBisectionSettings,
 ) -> ClosedLoopNoisyDatum {
     if at.same_controller {
         if let Some(v) = v_min_eq18(at, phi, rho) {
