@@ -10,7 +10,11 @@ fn the_guide_library_snippet_is_the_compiled_example() {
     let example = std::fs::read_to_string(common::repo("examples/library_api.rs")).unwrap();
     let start = guide
         .find("### Library API")
-        .and_then(|i| guide[i..].find("```rust\n").map(|j| i + j + "```rust\n".len()))
+        .and_then(|i| {
+            guide[i..]
+                .find("```rust\n")
+                .map(|j| i + j + "```rust\n".len())
+        })
         .expect("a ```rust block under ### Library API");
     let end = start + guide[start..].find("```\n").expect("the block ends");
     assert_eq!(
