@@ -83,7 +83,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         },
     };
     let controller_path = a.out.join("controller.toml");
-    synthesize::run(
+    let dry = synthesize::run(
         &config,
         &a.config,
         &rs,
@@ -92,20 +92,25 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         &controller_path,
     )?;
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
+    // Without --fit the run above is the outcome; with it, the proof is repeated with the
+    // fitted r added.
     let mut fit_text = String::new();
-    if let Some(input) = &fit_input {
-        let (text, r) = super::common::fit_bound("synthesize --fit", input, &a.out)?;
-        fit_text = text;
-        rs.push(("fitted".into(), r));
-    }
-    let outcome = synthesize::run(
-        &config,
-        &a.config,
-        &rs,
-        &settings,
-        a.data.as_deref(),
-        &controller_path,
-    )?;
+    let outcome = match &fit_input {
+        None => dry,
+        Some(input) => {
+            let (text, r) = super::common::fit_bound("synthesize --fit", input, &a.out)?;
+            fit_text = text;
+            rs.push(("fitted".into(), r));
+            synthesize::run(
+                &config,
+                &a.config,
+                &rs,
+                &settings,
+                a.data.as_deref(),
+                &controller_path,
+            )?
+        }
+    };
     let written = synthesize::write_outputs(&a.out, &outcome)?;
     let code = if outcome.robust { 0 } else { 1 };
     if a.json {

@@ -6,7 +6,7 @@
 //! nothing there once other effects were added).
 
 use super::channels::Channels;
-use super::holdout::model_of;
+use super::holdout::{model_of, without};
 use super::problem::Problem;
 use super::rank::MIN_DELTA_BIC;
 use super::retune::retune_within;
@@ -28,13 +28,7 @@ pub fn eliminate(
     while !node.effects.is_empty() {
         let mut worst: Option<(usize, f64, PhysicalModel, f64)> = None;
         for j in 0..node.effects.len() {
-            let others: Vec<_> = node
-                .effects
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| *i != j)
-                .map(|(_, e)| e.clone())
-                .collect();
+            let others = without(&node.effects, j);
             let wo = model_of(base, &others, nodes, data);
             let r = retune_within(&wo, base, data, None, false);
             let n_e = node.effects[j].0.n_params(data.n_ch());

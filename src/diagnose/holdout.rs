@@ -17,6 +17,17 @@ use super::retune::{cost, retune_within};
 use super::search::{add_effect, Node};
 use crate::model::physical::PhysicalModel;
 
+/// The effects of a set with its `j`-th left out (the set the holdout and the backward
+/// elimination compare against).
+pub fn without(effects: &[(Cand, Vec<f64>)], j: usize) -> Vec<(Cand, Vec<f64>)> {
+    effects
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != j)
+        .map(|(_, e)| e.clone())
+        .collect()
+}
+
 /// The model of the effect set `effects` on the configured model `root`: the search's
 /// lowest-cost node of that set, else the set assembled on `root` (parameters as fitted when
 /// added) and refit jointly from a rough start.
@@ -75,13 +86,7 @@ pub fn holdouts(
     let full_hi = extrap.then(|| part(&full, &low, &high));
     (0..node.effects.len())
         .map(|j| {
-            let others: Vec<_> = node
-                .effects
-                .iter()
-                .enumerate()
-                .filter(|(i, _)| *i != j)
-                .map(|(_, e)| e.clone())
-                .collect();
+            let others = without(&node.effects, j);
             let c = node.effects[j].0;
             let wo = model_of(root, &others, nodes, data);
             let wo_ho = part(&wo, &fit, &ho);
