@@ -1,5 +1,6 @@
 //! Linear time-invariant systems: polynomials, transfer functions, transfer-function
 //! matrices and state-space models, all evaluated on the imaginary axis.
+pub mod compensated;
 pub mod dense_inverse;
 pub mod eig;
 pub mod freq_eval;
