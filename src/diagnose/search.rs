@@ -25,6 +25,7 @@
 use super::candidates::Cand;
 use super::channels::Channels;
 use super::final_effects::final_effects;
+use super::holdout::same_set;
 use super::polish::settle;
 use super::problem::{Measures, Problem};
 use super::rank::{candidate_list, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC};
@@ -87,12 +88,6 @@ impl Node {
     /// Labels of the effects, in order.
     pub fn labels(&self) -> Vec<String> {
         self.effects.iter().map(|(c, _)| c.label()).collect()
-    }
-
-    fn key(&self) -> Vec<String> {
-        let mut l = self.labels();
-        l.sort();
-        l
     }
 }
 
@@ -254,10 +249,16 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                 }
             }
         }
-        // One node per effect set (the best order), the `beam` best kept.
+        // One node per effect set (the best order; added modes at different frequencies
+        // are different sets), the `beam` best kept.
         children.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-        let mut seen = std::collections::HashSet::new();
-        children.retain(|c| seen.insert(c.key()));
+        let mut kept: Vec<Node> = Vec::new();
+        for c in children {
+            if !kept.iter().any(|k| same_set(&k.effects, &c.effects)) {
+                kept.push(c);
+            }
+        }
+        let mut children = kept;
         children.truncate(s.beam.max(1));
         if children.is_empty() {
             break;
