@@ -11,6 +11,7 @@
 
 use crate::model::physical::{
     EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
+    Quantity,
 };
 use num_complex::Complex64;
 
@@ -497,18 +498,37 @@ pub fn explain(
                 sig(old)
             )
         }
-        Cand::Integrator(2) => format!(
-            "the error grows as 1/ω² towards low frequency (−40 dB/dec, phase of a double integrator): a missing rigid-body mode (or a mode below the band: a mass line) c/s², c = {}",
-            list("c")
-        ),
+        Cand::Integrator(2) => match base.quantity {
+            Quantity::Displacement => format!(
+                "the error grows as 1/ω² towards low frequency (−40 dB/dec, phase of a double integrator): a missing rigid-body mode, or the lower residual (residual mass of modes below the band) c/s², c = {}",
+                list("c")
+            ),
+            Quantity::Velocity => format!(
+                "the error grows as 1/ω towards low frequency (−20 dB/dec, −90°: the mobility of a mass): a missing rigid-body mode, or the lower residual (modes below the band) c/s² in displacement, c = {}",
+                list("c")
+            ),
+            Quantity::Acceleration => format!(
+                "the error is a constant real term at low frequency (the mass line of an accelerance): a missing rigid-body mode (1/m = c), or the lower residual of modes below the band, c/s² in displacement, c = {}",
+                list("c")
+            ),
+        },
         Cand::Integrator(_) => format!(
-            "the error grows as 1/ω towards low frequency (−20 dB/dec, −90°): a missing integrator c/s, c = {}",
+            "the error grows as 1/ω towards low frequency in displacement (−20 dB/dec, −90°): a missing integrator c/s, c = {}",
             list("c")
         ),
-        Cand::Feedthrough => format!(
-            "the error is a constant real term, flat in frequency, that dominates where the model rolls off and moves the anti-resonances: a feedthrough (residual compliance of modes above the band) D = {}",
-            list("d")
-        ),
+        Cand::Feedthrough => match base.quantity {
+            Quantity::Displacement => format!(
+                "the error is a constant real term, flat in frequency, that dominates where the model rolls off and moves the anti-resonances: the upper residual (residual flexibility of modes above the band) D = {}",
+                list("d")
+            ),
+            q => format!(
+                "the error rises as ω{} towards the band top and moves the anti-resonances: the upper residual of the {} (residual flexibility of modes above the band, D s{} with D = {})",
+                if q == Quantity::Acceleration { "²" } else { "" },
+                q.frf_name(),
+                if q == Quantity::Acceleration { "²" } else { "" },
+                list("d")
+            ),
+        },
         Cand::NmpZero(_) => format!(
             "magnitude matches but phase falls and saturates towards −180° (−90° at {}): a non-minimum-phase zero{on} at z = {}",
             fmt_w(p("z")),

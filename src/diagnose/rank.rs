@@ -4,7 +4,7 @@
 use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
 use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
-use crate::model::physical::PhysicalModel;
+use crate::model::physical::{PhysicalModel, Quantity};
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
@@ -102,6 +102,7 @@ pub fn plausibility(
     entries: &[(usize, usize)],
     w_min: f64,
     w_max: f64,
+    quantity: Quantity,
 ) -> (Vec<String>, Option<String>) {
     if !v.is_finite() || th.iter().any(|x| !x.is_finite()) {
         return (
@@ -144,9 +145,9 @@ pub fn plausibility(
             if at(0) {
                 let w = th[0].exp();
                 let edge = if w < (w_min * w_max).sqrt() {
-                    "below: a mass line, see the rigid_body candidate"
+                    "below: the lower residual of modes below the band, see the integrator candidate of order 2"
                 } else {
-                    "above: a compliance line, see the feedthrough candidate"
+                    "above: the upper residual of modes above the band, see the feedthrough candidate"
                 };
                 flags.push(format!(
                     "ω_n at the band edge {}: the resonance is not inside the measured band ({edge})",
@@ -163,6 +164,14 @@ pub fn plausibility(
             }
         }
         Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
+        // On a mobility or an accelerance, c/s (displacement) is a constant mobility or an
+        // accelerance rising as ω: no structural term (a rigid body or the lower residual is
+        // c/s², the upper residual a constant D).
+        Cand::Integrator(1) if quantity != Quantity::Displacement => flags.push(format!(
+            "implausible on a {}: c/s in displacement is {} here, which no structural term gives (a rigid-body mode or the lower residual is c/s², the upper residual D)",
+            quantity.frf_name(),
+            if quantity == Quantity::Acceleration { "c·s" } else { "a constant c" }
+        )),
         // More than half a cycle of lag at the band top is not a transport or computation
         // delay a servo loop works with; it fits the slope of dynamics the model lacks.
         Cand::Delay(_) if th[0].abs() * w_max > MAX_DELAY_PHASE => flags.push(format!(
@@ -246,6 +255,7 @@ impl Problem<'_> {
                     &self.data.entries,
                     self.omega_min(),
                     self.omega_max(),
+                    self.base.quantity,
                 );
                 Screened {
                     cand: *c,
