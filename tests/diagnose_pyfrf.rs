@@ -127,3 +127,71 @@ fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
     assert!(f.iter().any(|x| (x - 810.0).abs() < 3.0), "{f:?}");
     assert!(f.iter().any(|x| (x - 900.0).abs() < 3.0), "{f:?}");
 }
+
+#[test]
+#[ignore]
+fn explore_accelerance() {
+    let band: Vec<f64> = std::env::var("BAND")
+        .unwrap_or("20,1200".into())
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let data = pyfrf(band[0], band[1]);
+    let mut m = PhysicalModel {
+        quantity: rshape::model::physical::Quantity::Acceleration,
+        rigid_body: vec![rshape::model::physical::PoleAtZeroSpec {
+            name: None,
+            mass: 1.0,
+            input_gain: rshape::model::physical::Gains::Scalar(1.0),
+            output_gain: rshape::model::physical::Gains::Scalar(-1.2),
+            friction_pole: None,
+        }],
+        ..Default::default()
+    };
+    let me: usize = std::env::var("ME").map(|x| x.parse().unwrap()).unwrap_or(1);
+    for step in 0..std::env::var("STEPS")
+        .map(|x| x.parse().unwrap())
+        .unwrap_or(4)
+    {
+        let t = std::time::Instant::now();
+        let s = SearchSettings {
+            max_effects: me,
+            beam: 3,
+        };
+        let d = diagnose_channels(&m, &data, &s).unwrap();
+        println!(
+            "step {step} ({:.1} s): {}",
+            t.elapsed().as_secs_f64(),
+            d.message
+        );
+        for c in d.candidates.iter().take(6) {
+            println!(
+                "   cand {} dbic {:.3e} {:?} pass {} flags {:?}",
+                c.effect, c.delta_bic, c.params, c.passes, c.flags
+            );
+        }
+        println!(
+            "   holdout {:?} dropped {:?} elim {:?}",
+            d.holdout, d.dropped, d.eliminated
+        );
+        let f: Vec<String> = d
+            .final_model
+            .mode
+            .iter()
+            .map(|x| format!("{:.1}Hz/{:.2e}", x.omega_n / TAU, x.zeta))
+            .collect();
+        println!(
+            "   modes {f:?} rb {:?} ft {:?}",
+            d.final_model
+                .rigid_body
+                .iter()
+                .map(|r| r.output_gain.clone())
+                .collect::<Vec<_>>(),
+            d.final_model.feedthrough
+        );
+        if d.chosen.is_empty() {
+            break;
+        }
+        m = d.final_model;
+    }
+}

@@ -89,8 +89,11 @@ fn on_an_accelerance_the_rigid_body_is_the_mass_line() {
 #[test]
 fn a_bad_quantity_is_a_one_line_error_naming_the_key() {
     for bad in ["\"accel\"", "\"Acceleration\"", "2"] {
-        let text = format!("[physical]\nquantity = {bad}\n[[physical.mode]]\nomega_n = 1\nzeta = 0.1\n");
-        let e = Config::parse(&text, Path::new("x.toml")).unwrap_err().to_string();
+        let text =
+            format!("[physical]\nquantity = {bad}\n[[physical.mode]]\nomega_n = 1\nzeta = 0.1\n");
+        let e = Config::parse(&text, Path::new("x.toml"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("x.toml") && e.contains("quantity"), "{e}");
         assert!(!e.contains('\n'), "{e}");
         if bad.starts_with('"') {

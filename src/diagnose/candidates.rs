@@ -10,8 +10,8 @@
 //! in logarithms.
 
 use crate::model::physical::{
-    EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
-    Quantity,
+    EffectKind, EffectPath, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel,
+    PoleAtZeroSpec, Quantity,
 };
 use num_complex::Complex64;
 

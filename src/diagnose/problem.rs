@@ -63,7 +63,8 @@ impl Measures {
 /// bodies and residual terms keep their displacement form).
 pub fn path_at(m: &PhysicalModel, omega: f64, entry: (usize, usize)) -> Complex64 {
     let q = m.quantity.factor(omega);
-    q * m.effect
+    q * m
+        .effect
         .iter()
         .filter(|e| {
             let idx = match e.path {

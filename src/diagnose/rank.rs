@@ -22,6 +22,37 @@ pub const MIN_SPLIT_DATA: usize = 8;
 /// A fitted frequency beyond this factor outside the measured band is "no fit".
 pub const MAX_BAND_FACTOR: f64 = 1e6;
 
+/// A joint refit that lowers `misfit_rms` to this share of the parent's or less is an
+/// improvement even when its invalid fraction rose (see [`improves`]).
+pub const CLEAR_RMS_DROP: f64 = 0.9;
+
+/// Relative distance from a band edge (`ln ω`) under which a mode's `ω_n` is "at the band
+/// edge": the fit pushed it against the box of the band, the resonance is not in the data.
+pub const BAND_EDGE_LN: f64 = 2e-3;
+
+/// The acceptance rule of an effect (issue 20 item 8), besides `ΔBIC > 10`: the model with
+/// it has no more invalid data than the parent, **or** its `misfit_rms` fell to
+/// [`CLEAR_RMS_DROP`] of the parent's or less.  On a wide band one shared term (the mass
+/// line of an accelerance, a feedthrough) is a compromise between the bands: adding a
+/// correct mode moves it, so data far from the mode may leave their disks while the error
+/// falls overall; the rule then still accepts the mode, and the holdout judges it.
+pub fn improves(new: &Measures, parent: &Measures) -> bool {
+    new.invalid_fraction <= parent.invalid_fraction
+        || new.misfit_rms <= CLEAR_RMS_DROP * parent.misfit_rms
+}
+
+/// Number of modes of `m` at (or beyond) an edge of the band `[w_min, w_max]` (see
+/// [`BAND_EDGE_LN`]).
+pub fn modes_at_band_edge(m: &PhysicalModel, w_min: f64, w_max: f64) -> usize {
+    m.mode
+        .iter()
+        .filter(|md| {
+            let w = md.omega_n.ln();
+            w <= w_min.ln() + BAND_EDGE_LN || w >= w_max.ln() - BAND_EDGE_LN
+        })
+        .count()
+}
+
 /// Prior order among near-ties (lower first): fewer assumptions first.
 pub fn prior(c: &Cand) -> usize {
     match c {

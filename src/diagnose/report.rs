@@ -68,7 +68,8 @@ pub struct CandidateReport {
 
 impl CandidateReport {
     /// Why the tool rejected this candidate (`None` when it passes): no fit, a plausibility
-    /// flag, too small a ΔBIC, or more invalid data than the retune alone.
+    /// flag, too small a ΔBIC, or more invalid data than the retune alone without a clear fall
+    /// of `misfit_rms` ([`super::rank::improves`]).
     pub fn rejection(&self) -> Option<String> {
         if self.passes {
             return None;
@@ -91,8 +92,9 @@ impl CandidateReport {
             )
         } else {
             format!(
-                "more invalid data than the retune alone ({:.1} % with it)",
-                100.0 * self.invalid_fraction_after
+                "more invalid data than the retune alone ({:.1} % with it) and misfit_rms not down to {} % of the retune's",
+                100.0 * self.invalid_fraction_after,
+                100.0 * super::rank::CLEAR_RMS_DROP
             )
         })
     }

@@ -62,13 +62,21 @@ impl PhysicalModel {
             // D s^k: M̃ = 1/(s + a)^k, Ñ = D s^k/(s + a)^k (a zero row stays M̃ = 1, Ñ = 0).
             for i in 0..p {
                 let zero = (0..m).all(|j| d[(i, j)] == 0.0);
-                let qk = if zero { pole_power(a, 0) } else { pole_power(a, k) };
+                let qk = if zero {
+                    pole_power(a, 0)
+                } else {
+                    pole_power(a, k)
+                };
                 m_diag.push(TransferFunction {
                     num: Polynomial::constant(1.0),
                     den: qk.clone(),
                 });
                 let num = if zero { s_pow(0) } else { s_pow(k) };
-                n_rows.push(over(&d.row(i).iter().copied().collect::<Vec<_>>(), &num, &qk));
+                n_rows.push(over(
+                    &d.row(i).iter().copied().collect::<Vec<_>>(),
+                    &num,
+                    &qk,
+                ));
                 let mut col = vec![0.0; p];
                 col[i] = 1.0;
                 c_cols.push(col);

@@ -161,7 +161,8 @@ impl<'de> Deserialize<'de> for Quantity {
 /// Reads `[physical] quantity`; any other value is an error naming the key and the choices.
 struct QuantityVisitor;
 
-const QUANTITY_CHOICES: &str = "\"displacement\" (receptance), \"velocity\" (mobility) or \"acceleration\" (accelerance)";
+const QUANTITY_CHOICES: &str =
+    "\"displacement\" (receptance), \"velocity\" (mobility) or \"acceleration\" (accelerance)";
 
 impl serde::de::Visitor<'_> for QuantityVisitor {
     type Value = Quantity;
