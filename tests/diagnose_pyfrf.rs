@@ -7,8 +7,11 @@
 
 use num_complex::Complex64;
 use rshape::diagnose::retune::cost;
+use rshape::diagnose::Diagnosis;
 use rshape::diagnose::{diagnose_channels, retune_within, Channels, SearchSettings};
-use rshape::model::physical::{Feedthrough, ModeSpec, PhysicalModel};
+use rshape::model::physical::{
+    Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec, Quantity,
+};
 use std::path::Path;
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -63,8 +66,8 @@ fn mode(f_hz: f64, zeta: f64, rho: f64) -> ModeSpec {
         omega_n: TAU * f_hz,
         zeta,
         mass: 1.0,
-        input_gain: rshape::model::physical::Gains::Scalar(1.0),
-        output_gain: rshape::model::physical::Gains::Scalar(rho),
+        input_gain: Gains::Scalar(1.0),
+        output_gain: Gains::Scalar(rho),
     }
 }
 
@@ -128,70 +131,131 @@ fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
     assert!(f.iter().any(|x| (x - 900.0).abs() < 3.0), "{f:?}");
 }
 
-#[test]
-#[ignore]
-fn explore_accelerance() {
-    let band: Vec<f64> = std::env::var("BAND")
-        .unwrap_or("20,1200".into())
-        .split(',')
-        .map(|x| x.parse().unwrap())
-        .collect();
-    let data = pyfrf(band[0], band[1]);
-    let mut m = PhysicalModel {
-        quantity: rshape::model::physical::Quantity::Acceleration,
-        rigid_body: vec![rshape::model::physical::PoleAtZeroSpec {
+/// The free body as an accelerance: the mass line is a rigid body `c/(m s²)` times `s²`.
+fn accelerance_mass_line() -> PhysicalModel {
+    PhysicalModel {
+        quantity: Quantity::Acceleration,
+        rigid_body: vec![PoleAtZeroSpec {
             name: None,
             mass: 1.0,
-            input_gain: rshape::model::physical::Gains::Scalar(1.0),
-            output_gain: rshape::model::physical::Gains::Scalar(-1.2),
+            input_gain: Gains::Scalar(1.0),
+            output_gain: Gains::Scalar(-1.2),
             friction_pole: None,
         }],
         ..Default::default()
-    };
-    let me: usize = std::env::var("ME").map(|x| x.parse().unwrap()).unwrap_or(1);
-    for step in 0..std::env::var("STEPS")
-        .map(|x| x.parse().unwrap())
-        .unwrap_or(4)
-    {
+    }
+}
+
+/// One `diagnose` per step, its chosen set applied (`--apply chosen`), until nothing passes.
+fn walk(data: &Channels, max_steps: usize) -> Vec<Diagnosis> {
+    let mut m = accelerance_mass_line();
+    let mut out = Vec::new();
+    for _ in 0..max_steps {
         let t = std::time::Instant::now();
         let s = SearchSettings {
-            max_effects: me,
+            max_effects: 1,
             beam: 3,
         };
-        let d = diagnose_channels(&m, &data, &s).unwrap();
-        println!(
-            "step {step} ({:.1} s): {}",
-            t.elapsed().as_secs_f64(),
-            d.message
-        );
-        for c in d.candidates.iter().take(6) {
-            println!(
-                "   cand {} dbic {:.3e} {:?} pass {} flags {:?}",
-                c.effect, c.delta_bic, c.params, c.passes, c.flags
-            );
-        }
-        println!(
-            "   holdout {:?} dropped {:?} elim {:?}",
-            d.holdout, d.dropped, d.eliminated
-        );
-        let f: Vec<String> = d
+        let d = diagnose_channels(&m, data, &s).unwrap();
+        let modes: Vec<String> = d
             .final_model
             .mode
             .iter()
-            .map(|x| format!("{:.1}Hz/{:.2e}", x.omega_n / TAU, x.zeta))
+            .map(|x| format!("{:.1} Hz (ζ {:.2e})", x.omega_n / TAU, x.zeta))
             .collect();
         println!(
-            "   modes {f:?} rb {:?} ft {:?}",
-            d.final_model
-                .rigid_body
-                .iter()
-                .map(|r| r.output_gain.clone())
-                .collect::<Vec<_>>(),
-            d.final_model.feedthrough
+            "step {} ({:.1} s): {}\n  modes {modes:?}, dropped by the holdout {:?}",
+            out.len() + 1,
+            t.elapsed().as_secs_f64(),
+            d.message,
+            d.dropped
         );
-        if d.chosen.is_empty() {
+        let done = d.chosen.is_empty();
+        if !done {
+            m = d.final_model.clone();
+        }
+        out.push(d);
+        if done {
             break;
         }
-        m = d.final_model;
+    }
+    out
+}
+
+fn has_mode(m: &PhysicalModel, f_hz: f64, tol_hz: f64) -> bool {
+    m.mode
+        .iter()
+        .any(|x| (x.omega_n / TAU - f_hz).abs() < tol_hz)
+}
+
+/// docs/guide/discovery-walkthrough.md, section 6: on 20–1200 Hz, as an accelerance, the
+/// three close modes (810, 851, 900 Hz, ζ ≈ 1e-3) in three steps, `misfit_rms` falling at
+/// every step; the invalid fraction falls over the walk and at steps 2 and 3 (step 1 raises
+/// it: the one mass-line constant is shared by the bands below and above the cluster, see
+/// the guide); then nothing more passes (a fourth mode at 824 Hz is dropped by the holdout).
+#[test]
+fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
+    let data = pyfrf(20.0, 1200.0);
+    let steps = walk(&data, 5);
+    assert_eq!(steps.len(), 4, "three applied steps, then nothing passes");
+    let last = &steps[2].final_model;
+    for f in [810.0, 851.0, 900.0] {
+        assert!(has_mode(last, f, 2.0), "no mode at {f} Hz: {:?}", last.mode);
+    }
+    assert_eq!(last.mode.len(), 3);
+    for m in &last.mode {
+        assert!((5e-4..3e-3).contains(&m.zeta), "ζ = {}", m.zeta);
+    }
+    for (k, d) in steps[..3].iter().enumerate() {
+        assert_eq!(d.chosen, ["mode"], "step {}", k + 1);
+        assert!(
+            d.after.misfit_rms < 0.5 * d.before.misfit_rms,
+            "step {}: {:?} -> {:?}",
+            k + 1,
+            d.before,
+            d.after
+        );
+        if k > 0 {
+            assert!(
+                d.after.invalid_fraction < d.before.invalid_fraction,
+                "step {}",
+                k + 1
+            );
+        }
+    }
+    assert!(steps[2].after.invalid_fraction < 0.65 * steps[0].before.invalid_fraction);
+    // Nothing is applied after the third step, and no flagged candidate was ever written.
+    assert!(steps[3].chosen.is_empty(), "{}", steps[3].message);
+    // The 1/s term on an accelerance is flagged as implausible, never applied.
+    for d in &steps {
+        for c in d.candidates.iter().filter(|c| c.effect == "integrator") {
+            if c.params.get("order") == Some(&1.0) {
+                assert!(!c.passes && c.flags.iter().any(|f| f.contains("accelerance")));
+            }
+        }
+    }
+}
+
+/// The whole band, 20–5000 Hz (about 12 s per step at opt-level 1): the modes found, and
+/// nothing at a band edge.  Found: 900, 3664, 4126, 810 Hz; then the best single mode
+/// runs to the 5000 Hz edge (flagged, not applied) and the upper residual lowers the error
+/// too little: 851, 2640, 3035, 4160, 4390 Hz are not found (docs/guide/discovery-walkthrough.md).
+#[test]
+#[ignore = "the whole band: about 45 s at opt-level 1"]
+fn pyfrf_accelerance_whole_band() {
+    let data = pyfrf(20.0, 5000.0);
+    let steps = walk(&data, 10);
+    let last = &steps.last().unwrap().final_model;
+    for f in [900.0, 3664.0, 4126.0, 810.0] {
+        assert!(has_mode(last, f, 3.0), "no mode at {f} Hz: {:?}", last.mode);
+    }
+    let w_max = TAU * 5000.0;
+    for d in &steps {
+        assert!(
+            d.final_model.mode.iter().all(|m| m.omega_n < 0.99 * w_max),
+            "a mode at the band edge: {:?}",
+            d.final_model.mode
+        );
+        assert!(d.after.misfit_rms < d.before.misfit_rms || d.chosen.is_empty());
     }
 }
