@@ -46,7 +46,8 @@ pub struct CandidateReport {
     /// True when the numbers are after the joint refit of every parameter.
     pub joint_refit: bool,
     /// Passes: ΔBIC > 10 against the retuned model (the configured one for the retune),
-    /// invalid fraction not higher, physically plausible (no flags).
+    /// no more invalid data or `misfit_rms` down to 90 % ([`super::rank::improves`]),
+    /// physically plausible (no flags).
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
     pub tie_with_best: bool,
