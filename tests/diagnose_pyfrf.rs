@@ -236,12 +236,12 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
     }
 }
 
-/// The whole band, 20–5000 Hz (about 12 s per step at opt-level 1): the modes found, and
+/// The whole band, 20–5000 Hz (48 s for five steps at opt-level 1): the modes found, and
 /// nothing at a band edge.  Found: 900, 3664, 4126, 810 Hz; then the best single mode
 /// runs to the 5000 Hz edge (flagged, not applied) and the upper residual lowers the error
 /// too little: 851, 2640, 3035, 4160, 4390 Hz are not found (docs/guide/discovery-walkthrough.md).
 #[test]
-#[ignore = "the whole band: about 45 s at opt-level 1"]
+#[ignore = "the whole band: about 48 s at opt-level 1"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);
