@@ -488,6 +488,12 @@ fn toml_kinds() -> Vec<Kind> {
             &["model.toml", "zeta"],
         ),
         siso(
+            "TOML: unknown measured quantity",
+            2,
+            physical("quantity = \"accel\""),
+            &["model.toml", "quantity", "acceleration"],
+        ),
+        siso(
             "TOML: negative omega_n",
             2,
             physical("omega_n = -5.0"),

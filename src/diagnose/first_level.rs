@@ -6,7 +6,7 @@ use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Band};
 use super::problem::{Measures, Problem};
-use super::rank::{prior, si_map, MIN_DELTA_BIC, TIE_BIC};
+use super::rank::{improves, prior, si_map, MIN_DELTA_BIC, TIE_BIC};
 use super::report::CandidateReport;
 use super::search::{add_effect, SearchResult};
 use crate::error::Result;
@@ -124,7 +124,7 @@ pub(super) fn ranked_candidates(
             passes: sc.no_fit.is_none()
                 && sc.flags.is_empty()
                 && d_root > MIN_DELTA_BIC
-                && m.invalid_fraction <= retuned.invalid_fraction,
+                && improves(&m, &retuned),
             tie_with_best: false,
             flags: sc.flags.clone(),
             no_fit: sc.no_fit.clone(),

@@ -28,24 +28,54 @@ pub fn without(effects: &[(Cand, Vec<f64>)], j: usize) -> Vec<(Cand, Vec<f64>)> 
         .collect()
 }
 
+/// Two added modes are the same effect when their frequencies (as fitted when added) agree
+/// within this relative distance (`|ln ω_a − ln ω_b|`); close modes 5 % apart are distinct.
+pub const SAME_MODE_LN: f64 = 0.01;
+
+/// True when `a` and `b` hold the same effects in any order: each effect of `a` pairs with
+/// an equal candidate of `b`, and an added mode only with a mode at the same frequency
+/// (within [`SAME_MODE_LN`]).  Labels alone do not tell two added modes apart: a set
+/// `{mode 900 Hz}` must not be taken for `{mode 810 Hz}` (issue 20 item 3).
+pub fn same_set(a: &[(Cand, Vec<f64>)], b: &[(Cand, Vec<f64>)]) -> bool {
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut used = vec![false; b.len()];
+    for (ca, ta) in a {
+        let best = b
+            .iter()
+            .enumerate()
+            .filter(|(i, (cb, _))| !used[*i] && cb == ca)
+            .map(|(i, (_, tb))| {
+                let d = match ca {
+                    Cand::Mode => (ta[0] - tb[0]).abs(),
+                    _ => 0.0,
+                };
+                (i, d)
+            })
+            .filter(|(_, d)| *d <= SAME_MODE_LN)
+            .min_by(|x, y| x.1.total_cmp(&y.1));
+        match best {
+            Some((i, _)) => used[i] = true,
+            None => return false,
+        }
+    }
+    true
+}
+
 /// The model of the effect set `effects` on the configured model `root`: the search's
-/// lowest-cost node of that set, else the set assembled on `root` (parameters as fitted when
-/// added) and refit jointly from a rough start.
+/// lowest-cost node of that set ([`same_set`]: the same effects, added modes at the same
+/// frequencies), else the set assembled on `root` (parameters as fitted when added) and
+/// refit jointly from a rough start.
 pub fn model_of(
     root: &PhysicalModel,
     effects: &[(Cand, Vec<f64>)],
     nodes: &[Node],
     data: &Channels,
 ) -> PhysicalModel {
-    let mut key: Vec<String> = effects.iter().map(|e| e.0.label()).collect();
-    key.sort();
     let found = nodes
         .iter()
-        .filter(|n| {
-            let mut k = n.labels();
-            k.sort();
-            k == key && !n.configured
-        })
+        .filter(|n| !n.configured && same_set(&n.effects, effects))
         .min_by(|a, b| a.v_fit.total_cmp(&b.v_fit));
     if let Some(n) = found {
         return n.model.clone();

@@ -12,7 +12,8 @@
 //! * [`problem`]: the least-squares problem (base model, candidate effects, cost `V`);
 //!   [`fit`]: Levenberg–Marquardt; `slots` (private): the parameters `retune` refits;
 //! * [`retune`]: the joint refit of the configured model's own parameters;
-//! * [`candidates`]: the catalogue of effects and how each modifies the model; `starts`
+//! * [`candidates`]: the catalogue of effects and how each modifies the model (`explain`,
+//!   private: what each means in the data); `starts`
 //!   (private): their starting points; [`rank`]: screening and physical plausibility;
 //! * [`search`]: the beam search over effect sets with joint refits; [`polish`]: the
 //!   consistency polish; [`ties`]: sets the data cannot tell apart; [`holdout`]: the
@@ -30,6 +31,7 @@ pub mod candidates;
 pub mod changes;
 pub mod channels;
 pub mod engine;
+mod explain;
 pub mod factor_form;
 pub mod final_effects;
 mod first_level;

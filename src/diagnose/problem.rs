@@ -58,9 +58,13 @@ impl Measures {
     }
 }
 
-/// The product of the path effects of `m` on model entry `entry` at `ω`.
+/// The product of the path effects of `m` on model entry `entry` at `ω`, times `(jω)^k` of
+/// the measured quantity (the core stays the displacement model, so added modes, rigid
+/// bodies and residual terms keep their displacement form).
 pub fn path_at(m: &PhysicalModel, omega: f64, entry: (usize, usize)) -> Complex64 {
-    m.effect
+    let q = m.quantity.factor(omega);
+    q * m
+        .effect
         .iter()
         .filter(|e| {
             let idx = match e.path {

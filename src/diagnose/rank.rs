@@ -4,7 +4,7 @@
 use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
 use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
-use crate::model::physical::PhysicalModel;
+use crate::model::physical::{PhysicalModel, Quantity};
 use nalgebra::DMatrix;
 use std::collections::BTreeMap;
 
@@ -21,6 +21,37 @@ pub const EXTRAPOLATION_SPLIT: f64 = 0.7;
 pub const MIN_SPLIT_DATA: usize = 8;
 /// A fitted frequency beyond this factor outside the measured band is "no fit".
 pub const MAX_BAND_FACTOR: f64 = 1e6;
+
+/// A joint refit that lowers `misfit_rms` to this share of the parent's or less is an
+/// improvement even when its invalid fraction rose (see [`improves`]).
+pub const CLEAR_RMS_DROP: f64 = 0.9;
+
+/// Relative distance from a band edge (`ln ω`) under which a mode's `ω_n` is "at the band
+/// edge": the fit pushed it against the box of the band, the resonance is not in the data.
+pub const BAND_EDGE_LN: f64 = 2e-3;
+
+/// The acceptance rule of an effect (issue 20 item 8), besides `ΔBIC > 10`: the model with
+/// it has no more invalid data than the parent, **or** its `misfit_rms` fell to
+/// [`CLEAR_RMS_DROP`] of the parent's or less.  On a wide band one shared term (the mass
+/// line of an accelerance, a feedthrough) is a compromise between the bands: adding a
+/// correct mode moves it, so data far from the mode may leave their disks while the error
+/// falls overall; the rule then still accepts the mode, and the holdout judges it.
+pub fn improves(new: &Measures, parent: &Measures) -> bool {
+    new.invalid_fraction <= parent.invalid_fraction
+        || new.misfit_rms <= CLEAR_RMS_DROP * parent.misfit_rms
+}
+
+/// Number of modes of `m` at (or beyond) an edge of the band `[w_min, w_max]` (see
+/// [`BAND_EDGE_LN`]).
+pub fn modes_at_band_edge(m: &PhysicalModel, w_min: f64, w_max: f64) -> usize {
+    m.mode
+        .iter()
+        .filter(|md| {
+            let w = md.omega_n.ln();
+            w <= w_min.ln() + BAND_EDGE_LN || w >= w_max.ln() - BAND_EDGE_LN
+        })
+        .count()
+}
 
 /// Prior order among near-ties (lower first): fewer assumptions first.
 pub fn prior(c: &Cand) -> usize {
@@ -102,6 +133,7 @@ pub fn plausibility(
     entries: &[(usize, usize)],
     w_min: f64,
     w_max: f64,
+    quantity: Quantity,
 ) -> (Vec<String>, Option<String>) {
     if !v.is_finite() || th.iter().any(|x| !x.is_finite()) {
         return (
@@ -144,9 +176,9 @@ pub fn plausibility(
             if at(0) {
                 let w = th[0].exp();
                 let edge = if w < (w_min * w_max).sqrt() {
-                    "below: a mass line, see the rigid_body candidate"
+                    "below: the lower residual of modes below the band, see the integrator candidate of order 2"
                 } else {
-                    "above: a compliance line, see the feedthrough candidate"
+                    "above: the upper residual of modes above the band, see the feedthrough candidate"
                 };
                 flags.push(format!(
                     "ω_n at the band edge {}: the resonance is not inside the measured band ({edge})",
@@ -163,6 +195,14 @@ pub fn plausibility(
             }
         }
         Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
+        // On a mobility or an accelerance, c/s (displacement) is a constant mobility or an
+        // accelerance rising as ω: no structural term (a rigid body or the lower residual is
+        // c/s², the upper residual a constant D).
+        Cand::Integrator(1) if quantity != Quantity::Displacement => flags.push(format!(
+            "implausible on a {}: c/s in displacement is {} here, which no structural term gives (a rigid-body mode or the lower residual is c/s², the upper residual D)",
+            quantity.frf_name(),
+            if quantity == Quantity::Acceleration { "c·s" } else { "a constant c" }
+        )),
         // More than half a cycle of lag at the band top is not a transport or computation
         // delay a servo loop works with; it fits the slope of dynamics the model lacks.
         Cand::Delay(_) if th[0].abs() * w_max > MAX_DELAY_PHASE => flags.push(format!(
@@ -246,6 +286,7 @@ impl Problem<'_> {
                     &self.data.entries,
                     self.omega_min(),
                     self.omega_max(),
+                    self.base.quantity,
                 );
                 Screened {
                     cand: *c,

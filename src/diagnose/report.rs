@@ -46,7 +46,8 @@ pub struct CandidateReport {
     /// True when the numbers are after the joint refit of every parameter.
     pub joint_refit: bool,
     /// Passes: ΔBIC > 10 against the retuned model (the configured one for the retune),
-    /// invalid fraction not higher, physically plausible (no flags).
+    /// no more invalid data or `misfit_rms` down to 90 % ([`super::rank::improves`]),
+    /// physically plausible (no flags).
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
     pub tie_with_best: bool,
@@ -68,7 +69,8 @@ pub struct CandidateReport {
 
 impl CandidateReport {
     /// Why the tool rejected this candidate (`None` when it passes): no fit, a plausibility
-    /// flag, too small a ΔBIC, or more invalid data than the retune alone.
+    /// flag, too small a ΔBIC, or more invalid data than the retune alone without a clear fall
+    /// of `misfit_rms` ([`super::rank::improves`]).
     pub fn rejection(&self) -> Option<String> {
         if self.passes {
             return None;
@@ -91,8 +93,9 @@ impl CandidateReport {
             )
         } else {
             format!(
-                "more invalid data than the retune alone ({:.1} % with it)",
-                100.0 * self.invalid_fraction_after
+                "more invalid data than the retune alone ({:.1} % with it) and misfit_rms not down to {} % of the retune's",
+                100.0 * self.invalid_fraction_after,
+                100.0 * super::rank::CLEAR_RMS_DROP
             )
         })
     }

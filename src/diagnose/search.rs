@@ -7,8 +7,9 @@
 //!   scored by `ΔBIC = 2(V_node − V) − n·ln(2F)`; the best `beam + 1` that pass the screen
 //!   (ΔBIC > 10, plausible: no parameter at a bound, a mode inside the band) are written into
 //!   the model and **every** parameter is refit jointly (the node's own and the new
-//!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10 and its
-//!   invalid fraction is not higher.
+//!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10, it
+//!   improves on the node ([`super::rank::improves`]: no more invalid data, or `misfit_rms`
+//!   down to 90 % or less), and the refit left no new mode at a band edge.
 //! * **Level**: the children of all nodes, one per effect set (the best of the orders that
 //!   reach it), the `beam` lowest `BIC = 2V + n_θ·ln(2F)` kept.
 //! * **Stop** at the first level with a consistent node (fewest effects that explain the
@@ -25,9 +26,12 @@
 use super::candidates::Cand;
 use super::channels::Channels;
 use super::final_effects::final_effects;
+use super::holdout::same_set;
 use super::polish::settle;
 use super::problem::{Measures, Problem};
-use super::rank::{candidate_list, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC};
+use super::rank::{
+    candidate_list, improves, modes_at_band_edge, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC,
+};
 use super::report::Step;
 use super::retune::{retune, retune_within, ADDED_NOTE};
 use crate::error::Result;
@@ -87,12 +91,6 @@ impl Node {
     /// Labels of the effects, in order.
     pub fn labels(&self) -> Vec<String> {
         self.effects.iter().map(|(c, _)| c.label()).collect()
-    }
-
-    fn key(&self) -> Vec<String> {
-        let mut l = self.labels();
-        l.sort();
-        l
     }
 }
 
@@ -202,8 +200,12 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                         node.v_fit
                     };
                     let d_bic = 2.0 * (ref_v - v_fit) - n_new as f64 * ln2f;
-                    if d_bic > MIN_DELTA_BIC && m.invalid_fraction <= node.measures.invalid_fraction
-                    {
+                    // A mode the joint refit pushed to a band edge is not a resonance of the
+                    // data (it would be written at exactly the band top).
+                    let (w_lo, w_hi) = (data.omega[0], *data.omega.last().expect("data"));
+                    let at_edge = modes_at_band_edge(&model, w_lo, w_hi)
+                        > modes_at_band_edge(&node.model, w_lo, w_hi);
+                    if d_bic > MIN_DELTA_BIC && improves(&m, &node.measures) && !at_edge {
                         let mut effects = node.effects.clone();
                         effects.push((sc.cand, sc.mods.theta.clone()));
                         let mut steps = node.steps.clone();
@@ -254,10 +256,16 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                 }
             }
         }
-        // One node per effect set (the best order), the `beam` best kept.
+        // One node per effect set (the best order; added modes at different frequencies
+        // are different sets), the `beam` best kept.
         children.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-        let mut seen = std::collections::HashSet::new();
-        children.retain(|c| seen.insert(c.key()));
+        let mut kept: Vec<Node> = Vec::new();
+        for c in children {
+            if !kept.iter().any(|k| same_set(&k.effects, &c.effects)) {
+                kept.push(c);
+            }
+        }
+        let mut children = kept;
         children.truncate(s.beam.max(1));
         if children.is_empty() {
             break;

@@ -81,6 +81,10 @@ pub enum Hidden {
     Integrator2(f64),
     Feedthrough(f64),
     NmpZero(f64),
+    /// A mode far above the band `(ω_n, ζ, ρ)`: in the band the upper residual `ρ/ω_n²`.
+    ModeAbove(f64, f64, f64),
+    /// A mode far below the band: in the band the lower residual `ρ/s²`.
+    ModeBelow(f64, f64, f64),
 }
 
 pub fn effect(kind: EffectKind, set: impl Fn(&mut EffectSpec)) -> EffectSpec {
@@ -101,7 +105,9 @@ pub fn add(m: &mut PhysicalModel, h: &Hidden) {
         Hidden::NmpZero(z) => m
             .effect
             .push(effect(EffectKind::NmpZero, |e| e.z = Some(*z))),
-        Hidden::Mode(w, z, rho) => m.mode.push(mode(*w, *z, *rho)),
+        Hidden::Mode(w, z, rho) | Hidden::ModeAbove(w, z, rho) | Hidden::ModeBelow(w, z, rho) => {
+            m.mode.push(mode(*w, *z, *rho))
+        }
         Hidden::ModeShift(i, w) => m.mode[*i].omega_n = *w,
         Hidden::Integrator2(c) => m.rigid_body.push(PoleAtZeroSpec {
             friction_pole: None,
@@ -150,7 +156,14 @@ pub fn expected(h: &Hidden, has_rigid: bool) -> Option<(&'static str, Checks)> {
         Hidden::Integrator2(c) if !has_rigid => Some(("integrator", vec![("c", *c, 0.10)])),
         Hidden::Feedthrough(d) => Some(("feedthrough", vec![("d", *d, 0.15)])),
         Hidden::NmpZero(z) => Some(("nmp_zero", vec![("z", *z, 0.10)])),
-        Hidden::Gain(_) | Hidden::ModeShift(..) | Hidden::Integrator2(_) => None,
+        // The in-band effect of a mode far above the band is the upper residual ρ/ω_n² (its
+        // variation over the band, (ω/ω_n)² ≤ 4 %, is within the noise).
+        Hidden::ModeAbove(w, _, rho) => Some(("feedthrough", vec![("d", rho / (w * w), 0.15)])),
+        Hidden::ModeBelow(_, _, rho) if !has_rigid => Some(("integrator", vec![("c", *rho, 0.10)])),
+        Hidden::Gain(_)
+        | Hidden::ModeShift(..)
+        | Hidden::Integrator2(_)
+        | Hidden::ModeBelow(..) => None,
     }
 }
 
@@ -228,7 +241,7 @@ pub fn check(
                 let r = rho0(fm) / base_residue;
                 checks.push(("retuned residue ratio".into(), r, *k, 0.03));
             }
-            Hidden::Integrator2(c) if has_rigid => {
+            Hidden::Integrator2(c) | Hidden::ModeBelow(_, _, c) if has_rigid => {
                 let r = rho0(fm);
                 checks.push((
                     "retuned rigid-body residue".into(),
@@ -306,7 +319,10 @@ pub struct Case {
 
 pub fn cases(base: &PhysicalModel, w: &[f64]) -> Vec<Case> {
     let (wmin, wmax) = (w[0], *w.last().unwrap());
-    let g = |x: f64| base.eval_siso(x).norm();
+    // |G| of the displacement model (the measured quantity's (jω)^k divided out), so that
+    // the hidden effects are the same physical terms on a receptance and an accelerance.
+    let k = base.quantity.power() as i32;
+    let g = |x: f64| base.eval_siso(x).norm() / x.powi(k);
     // Mode residues: the added mode peaks at 30 % of the nominal's magnitude there.
     let rho = |wn: f64, z: f64| 0.3 * g(wn) * 2.0 * z * wn * wn;
     let robot = base.rigid_body.is_empty();
@@ -372,6 +388,33 @@ pub fn cases(base: &PhysicalModel, w: &[f64]) -> Vec<Case> {
     ]
 }
 
+/// Out-of-band modes (issue 20): a mode 5× above the band, whose in-band effect is the upper
+/// residual (30 % of |G| at the band top), and a mode 5× below it, whose in-band effect is the
+/// lower residual `ρ/s²` (30 % of |G| at the band bottom; with a rigid body in the model, a
+/// change of its residue).
+pub fn out_of_band_cases(base: &PhysicalModel, w: &[f64]) -> Vec<Case> {
+    let (wmin, wmax) = (w[0], *w.last().unwrap());
+    let k = base.quantity.power() as i32;
+    let g = |x: f64| base.eval_siso(x).norm() / x.powi(k);
+    let (above, below) = (5.0 * wmax, wmin / 5.0);
+    vec![
+        Case {
+            class: "mode above the band",
+            hidden: vec![Hidden::ModeAbove(
+                above,
+                0.02,
+                0.3 * g(wmax) * above * above,
+            )],
+            rough: None,
+        },
+        Case {
+            class: "mode below the band",
+            hidden: vec![Hidden::ModeBelow(below, 0.02, 0.3 * g(wmin) * wmin * wmin)],
+            rough: None,
+        },
+    ]
+}
+
 /// Which cases of the suite to run.
 pub struct Selection<'a> {
     /// Noise seeds.
@@ -409,6 +452,18 @@ impl Outcome {
 /// Runs the selected cases on model `base` over frequencies `w`; every diagnosis is also
 /// scanned ([`scan::scan_json`]: numbers finite, frequencies within 1e6× of the band).
 pub fn run_suite(name: &str, base: PhysicalModel, w: Vec<f64>, sel: &Selection) -> Outcome {
+    let cases = cases(&base, &w);
+    run_cases(name, base, w, cases, sel)
+}
+
+/// [`run_suite`] on the given cases.
+pub fn run_cases(
+    name: &str,
+    base: PhysicalModel,
+    w: Vec<f64>,
+    cases: Vec<Case>,
+    sel: &Selection,
+) -> Outcome {
     let mut failures = Vec::new();
     let mut per_class: BTreeMap<&'static str, (usize, usize)> = BTreeMap::new();
     let mut scanned = 0;
@@ -422,7 +477,7 @@ pub fn run_suite(name: &str, base: PhysicalModel, w: Vec<f64>, sel: &Selection) 
         }
     };
     let base_res = rho0(&base);
-    for (ci, case) in cases(&base, &w).into_iter().enumerate() {
+    for (ci, case) in cases.into_iter().enumerate() {
         if sel.cases.is_some_and(|c| !c.contains(&ci)) {
             continue;
         }

@@ -20,6 +20,9 @@ impl PhysicalModel {
         let mut m_diag = Vec::new();
         let mut n_rows: Vec<Vec<TransferFunction>> = Vec::new();
         let mut c_cols: Vec<Vec<f64>> = Vec::new();
+        // The measured quantity's s^k multiplies every term: a mode keeps its q(s) (degree 2
+        // ≥ k); a pole at zero cancels against s^k; the rest is written over (s + a)^deg.
+        let k = self.quantity.power() as usize;
         for md in &self.mode {
             let qk = q(md.omega_n);
             let d = Polynomial::new(vec![
@@ -31,33 +34,49 @@ impl PhysicalModel {
                 num: d,
                 den: qk.clone(),
             });
-            n_rows.push(over(&md.input_gain.to_vec(m), &qk));
+            n_rows.push(over(&md.input_gain.to_vec(m), &s_pow(k), &qk));
             c_cols.push(md.output_gain.to_vec(p));
         }
         for (list, order) in [(&self.rigid_body, 2usize), (&self.integrator, 1)] {
             for md in list {
-                let qk = if order == 2 {
-                    q(a)
-                } else {
-                    Polynomial::new(vec![1.0, a])
-                };
-                let mut num = vec![md.mass];
-                num.extend(std::iter::repeat_n(0.0, order));
-                if let Some(p) = md.friction_pole {
-                    num = vec![md.mass, md.mass * p, 0.0];
+                // c b s^k/(m s^z (s + p)): the powers of s cancel first.
+                let friction = md.friction_pole.filter(|_| order == 2);
+                let z = if friction.is_some() { 1 } else { order };
+                let n_s = z.min(k);
+                let num_order = k - n_s;
+                let mut d = Polynomial::constant(md.mass).mul(&s_pow(z - n_s));
+                if let Some(p) = friction {
+                    d = d.mul(&Polynomial::new(vec![1.0, p]));
                 }
+                let deg = d.degree().max(num_order);
+                let qk = if deg == 2 { q(a) } else { pole_power(a, deg) };
                 m_diag.push(TransferFunction {
-                    num: Polynomial::new(num),
+                    num: d,
                     den: qk.clone(),
                 });
-                n_rows.push(over(&md.input_gain.to_vec(m), &qk));
+                n_rows.push(over(&md.input_gain.to_vec(m), &s_pow(num_order), &qk));
                 c_cols.push(md.output_gain.to_vec(p));
             }
         }
         if let Some(d) = self.d_matrix() {
+            // D s^k: M̃ = 1/(s + a)^k, Ñ = D s^k/(s + a)^k (a zero row stays M̃ = 1, Ñ = 0).
             for i in 0..p {
-                m_diag.push(TransferFunction::gain(1.0));
-                n_rows.push((0..m).map(|j| TransferFunction::gain(d[(i, j)])).collect());
+                let zero = (0..m).all(|j| d[(i, j)] == 0.0);
+                let qk = if zero {
+                    pole_power(a, 0)
+                } else {
+                    pole_power(a, k)
+                };
+                m_diag.push(TransferFunction {
+                    num: Polynomial::constant(1.0),
+                    den: qk.clone(),
+                });
+                let num = if zero { s_pow(0) } else { s_pow(k) };
+                n_rows.push(over(
+                    &d.row(i).iter().copied().collect::<Vec<_>>(),
+                    &num,
+                    &qk,
+                ));
                 let mut col = vec![0.0; p];
                 col[i] = 1.0;
                 c_cols.push(col);
@@ -91,14 +110,28 @@ impl PhysicalModel {
     }
 }
 
-/// The row of `Ñ` for one modal coordinate: constant input gains over the common
+/// The row of `Ñ` for one modal coordinate: the input gains times `num(s)` over the common
 /// denominator `q(s)` of its row of `M̃`.
-fn over(gains: &[f64], q: &Polynomial) -> Vec<TransferFunction> {
+fn over(gains: &[f64], num: &Polynomial, q: &Polynomial) -> Vec<TransferFunction> {
     gains
         .iter()
         .map(|b| TransferFunction {
-            num: Polynomial::constant(*b),
+            num: num.scale(*b),
             den: q.clone(),
         })
         .collect()
+}
+
+/// `s^k`.
+fn s_pow(k: usize) -> Polynomial {
+    let mut c = vec![1.0];
+    c.extend(std::iter::repeat_n(0.0, k));
+    Polynomial::new(c)
+}
+
+/// `(s + a)^deg`.
+fn pole_power(a: f64, deg: usize) -> Polynomial {
+    (0..deg).fold(Polynomial::constant(1.0), |acc, _| {
+        acc.mul(&Polynomial::new(vec![1.0, a]))
+    })
 }

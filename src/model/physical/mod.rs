@@ -23,8 +23,13 @@
 //! path = "input"           # zoh: t_s (sample period, s); nmp_zero: z (rad/s)
 //! ```
 //!
+//! **Measured quantity.** `quantity = "displacement" | "velocity" | "acceleration"`
+//! (receptance, mobility, accelerance; default displacement): the model is `s^k` times the
+//! displacement model below, `k` = 0, 1, 2, so the terms keep their physical meaning (on an
+//! accelerance a rigid body is the mass line `c b/m`).
+//!
 //! **Exact evaluation.** [`PhysicalModel::eval`] returns
-//! `G(jω) = O(jω)·[Σ_k c_k b_kᵀ/(m_k d_k(jω)) + Σ c b/(m s²) + Σ c b/(m s) + D]·I(jω)` with
+//! `G(jω) = (jω)^k·O(jω)·[Σ_k c_k b_kᵀ/(m_k d_k(jω)) + Σ c b/(m s²) + Σ c b/(m s) + D]·I(jω)` with
 //! `d_k(s) = s² + 2ζ_kω_k s + ω_k²` and `I`, `O` the diagonal input- and output-path effects,
 //! evaluated exactly (a delay is `e^{−jωτ}`, a ZOH `e^{−jωT/2}·sin(ωT/2)/(ωT/2)`). `compare`
 //! and `diagnose` use this.
@@ -55,7 +60,7 @@ mod terms;
 mod validate;
 
 pub use effect::{pade, EffectKind, EffectPath, EffectSpec};
-pub use terms::{Feedthrough, Gains, ModeSpec, PoleAtZeroSpec};
+pub use terms::{Feedthrough, Gains, ModeSpec, PoleAtZeroSpec, Quantity};
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -68,6 +73,10 @@ pub struct PhysicalModel {
     /// Number of inputs (default: from the gains, else 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<usize>,
+    /// The measured quantity: `"displacement"` (default), `"velocity"` or `"acceleration"`;
+    /// the model is `s^k` times the displacement model ([`Quantity`]).
+    #[serde(default, skip_serializing_if = "Quantity::is_displacement")]
+    pub quantity: Quantity,
     /// Number of outputs (default: from the gains, else 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub outputs: Option<usize>,
@@ -139,7 +148,8 @@ impl PhysicalModel {
         }
     }
 
-    /// The dynamics without path effects, `Σ c bᵀ/(m·den(jω)) + D`, at `jω`.
+    /// The dynamics without path effects, `Σ c bᵀ/(m·den(jω)) + D`, at `jω`: the
+    /// displacement model, without the `(jω)^k` of the measured quantity.
     pub fn eval_core(&self, omega: f64) -> DMatrix<Complex64> {
         let (p, m) = (self.n_outputs(), self.n_inputs());
         let s = Complex64::new(0.0, omega);
@@ -173,9 +183,10 @@ impl PhysicalModel {
         g
     }
 
-    /// The exact plant `G(jω)` (`p×m`), delays and ZOH included exactly.
+    /// The exact plant `G(jω)` (`p×m`): `(jω)^k` (the measured quantity) times the
+    /// displacement model, delays and ZOH included exactly.
     pub fn eval(&self, omega: f64) -> DMatrix<Complex64> {
-        let mut g = self.eval_core(omega);
+        let mut g = self.eval_core(omega) * self.quantity.factor(omega);
         let (p, m) = (g.nrows(), g.ncols());
         for e in &self.effect {
             let v = e.eval(omega);

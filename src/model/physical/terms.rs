@@ -104,3 +104,82 @@ pub enum Feedthrough {
     /// Rows.
     Matrix(Vec<Vec<f64>>),
 }
+
+/// The measured quantity of a physical model (`[physical] quantity`): the model is
+/// `s^k` times the displacement model, `k` = 0, 1, 2 for a receptance (displacement/force),
+/// a mobility (velocity/force) or an accelerance (acceleration/force).  The terms of the
+/// model (modes, rigid bodies, feedthrough) keep their displacement meaning: on an
+/// accelerance a rigid body `c b/(m s²)` is the mass line `c b/m`, a mode becomes
+/// `c b s²/(m d(s))`, and the feedthrough (the upper residual, residual flexibility) `D s²`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// Receptance (the default).
+    #[default]
+    Displacement,
+    /// Mobility.
+    Velocity,
+    /// Accelerance (inertance).
+    Acceleration,
+}
+
+impl Quantity {
+    /// The power `k` of `s`.
+    pub fn power(self) -> u8 {
+        match self {
+            Quantity::Displacement => 0,
+            Quantity::Velocity => 1,
+            Quantity::Acceleration => 2,
+        }
+    }
+
+    /// `(jω)^k`.
+    pub fn factor(self, omega: f64) -> num_complex::Complex64 {
+        num_complex::Complex64::new(0.0, omega).powu(self.power() as u32)
+    }
+
+    /// The FRF's name: receptance, mobility or accelerance.
+    pub fn frf_name(self) -> &'static str {
+        match self {
+            Quantity::Displacement => "receptance",
+            Quantity::Velocity => "mobility",
+            Quantity::Acceleration => "accelerance",
+        }
+    }
+
+    pub(super) fn is_displacement(&self) -> bool {
+        *self == Quantity::Displacement
+    }
+}
+
+impl<'de> Deserialize<'de> for Quantity {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(QuantityVisitor)
+    }
+}
+
+/// Reads `[physical] quantity`; any other value is an error naming the key and the choices.
+struct QuantityVisitor;
+
+const QUANTITY_CHOICES: &str =
+    "\"displacement\" (receptance), \"velocity\" (mobility) or \"acceleration\" (accelerance)";
+
+impl serde::de::Visitor<'_> for QuantityVisitor {
+    type Value = Quantity;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "[physical] quantity = {QUANTITY_CHOICES}")
+    }
+
+    fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Quantity, E> {
+        match v {
+            "displacement" => Ok(Quantity::Displacement),
+            "velocity" => Ok(Quantity::Velocity),
+            "acceleration" => Ok(Quantity::Acceleration),
+            other => Err(E::custom(format!(
+                "[physical] quantity = \"{}\" is not a measured quantity: write {QUANTITY_CHOICES}",
+                other.chars().take(40).collect::<String>(),
+            ))),
+        }
+    }
+}

@@ -1,0 +1,261 @@
+//! Real impact-hammer data (../shared/data/pyfrf-impact, accelerance of a free body, three
+//! close modes at 810, 851 and 900 Hz with ζ ≈ 1e-3): discovery step by step.
+//!
+//! The noise radius comes from the coherence γ² of the H1 estimate over `n` = 5 averages:
+//! the random error of `|H1|` is `ε = √(1 − γ²)/(|γ|·√(2n))` (Bendat & Piersol, *Random Data*,
+//! Table 9.6), and the radius is 3ε|H| (3σ, as `std_factor = 3` elsewhere).
+
+use num_complex::Complex64;
+use rshape::diagnose::retune::cost;
+use rshape::diagnose::Diagnosis;
+use rshape::diagnose::{diagnose_channels, retune_within, Channels, SearchSettings};
+use rshape::model::physical::{
+    Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec, Quantity,
+};
+use std::path::Path;
+
+const TAU: f64 = std::f64::consts::TAU;
+const DIR: &str = "../shared/data/pyfrf-impact";
+
+fn columns(path: &Path) -> Vec<Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.trim().parse().unwrap()).collect())
+        .collect()
+}
+
+/// The accelerance on `[f_lo, f_hi]` Hz with its noise radius from the coherence.
+fn pyfrf(f_lo: f64, f_hi: f64) -> Channels {
+    let h = columns(&Path::new(DIR).join("frf_h1.csv"));
+    let c = columns(&Path::new(DIR).join("frf_h1_coherence.csv"));
+    let (mut omega, mut g, mut radius) = (vec![], vec![], vec![]);
+    for (row, coh) in h.iter().zip(&c) {
+        assert_eq!(row[0], coh[0]);
+        if row[0] < f_lo || row[0] > f_hi {
+            continue;
+        }
+        let gamma2 = coh[1].clamp(1e-6, 1.0 - 1e-9);
+        let hv = Complex64::new(row[1], row[2]);
+        let eps = ((1.0 - gamma2) / (gamma2 * 2.0 * 5.0)).sqrt();
+        omega.push(TAU * row[0]);
+        g.push(hv);
+        radius.push(3.0 * eps * hv.norm());
+    }
+    Channels {
+        path: DIR.into(),
+        omega,
+        entries: vec![(0, 0)],
+        g: vec![g],
+        radius: vec![radius],
+        radius_source: vec!["coherence".into()],
+    }
+}
+
+/// The mass line of the free body (the accelerance's constant), as a displacement-type model.
+fn mass_line() -> PhysicalModel {
+    PhysicalModel {
+        feedthrough: Some(Feedthrough::Scalar(-1.2)),
+        ..Default::default()
+    }
+}
+
+fn mode(f_hz: f64, zeta: f64, rho: f64) -> ModeSpec {
+    ModeSpec {
+        name: None,
+        omega_n: TAU * f_hz,
+        zeta,
+        mass: 1.0,
+        input_gain: Gains::Scalar(1.0),
+        output_gain: Gains::Scalar(rho),
+    }
+}
+
+/// The hand check, independent of the holdout code: with the 900 Hz mode in the
+/// model, the 810 Hz mode lowers the held-out cost in every one of the four interleaved
+/// splits (fit on 3 of every 4 lines, test on the fourth), and the diagnosis keeps it.
+#[test]
+fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
+    let data = pyfrf(20.0, 1200.0);
+    let s = SearchSettings {
+        max_effects: 1,
+        beam: 3,
+    };
+    // Step 1 from the mass line: the 900 Hz mode (the largest peak).
+    let d1 = diagnose_channels(&mass_line(), &data, &s).unwrap();
+    let with_900 = d1.final_model.clone();
+    assert_eq!(with_900.mode.len(), 1, "{}", d1.message);
+    let f900 = with_900.mode[0].omega_n / TAU;
+    assert!(
+        (f900 - 900.0).abs() < 5.0,
+        "step 1 added a mode at {f900} Hz"
+    );
+    // The 810 Hz mode added by hand (residue from the peak height: |G| ≈ ρ/(2ζω²)).
+    let mut with_810 = with_900.clone();
+    with_810.mode.push(mode(810.0, 1.3e-3, -8.4e6));
+    let with_810 = retune_within(&with_810, &with_900, &data, None, true).model;
+    let f: Vec<f64> = with_810.mode.iter().map(|m| m.omega_n / TAU).collect();
+    assert!(f.iter().any(|x| (x - 810.0).abs() < 3.0), "{f:?}");
+    let n = data.len();
+    for j in 0..4 {
+        let fit: Vec<usize> = (0..n).filter(|k| k % 4 != j).collect();
+        let test: Vec<usize> = (0..n).filter(|k| k % 4 == j).collect();
+        let held_out = |m: &PhysicalModel| {
+            cost(
+                &retune_within(m, &with_900, &data, Some(&fit), false).model,
+                &data,
+                &test,
+            )
+        };
+        let (v_with, v_without) = (held_out(&with_810), held_out(&with_900));
+        println!(
+            "split {j}: held-out V with 810 Hz {v_with:.4e}, without {v_without:.4e}, ratio {:.1}",
+            v_without / v_with
+        );
+        assert!(
+            v_with < 0.5 * v_without,
+            "split {j}: {v_with} vs {v_without}"
+        );
+    }
+    // The diagnosis from the model with the 900 Hz mode adds the 810 Hz mode and keeps it.
+    let d2 = diagnose_channels(&with_900, &data, &s).unwrap();
+    println!("{}\n{:?}\n{:?}", d2.message, d2.holdout, d2.dropped);
+    assert!(d2.dropped.is_empty(), "{:?}", d2.dropped);
+    let f: Vec<f64> = d2
+        .final_model
+        .mode
+        .iter()
+        .map(|m| m.omega_n / TAU)
+        .collect();
+    assert!(f.iter().any(|x| (x - 810.0).abs() < 3.0), "{f:?}");
+    assert!(f.iter().any(|x| (x - 900.0).abs() < 3.0), "{f:?}");
+}
+
+/// The free body as an accelerance: the mass line is a rigid body `c/(m s²)` times `s²`.
+fn accelerance_mass_line() -> PhysicalModel {
+    PhysicalModel {
+        quantity: Quantity::Acceleration,
+        rigid_body: vec![PoleAtZeroSpec {
+            name: None,
+            mass: 1.0,
+            input_gain: Gains::Scalar(1.0),
+            output_gain: Gains::Scalar(-1.2),
+            friction_pole: None,
+        }],
+        ..Default::default()
+    }
+}
+
+/// One `diagnose` per step, its chosen set applied (`--apply chosen`), until nothing passes.
+fn walk(data: &Channels, max_steps: usize) -> Vec<Diagnosis> {
+    let mut m = accelerance_mass_line();
+    let mut out = Vec::new();
+    for _ in 0..max_steps {
+        let t = std::time::Instant::now();
+        let s = SearchSettings {
+            max_effects: 1,
+            beam: 3,
+        };
+        let d = diagnose_channels(&m, data, &s).unwrap();
+        let modes: Vec<String> = d
+            .final_model
+            .mode
+            .iter()
+            .map(|x| format!("{:.1} Hz (ζ {:.2e})", x.omega_n / TAU, x.zeta))
+            .collect();
+        println!(
+            "step {} ({:.1} s): {}\n  modes {modes:?}, dropped by the holdout {:?}",
+            out.len() + 1,
+            t.elapsed().as_secs_f64(),
+            d.message,
+            d.dropped
+        );
+        let done = d.chosen.is_empty();
+        if !done {
+            m = d.final_model.clone();
+        }
+        out.push(d);
+        if done {
+            break;
+        }
+    }
+    out
+}
+
+fn has_mode(m: &PhysicalModel, f_hz: f64, tol_hz: f64) -> bool {
+    m.mode
+        .iter()
+        .any(|x| (x.omega_n / TAU - f_hz).abs() < tol_hz)
+}
+
+/// docs/guide/discovery-walkthrough.md, section 6: on 20–1200 Hz, as an accelerance, the
+/// three close modes (810, 851, 900 Hz, ζ ≈ 1e-3) in three steps, `misfit_rms` falling at
+/// every step; the invalid fraction falls over the walk and at steps 2 and 3 (step 1 raises
+/// it: the one mass-line constant is shared by the bands below and above the cluster, see
+/// the guide); then nothing more passes (a fourth mode at 824 Hz is dropped by the holdout).
+#[test]
+fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
+    let data = pyfrf(20.0, 1200.0);
+    let steps = walk(&data, 5);
+    assert_eq!(steps.len(), 4, "three applied steps, then nothing passes");
+    let last = &steps[2].final_model;
+    for f in [810.0, 851.0, 900.0] {
+        assert!(has_mode(last, f, 2.0), "no mode at {f} Hz: {:?}", last.mode);
+    }
+    assert_eq!(last.mode.len(), 3);
+    for m in &last.mode {
+        assert!((5e-4..3e-3).contains(&m.zeta), "ζ = {}", m.zeta);
+    }
+    for (k, d) in steps[..3].iter().enumerate() {
+        assert_eq!(d.chosen, ["mode"], "step {}", k + 1);
+        assert!(
+            d.after.misfit_rms < 0.5 * d.before.misfit_rms,
+            "step {}: {:?} -> {:?}",
+            k + 1,
+            d.before,
+            d.after
+        );
+        if k > 0 {
+            assert!(
+                d.after.invalid_fraction < d.before.invalid_fraction,
+                "step {}",
+                k + 1
+            );
+        }
+    }
+    assert!(steps[2].after.invalid_fraction < 0.65 * steps[0].before.invalid_fraction);
+    // Nothing is applied after the third step, and no flagged candidate was ever written.
+    assert!(steps[3].chosen.is_empty(), "{}", steps[3].message);
+    // The 1/s term on an accelerance is flagged as implausible, never applied.
+    for d in &steps {
+        for c in d.candidates.iter().filter(|c| c.effect == "integrator") {
+            if c.params.get("order") == Some(&1.0) {
+                assert!(!c.passes && c.flags.iter().any(|f| f.contains("accelerance")));
+            }
+        }
+    }
+}
+
+/// The whole band, 20–5000 Hz (48 s for five steps at opt-level 1): the modes found, and
+/// nothing at a band edge.  Found: 900, 3664, 4126, 810 Hz; then the best single mode
+/// runs to the 5000 Hz edge (flagged, not applied) and the upper residual lowers the error
+/// too little: 851, 2640, 3035, 4160, 4390 Hz are not found (docs/guide/discovery-walkthrough.md).
+#[test]
+#[ignore = "the whole band: about 48 s at opt-level 1"]
+fn pyfrf_accelerance_whole_band() {
+    let data = pyfrf(20.0, 5000.0);
+    let steps = walk(&data, 10);
+    let last = &steps.last().unwrap().final_model;
+    for f in [900.0, 3664.0, 4126.0, 810.0] {
+        assert!(has_mode(last, f, 3.0), "no mode at {f} Hz: {:?}", last.mode);
+    }
+    let w_max = TAU * 5000.0;
+    for d in &steps {
+        assert!(
+            d.final_model.mode.iter().all(|m| m.omega_n < 0.99 * w_max),
+            "a mode at the band edge: {:?}",
+            d.final_model.mode
+        );
+        assert!(d.after.misfit_rms < d.before.misfit_rms || d.chosen.is_empty());
+    }
+}
