@@ -10,8 +10,8 @@ use nalgebra::DMatrix;
 use rshape::model::plant::PlantSection;
 use rshape::model::Factorization;
 use rshape::stability::theorem1_system;
-use rshape::system::hinf::hinf_norm;
-use rshape::system::ncf::NormalizedLcf;
+use rshape::system::hinf_norm;
+use rshape::system::NormalizedLcf;
 use rshape::system::{logspace, StateSpace};
 use std::path::Path;
 

@@ -11,8 +11,8 @@ use rshape::model::controller::{Controller, Feedback};
 use rshape::model::Factorization;
 use rshape::stability::{analyze, gang_of_four, Verdict};
 use rshape::synthesis::{optimum, synthesize};
-use rshape::system::hinf::hinf_norm;
-use rshape::system::ncf::NormalizedLcf;
+use rshape::system::hinf_norm;
+use rshape::system::NormalizedLcf;
 use rshape::system::{logspace, StateSpace, TransferFunction};
 use std::path::{Path, PathBuf};
 
@@ -36,7 +36,7 @@ fn lyap_kron(a: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
 fn hankel_norm(ss: &StateSpace) -> f64 {
     let p = lyap_kron(&ss.a, &(&ss.b * ss.b.transpose()));
     let q = lyap_kron(&ss.a.transpose(), &(ss.c.transpose() * &ss.c));
-    let e = rshape::system::eig::eigenvalues(&(p * q), "pq").unwrap();
+    let e = rshape::system::eigenvalues(&(p * q), "pq").unwrap();
     e.iter().map(|z| z.re).fold(0.0, f64::max).sqrt()
 }
 
@@ -65,8 +65,8 @@ fn b_opt_matches_the_hankel_norm_route_and_the_central_controller_attains_it() {
     let (mut unstable, mut matched) = (0, 0);
     for seed in 0..64u64 {
         let plant = random_plant(seed);
-        let poles = rshape::system::eig::eigenvalues(&plant.a, "p").unwrap();
-        if rshape::system::eig::spectral_abscissa(&poles) > 0.0 {
+        let poles = rshape::system::eigenvalues(&plant.a, "p").unwrap();
+        if rshape::system::spectral_abscissa(&poles) > 0.0 {
             unstable += 1;
         }
         let ncf = NormalizedLcf::new(plant.clone()).unwrap();
@@ -355,8 +355,8 @@ fn reduced_controller_is_re_proved() {
             continue;
         };
         let gm = synthesize(&ncf, 1.1).unwrap();
-        let kp = rshape::system::eig::eigenvalues(&gm.k.a, "k").unwrap();
-        if rshape::system::eig::spectral_abscissa(&kp) >= -1e-6 {
+        let kp = rshape::system::eigenvalues(&gm.k.a, "k").unwrap();
+        if rshape::system::spectral_abscissa(&kp) >= -1e-6 {
             continue;
         }
         let n = plant.states();
