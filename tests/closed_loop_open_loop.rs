@@ -5,7 +5,7 @@
 //! of the noise disk.
 
 use num_complex::Complex64;
-use rshape::consistency::closed_loop::noise_free::delta_bar;
+use rshape::consistency::closed_loop::delta_bar;
 use rshape::consistency::noise_free_envelope;
 use rshape::data::closed_loop::read_closed_loop_csv;
 use rshape::data::read_frf_csv;

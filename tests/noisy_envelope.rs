@@ -4,8 +4,8 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::consistency::noise_free::{r_min_special, r_min_standard};
-use rshape::consistency::noisy::{gamma_lft, r_min_noisy, v_matrix, NoisyFailure};
+use rshape::consistency::{r_min_special, r_min_standard};
+use rshape::consistency::{gamma_lft, r_min_noisy, v_matrix, NoisyFailure};
 use rshape::consistency::{check, noisy_envelope, noisy_envelope_report, BisectionSettings};
 use rshape::data::FrfData;
 use rshape::model::{Config, Factorization, FactorsAt};

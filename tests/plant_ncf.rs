@@ -6,7 +6,7 @@ use common::repo;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::consistency::envelope::noise_free_envelope;
+use rshape::consistency::noise_free_envelope;
 use rshape::data::FrfData;
 use rshape::model::Config;
 use rshape::system::{eigenvalues, spectral_abscissa};
