@@ -3,7 +3,7 @@
 use rshape::consistency::noise_free_envelope;
 use rshape::consistency::noise_free_envelope_rows;
 use rshape::data::read_frf_csv;
-use rshape::data::reader::FrfRows;
+use rshape::data::FrfRows;
 use rshape::model::Config;
 use std::path::Path;
 

@@ -25,7 +25,7 @@ fn robot() -> Config {
 }
 
 fn robot_data(cfg: &Config) -> FrfData {
-    rshape::data::reader::read_frf_csv(cfg.data.as_ref().unwrap()).expect("configs/robot.csv reads")
+    rshape::data::read_frf_csv(cfg.data.as_ref().unwrap()).expect("configs/robot.csv reads")
 }
 
 /// Undamped natural frequencies `√(b_k/4)` of the five modes of eq. (19).
