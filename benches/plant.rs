@@ -7,7 +7,7 @@
 
 use divan::{black_box, Bencher};
 use nalgebra::DMatrix;
-use rshape::model::plant::PlantSection;
+use rshape::model::PlantSection;
 use rshape::model::Factorization;
 use rshape::stability::theorem1_system;
 use rshape::system::hinf_norm;

@@ -9,7 +9,7 @@ mod common;
 use common::{rshape, stdout};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
-use rshape::model::controller::Controller;
+use rshape::model::Controller;
 use rshape::model::Config;
 use rshape::stability::{analyze, Verdict};
 use rshape::system::hinf_norm;

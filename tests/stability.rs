@@ -5,7 +5,7 @@ mod common;
 use common::{repo, rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::model::controller::Controller;
+use rshape::model::Controller;
 use rshape::model::Config;
 use rshape::stability::{analyze, gang_of_four};
 use rshape::system::hinf_norm;

@@ -7,7 +7,7 @@ mod common;
 use common::{rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
-use rshape::model::controller::{Controller, Feedback};
+use rshape::model::{Controller, Feedback};
 use rshape::model::Factorization;
 use rshape::stability::{analyze, gang_of_four, Verdict};
 use rshape::synthesis::{optimum, synthesize};
