@@ -7,8 +7,8 @@
 
 use divan::{black_box, Bencher};
 use nalgebra::DMatrix;
-use rshape::model::PlantSection;
 use rshape::model::Factorization;
+use rshape::model::PlantSection;
 use rshape::stability::theorem1_system;
 use rshape::system::hinf_norm;
 use rshape::system::NormalizedLcf;

@@ -9,8 +9,8 @@ use proptest::prelude::*;
 use rshape::consistency::noise_free_envelope;
 use rshape::data::FrfData;
 use rshape::model::Config;
-use rshape::system::{eigenvalues, spectral_abscissa};
 use rshape::system::NormalizedLcf;
+use rshape::system::{eigenvalues, spectral_abscissa};
 use rshape::system::{logspace, StateSpace};
 use std::path::{Path, PathBuf};
 

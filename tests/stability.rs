@@ -5,8 +5,8 @@ mod common;
 use common::{repo, rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::model::Controller;
 use rshape::model::Config;
+use rshape::model::Controller;
 use rshape::stability::{analyze, gang_of_four};
 use rshape::system::hinf_norm;
 use rshape::system::{logspace, StateSpace, TransferFunction};
@@ -92,9 +92,8 @@ fn random_stable(seed: u64, n: usize, p: usize, m: usize, with_d: bool) -> State
     let mut r = |_, _| rng.gen_range(-1.0..1.0);
     let a0 = DMatrix::from_fn(n, n, &mut r) * 3.0;
     // Shift to make A stable with a moderately damped slowest mode.
-    let abscissa = rshape::system::spectral_abscissa(
-        &rshape::system::eigenvalues(&a0, "a").unwrap(),
-    );
+    let abscissa =
+        rshape::system::spectral_abscissa(&rshape::system::eigenvalues(&a0, "a").unwrap());
     let a = a0 - DMatrix::identity(n, n) * (abscissa + 0.3);
     let b = DMatrix::from_fn(n, m, &mut r);
     let c = DMatrix::from_fn(p, n, &mut r);

@@ -3,8 +3,8 @@
 //! Exit 0 robustly stable for every bound given, 1 not (including a controller that does
 //! not stabilize the nominal plant), 2 error.
 
-use crate::model::Controller;
 use crate::model::Config;
+use crate::model::Controller;
 use crate::pipeline::stability;
 use anyhow::{anyhow, Result};
 use clap::Args;

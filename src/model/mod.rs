@@ -30,18 +30,16 @@ pub mod physical;
 pub(crate) mod plant;
 
 pub use config::{
-    ChannelSection, Config, ModelSection, NoiseSection, RSection, RationalEntry, RawConfig,
-    TfEntry,
+    ChannelSection, Config, ModelSection, NoiseSection, RSection, RationalEntry, RawConfig, TfEntry,
 };
 pub use controller::{Controller, ControllerSection, Feedback};
 pub use coprime::{
-    check_left_coprime, check_right_coprime, check_stable, common_zero, CommonZero,
-    COPRIME_TOL, MAX_COFACTOR_SIZE,
+    check_left_coprime, check_right_coprime, check_stable, common_zero, CommonZero, COPRIME_TOL,
+    MAX_COFACTOR_SIZE,
 };
 pub use factorization::{sigma_min, Factorization, FactorizationKind, FactorsAt};
 pub use noise::{
     is_noise_free, linf_disk_radius, noise_radii, noise_source, phase_bound,
-    radii_from_output_bound, resolve_noise, resolve_noise_for_channel, NoiseSource,
-    ResolvedNoise,
+    radii_from_output_bound, resolve_noise, resolve_noise_for_channel, NoiseSource, ResolvedNoise,
 };
 pub use plant::PlantSection;
