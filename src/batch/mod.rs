@@ -3,7 +3,7 @@
 //! combined envelope (pointwise maximum) and one `r` fitted above it.
 //!
 //! Output directory `OUT/`:
-//! - `summary.csv`: one row per dataset ([`summary`]);
+//! - `summary.csv`: one row per dataset ([`SummaryRow`]);
 //! - `datasets/NAME/envelope.csv`, `datasets/NAME/result.json`: per dataset;
 //! - `combined_envelope.csv`: the combined envelope ([`combine`]);
 //! - `r.json` (and the other exports of the fit): one `r` covering every dataset;

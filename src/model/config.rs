@@ -83,7 +83,7 @@ pub struct RSection {
     pub den: Vec<f64>,
 }
 
-/// The `[noise]` table (see [`crate::model::noise`] for how the keys are resolved).
+/// The `[noise]` table (see [`crate::model::resolve_noise`] for how the keys are resolved).
 ///
 /// ```toml
 /// [noise]

@@ -252,7 +252,7 @@ impl ClosedLoopModel {
     }
 
     /// As [`Self::build`], with the nominal's factors given from outside (`[physical]`,
-    /// see [`physical_nominal`]) when `[closed_loop]` does not give the plant itself.
+    /// see [`rcf_from_modal`]) when `[closed_loop]` does not give the plant itself.
     pub fn build_with_plant(
         s: &ClosedLoopSection,
         nominal: Option<RightFactors>,
