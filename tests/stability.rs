@@ -459,3 +459,73 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     assert!(!out_dir.exists());
     let _ = Complex64::new(0.0, 0.0);
 }
+
+/// The title of `stability.svg` never drops the controller's name: a long model name is cut in
+/// the middle first (its beginning and end stay), the title stays within one caption line, and
+/// short titles are untouched.  End to end, the figure written by `rshape stability` carries
+/// the controller's file name.
+#[test]
+fn stability_title_keeps_the_controller_name() {
+    use rshape::pipeline::stability::{figure_title, FIGURE_TITLE_CHARS};
+    let long_name = format!(
+        "flexible robot arm {} five modes, tip sensor, revision 7",
+        "with a very long description ".repeat(3)
+    );
+    let config = |name: &str| {
+        Config::parse(
+            &format!("name = \"{name}\"\n[plant]\ntf = [[{{ num = [1], den = [1, 1, 0] }}]]\n"),
+            Path::new("t.toml"),
+        )
+        .unwrap()
+    };
+    let k = "K = robot_controller.toml";
+    let t = figure_title(&config(&long_name), k);
+    assert!(t.chars().count() <= FIGURE_TITLE_CHARS, "{t}");
+    assert!(t.ends_with(&format!(", {k}")), "{t}");
+    assert!(
+        t.contains("— flexible") && t.contains("revision 7, K") && t.contains('…'),
+        "{t}"
+    );
+    let short = figure_title(&config("robot"), k);
+    assert_eq!(short, format!("Theorem 1: 1/σ_max(T) vs |r| — robot, {k}"));
+    // An absurdly long controller name is cut in the middle too, keeping its end.
+    let long_k = format!("K = {}final.toml", "controller_".repeat(10));
+    let t = figure_title(&config(&long_name), &long_k);
+    assert!(t.chars().count() <= FIGURE_TITLE_CHARS, "{t}");
+    assert!(t.ends_with("final.toml") && t.contains("flexible"), "{t}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("configs/plant_first.toml"))
+        .unwrap()
+        .replace(
+            "name = \"integrator plus lag, plant given as a transfer function\"",
+            &format!("name = \"{long_name}\""),
+        )
+        .replace(
+            "data = \"plant_first.csv\"",
+            &format!("data = \"{}\"", repo("configs/plant_first.csv").display()),
+        );
+    let cfg = write(dir.path(), "long.toml", &text);
+    let out = dir.path().join("out");
+    let o = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        repo("configs/plant_first_controller.toml")
+            .to_str()
+            .unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(1)),
+        "{}",
+        stderr(&o)
+    );
+    let svg = std::fs::read_to_string(out.join("stability.svg")).unwrap();
+    assert!(
+        svg.contains(", K = plant_first_controller.toml\n</text>"),
+        "{}",
+        stdout(&o)
+    );
+}
