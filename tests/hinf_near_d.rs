@@ -9,11 +9,9 @@ mod common;
 use common::{rshape, stdout};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
-use rshape::model::Config;
-use rshape::model::Controller;
+use rshape::model::{Config, Controller};
 use rshape::stability::{analyze, Verdict};
-use rshape::system::hinf_norm;
-use rshape::system::{logspace, StateSpace};
+use rshape::system::{hinf_norm, logspace, StateSpace};
 use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

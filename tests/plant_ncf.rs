@@ -9,9 +9,7 @@ use proptest::prelude::*;
 use rshape::consistency::noise_free_envelope;
 use rshape::data::FrfData;
 use rshape::model::Config;
-use rshape::system::NormalizedLcf;
-use rshape::system::{eigenvalues, spectral_abscissa};
-use rshape::system::{logspace, StateSpace};
+use rshape::system::{eigenvalues, logspace, spectral_abscissa, NormalizedLcf, StateSpace};
 use std::path::{Path, PathBuf};
 
 /// Worst normalization error ‖M̃M̃* + ÑÑ* − I‖ and worst relative error of M̃⁻¹Ñ against

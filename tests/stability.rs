@@ -5,11 +5,9 @@ mod common;
 use common::{repo, rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::model::Config;
-use rshape::model::Controller;
+use rshape::model::{Config, Controller};
 use rshape::stability::{analyze, gang_of_four};
-use rshape::system::hinf_norm;
-use rshape::system::{logspace, StateSpace, TransferFunction};
+use rshape::system::{hinf_norm, logspace, StateSpace, TransferFunction};
 use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
