@@ -7,7 +7,7 @@
 #[path = "support/gen.rs"]
 mod gen;
 
-use rshape::batch::{self, combine::combine, discover, runner, shard::Shard, summary::SummaryRow};
+use rshape::batch::{self, combine, discover_dir, run_all, BatchSettings, Shard, SummaryRow};
 use rshape::model::Config;
 use std::path::PathBuf;
 
@@ -46,12 +46,12 @@ fn batch_1000(bencher: divan::Bencher) {
         .with_inputs(|| tempfile::tempdir().unwrap())
         .bench_local_values(|out| {
             let t = std::time::Instant::now();
-            let list = discover::from_dir(dir.path()).unwrap();
-            let opts = runner::BatchSettings {
+            let list = discover_dir(dir.path()).unwrap();
+            let opts = BatchSettings {
                 noise_radius: None,
                 per_dataset_files: true,
             };
-            let res = runner::run_all(&config, &list, &opts, out.path(), &|| {});
+            let res = run_all(&config, &list, &opts, out.path(), &|| {});
             assert!(
                 res.iter().all(|r| r.ok()),
                 "{:?}",

@@ -6,8 +6,8 @@
 //!
 //! Run: `cargo bench --bench closed_loop -- --sample-count 5`.
 use rshape::consistency::closed_loop::closed_loop_envelope;
-use rshape::consistency::closed_loop::noisy::VBisectionSettings;
-use rshape::consistency::noisy::{noisy_envelope, BisectionSettings};
+use rshape::consistency::closed_loop::VBisectionSettings;
+use rshape::consistency::{noisy_envelope, BisectionSettings};
 use rshape::data::FrfData;
 use rshape::model::Config;
 use std::path::Path;

@@ -6,8 +6,7 @@
 use divan::{black_box, Bencher};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::noisy::{gamma_lft, r_min_noisy};
-use rshape::consistency::{noisy_envelope, BisectionSettings};
+use rshape::consistency::{gamma_lft, noisy_envelope, r_min_noisy, BisectionSettings};
 use rshape::data::{read_frf_csv, FrfData};
 use rshape::model::Config;
 use rshape::mu::{mu_full_scalar, FullPlusScalar, MuSettings};

@@ -7,12 +7,9 @@
 
 use divan::{black_box, Bencher};
 use nalgebra::DMatrix;
-use rshape::model::plant::PlantSection;
-use rshape::model::Factorization;
+use rshape::model::{Factorization, PlantSection};
 use rshape::stability::theorem1_system;
-use rshape::system::hinf::hinf_norm;
-use rshape::system::ncf::NormalizedLcf;
-use rshape::system::{logspace, StateSpace};
+use rshape::system::{hinf_norm, logspace, NormalizedLcf, StateSpace};
 use std::path::Path;
 
 fn main() {

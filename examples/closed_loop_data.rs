@@ -48,7 +48,7 @@ fn c_bar(w: f64) -> Complex64 {
 /// Asserts that both controllers stabilize the true plant (the experiments are feasible):
 /// `P₀ = N/D` with `N = 2875/q`, `D = s²(s² + s + 2500)(0.004s + 1)/q`, `q = (s+2)⁵`.
 fn check_experiments() -> anyhow::Result<()> {
-    use rshape::model::closed_loop::stability::check_loop;
+    use rshape::model::closed_loop::check_loop;
     use rshape::system::{Polynomial, TfMatrix, TransferFunction};
     let q = (0..5).fold(Polynomial::constant(1.0), |a, _| {
         a.mul(&Polynomial::new(vec![1.0, 2.0]))

@@ -62,6 +62,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 
 pub mod batch;
 pub mod consistency;
@@ -83,7 +84,8 @@ pub mod util;
 pub use error::{Error, Result};
 
 // The curated surface: the types and calls of the pipeline, in its order.  Everything else
-// stays reachable through its module for advanced use.
+// is reachable at its folder (`rshape::system::hinf_norm`): the files inside `system`,
+// `consistency`, `data`, `model`, `mu`, `report`, `batch` and `stability` are private.
 
 /// Per-frequency envelope of the smallest consistent `|r|`, chosen for the config
 /// ([`pipeline::envelope::envelope`]), and the check of a given `r` against it.

@@ -22,7 +22,7 @@ pub struct InvalidSetting {
 
 /// Checks the fields of one settings value, in order; the first failure is kept.
 #[derive(Debug)]
-pub struct Checker {
+pub(crate) struct Checker {
     settings: &'static str,
     first: Option<InvalidSetting>,
 }

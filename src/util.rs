@@ -1,5 +1,7 @@
-//! Small helpers shared by the I/O code: atomic file writes, whole or streamed, and the
-//! record of what a run wrote into its output folder ([`OutputManifest`]).
+//! Small helpers shared by the I/O code: atomic file writes, whole ([`write_atomic`],
+//! [`write_atomic_nosync`]) or streamed ([`AtomicFile`]), and the record of what a run wrote
+//! into its output folder ([`OutputManifest`]).  The capped readers of input files and the
+//! quoting of input in messages are internal to the crate.
 
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -205,7 +207,7 @@ fn create_dir_error(dir: &Path, source: std::io::Error) -> Error {
 
 /// Opens `path` for reading, refusing anything but a regular file (after symlinks): a FIFO
 /// without a writer would block forever, and `/dev/zero` or `/dev/urandom` never end.
-pub fn open_regular(path: &Path) -> Result<std::fs::File> {
+pub(crate) fn open_regular(path: &Path) -> Result<std::fs::File> {
     let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
@@ -225,7 +227,7 @@ pub fn open_regular(path: &Path) -> Result<std::fs::File> {
 }
 
 /// Reads a whole regular file ([`open_regular`]) of at most `cap` bytes.
-pub fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
+pub(crate) fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
     use std::io::Read;
     let file = open_regular(path)?;
     let mut bytes = Vec::new();
@@ -246,11 +248,11 @@ pub fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
 }
 
 /// Largest config, controller or `r.json` read whole.
-pub const MAX_TEXT_FILE: u64 = 64 << 20;
+pub(crate) const MAX_TEXT_FILE: u64 = 64 << 20;
 
 /// Largest data file read whole (closed-loop data, noise std files, envelope files; the
 /// FRF files of `envelope` are streamed and have no such cap).
-pub const MAX_DATA_FILE: u64 = 1 << 30;
+pub(crate) const MAX_DATA_FILE: u64 = 1 << 30;
 
 fn file_kind(meta: &std::fs::Metadata) -> &'static str {
     #[cfg(unix)]
@@ -273,7 +275,7 @@ fn file_kind(meta: &std::fs::Metadata) -> &'static str {
 
 /// Input text quoted in a message: at most [`ECHO_CHARS`] characters, `…` marking a cut,
 /// so a huge field never becomes a huge message.
-pub fn echo(s: &str) -> String {
+pub(crate) fn echo(s: &str) -> String {
     match s.char_indices().nth(ECHO_CHARS) {
         Some((k, _)) => format!("{}…", &s[..k]),
         None => s.to_string(),
@@ -281,10 +283,10 @@ pub fn echo(s: &str) -> String {
 }
 
 /// Characters of input quoted in a message ([`echo`]).
-pub const ECHO_CHARS: usize = 40;
+pub(crate) const ECHO_CHARS: usize = 40;
 
 /// A whole UTF-8 text file (a regular file of at most [`MAX_TEXT_FILE`] bytes).
-pub fn read_text_file(path: &Path) -> Result<String> {
+pub(crate) fn read_text_file(path: &Path) -> Result<String> {
     String::from_utf8(read_regular(path, MAX_TEXT_FILE)?).map_err(|_| Error::Io {
         path: path.to_path_buf(),
         source: std::io::Error::from(std::io::ErrorKind::InvalidData),

@@ -147,7 +147,7 @@ fn non_unit_r_is_rejected() {
 
 #[test]
 fn hz_and_mag_phase_columns_equal_rad_s_and_re_im() {
-    use rshape::data::reader::parse_frf_csv;
+    use rshape::data::parse_frf_csv;
     let a = parse_frf_csv(
         "freq_hz,mag_1_1,phase_deg_1_1,noise_radius\n1.5,2,-30,0.1\n",
         Path::new("a.csv"),

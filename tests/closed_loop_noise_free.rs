@@ -5,11 +5,11 @@
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::closed_loop::noise_free::{
+use rshape::consistency::closed_loop::{closed_loop_envelope, VBisectionSettings};
+use rshape::consistency::closed_loop::{
     delta_bar, delta_bar_corollary1_printed, delta_bar_from_plant, lft_m, perturbed_plant,
     recover_plant, theorem1_n11, upper_lft,
 };
-use rshape::consistency::closed_loop::{closed_loop_envelope, noisy::VBisectionSettings};
 use rshape::consistency::{check, EnvelopeMethod};
 use rshape::data::FrfData;
 use rshape::model::Config;

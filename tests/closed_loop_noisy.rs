@@ -5,10 +5,10 @@
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::closed_loop::noisy::{
+use rshape::consistency::closed_loop::{closed_loop_envelope, mu_per_datum};
+use rshape::consistency::closed_loop::{
     mu_at, theorem2_g1, v_min_eq18, v_min_mu_bisection, v_min_noisy, NoisyRoute, VBisectionSettings,
 };
-use rshape::consistency::closed_loop::{closed_loop_envelope, mu_per_datum};
 use rshape::consistency::EnvelopeMethod;
 use rshape::data::FrfData;
 use rshape::model::closed_loop::ClosedLoopAt;

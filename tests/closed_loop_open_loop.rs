@@ -5,10 +5,9 @@
 //! of the noise disk.
 
 use num_complex::Complex64;
-use rshape::consistency::closed_loop::noise_free::delta_bar;
+use rshape::consistency::closed_loop::delta_bar;
 use rshape::consistency::noise_free_envelope;
-use rshape::data::closed_loop::read_closed_loop_csv;
-use rshape::data::read_frf_csv;
+use rshape::data::{read_closed_loop_csv, read_frf_csv};
 use rshape::model::Config;
 use rshape::pipeline::closed_loop::open_loop_equivalent;
 use std::path::PathBuf;

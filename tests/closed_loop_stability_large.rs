@@ -7,7 +7,7 @@
 
 use nalgebra::{DMatrix, Matrix4};
 use num_complex::Complex64;
-use rshape::model::closed_loop::stability::{check_loop_with, LoopInstability, LoopRoute};
+use rshape::model::closed_loop::{check_loop_with, LoopInstability, LoopRoute};
 use rshape::system::{TfMatrix, TransferFunction};
 
 /// Unstable poles `a_i`, stable poles `−b_i` of `p_i = 1/((s − a_i)(s + b_i))`.

@@ -8,8 +8,11 @@
 //! (stdout, then stderr).  In an expected line `[..]` matches any text (times, for
 //! instance); a line `...` matches any number of lines.  A ```` ```toml ```` block whose first
 //! line is `# file: PATH` is written to `PATH` in the scratch folder before the commands that
-//! follow it.  Each document gets its own scratch folder, so its commands may build on each
-//! other in order (the README's tutorial does).
+//! follow it.  A ```` ```text output-of: CMD ```` block shows part of what `CMD` prints: `CMD`
+//! is run there and the block's lines must appear in its output as one run (with the same
+//! `[..]` and `...`).  Each document gets its own scratch folder, so its commands may build on
+//! each other in order (the README's tutorial does).  Every other fenced block has a language
+//! and shows no `$ ` command line, so no documented command escapes the test.
 #![cfg(unix)]
 mod common;
 
@@ -25,6 +28,17 @@ enum Step {
     /// Run a command and compare its output (line of the `$` in the document, command,
     /// expected lines).
     Run(usize, String, Vec<String>),
+    /// Run a command and find the lines of an excerpt in its output (line of the block,
+    /// command, excerpt).
+    Excerpt(usize, String, Vec<String>),
+}
+
+/// The command of a ```` ```text output-of: CMD ```` fence.
+fn output_of(fence: &str) -> Option<&str> {
+    fence
+        .strip_prefix("```text output-of:")
+        .map(str::trim)
+        .filter(|c| !c.is_empty())
 }
 
 /// The steps of a Markdown document.
@@ -34,7 +48,16 @@ fn steps(text: &str) -> Vec<Step> {
     let mut i = 0;
     while i < lines.len() {
         let l = lines[i].trim_end();
-        if l == "```console" || l == "```toml" {
+        if let Some(cmd) = output_of(l) {
+            let mut body = Vec::new();
+            let mut j = i + 1;
+            while j < lines.len() && !lines[j].starts_with("```") {
+                body.push(lines[j].trim_end().to_string());
+                j += 1;
+            }
+            out.push(Step::Excerpt(i + 1, cmd.to_string(), body));
+            i = j;
+        } else if l == "```console" || l == "```toml" {
             let mut body = Vec::new();
             let mut j = i + 1;
             while j < lines.len() && !lines[j].starts_with("```") {
@@ -112,13 +135,14 @@ fn run_document(doc: &Path) -> (usize, Vec<String>) {
     let mut failures = Vec::new();
     let mut n = 0;
     for step in steps(&text) {
+        let excerpt = matches!(step, Step::Excerpt(..));
         match step {
             Step::File(p, contents) => {
                 let f = dir.path().join(&p);
                 std::fs::create_dir_all(f.parent().unwrap()).unwrap();
                 std::fs::write(&f, contents).unwrap();
             }
-            Step::Run(line, cmd, want) => {
+            Step::Run(line, cmd, want) | Step::Excerpt(line, cmd, want) => {
                 n += 1;
                 let o = Command::new("sh")
                     .arg("-c")
@@ -134,7 +158,18 @@ fn run_document(doc: &Path) -> (usize, Vec<String>) {
                 )
                 .replace(&scratch, "DIR");
                 let got: Vec<String> = all.lines().map(|l| l.trim_end().to_string()).collect();
-                if !lines_match(&want, &got) {
+                // An excerpt is one run of lines anywhere in the output.
+                let pattern = if excerpt {
+                    [
+                        vec!["...".to_string()],
+                        want.clone(),
+                        vec!["...".to_string()],
+                    ]
+                    .concat()
+                } else {
+                    want.clone()
+                };
+                if !lines_match(&pattern, &got) {
                     failures.push(format!(
                         "{}:{line}: `{cmd}`\n--- documented\n{}\n--- printed\n{}",
                         doc.display(),
@@ -206,6 +241,48 @@ fn the_readme_tutorial_is_executed() {
         })
         .collect();
     assert_eq!(files, ["mine/model.toml", "mine/k.toml"]);
+}
+
+/// Every fenced block of README.md and the guide has a language, and only `console` blocks
+/// show `$ ` command lines: a command with its output in a `text`, `sh` or unlabelled block
+/// would escape the test above.
+#[test]
+fn no_documented_command_escapes_the_test() {
+    let mut bad = Vec::new();
+    let mut excerpts = 0;
+    for doc in documents() {
+        let text = std::fs::read_to_string(&doc).unwrap();
+        let mut fence: Option<(usize, String)> = None;
+        for (k, line) in text.lines().enumerate() {
+            let l = line.trim_start();
+            match (&fence, l.strip_prefix("```")) {
+                (None, Some(info)) => {
+                    if info.trim().is_empty() {
+                        bad.push(format!(
+                            "{}:{}: a block without a language",
+                            doc.display(),
+                            k + 1
+                        ));
+                    }
+                    excerpts += usize::from(output_of(l).is_some());
+                    fence = Some((k + 1, info.trim().to_string()));
+                }
+                (Some(_), Some(_)) => fence = None,
+                (Some((start, info)), None) => {
+                    if info != "console" && l.starts_with("$ ") {
+                        bad.push(format!(
+                            "{}:{}: `{l}` in a `{info}` block (line {start}): put it in a console block",
+                            doc.display(),
+                            k + 1
+                        ));
+                    }
+                }
+                (None, None) => {}
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    assert!(excerpts >= 2, "only {excerpts} output-of excerpts found");
 }
 
 #[test]

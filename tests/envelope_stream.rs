@@ -1,9 +1,7 @@
 //! The streamed noise-free envelope (`rshape envelope` on large files) gives the numbers of
 //! the in-memory one, sorted, with the same errors.
-use rshape::consistency::noise_free_envelope;
-use rshape::consistency::stream::noise_free_envelope_rows;
-use rshape::data::read_frf_csv;
-use rshape::data::reader::FrfRows;
+use rshape::consistency::{noise_free_envelope, noise_free_envelope_rows};
+use rshape::data::{read_frf_csv, FrfRows};
 use rshape::model::Config;
 use std::path::Path;
 

@@ -10,7 +10,7 @@
 #![allow(clippy::excessive_precision)]
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::noise_free::{min_norm_perturbation, r_min_standard};
+use rshape::consistency::{min_norm_perturbation, r_min_standard};
 use rshape::model::FactorsAt;
 
 type M = &'static [&'static [(f64, f64)]];

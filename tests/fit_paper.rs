@@ -204,7 +204,7 @@ fn conservatism_does_not_increase_with_order_shipped_robot() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let cfg = rshape::model::Config::load(&root.join("configs/robot.toml")).unwrap();
     let data = rshape::data::read_frf_csv(&root.join("configs/robot.csv")).unwrap();
-    let radii = rshape::model::noise::noise_radii(None, Some(&cfg), &data)
+    let radii = rshape::model::noise_radii(None, Some(&cfg), &data)
         .unwrap()
         .expect("robot.toml has a noise radius");
     let env = rshape::consistency::noisy_envelope(

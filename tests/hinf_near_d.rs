@@ -9,11 +9,9 @@ mod common;
 use common::{rshape, stdout};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
-use rshape::model::controller::Controller;
-use rshape::model::Config;
+use rshape::model::{Config, Controller};
 use rshape::stability::{analyze, Verdict};
-use rshape::system::hinf::hinf_norm;
-use rshape::system::{logspace, StateSpace};
+use rshape::system::{hinf_norm, logspace, StateSpace};
 use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -41,7 +39,7 @@ fn sigma(ss: &StateSpace, w: f64) -> f64 {
 /// Independent peak: σ_max(D) (the value at ∞), a 4000-point log grid plus the poles'
 /// damped frequencies, every local maximum refined by 100 golden-section steps.
 fn reference_peak(ss: &StateSpace) -> f64 {
-    let poles = rshape::system::eig::eigenvalues(&ss.a, "p").unwrap();
+    let poles = rshape::system::eigenvalues(&ss.a, "p").unwrap();
     let mags: Vec<f64> = poles.iter().map(|z| z.norm()).collect();
     let lo = mags.iter().copied().fold(f64::INFINITY, f64::min) / 100.0;
     let hi = mags.iter().copied().fold(0.0, f64::max) * 100.0;

@@ -4,8 +4,7 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rshape::data::FrfData;
-use rshape::model::noise::{linf_disk_radius, noise_radii, resolve_noise, NoiseSource};
-use rshape::model::Config;
+use rshape::model::{linf_disk_radius, noise_radii, resolve_noise, Config, NoiseSource};
 use rshape::Error;
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};

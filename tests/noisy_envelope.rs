@@ -4,9 +4,10 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::consistency::noise_free::{r_min_special, r_min_standard};
-use rshape::consistency::noisy::{gamma_lft, r_min_noisy, v_matrix, NoisyFailure};
-use rshape::consistency::{check, noisy_envelope, noisy_envelope_report, BisectionSettings};
+use rshape::consistency::{
+    check, gamma_lft, noisy_envelope, noisy_envelope_report, r_min_noisy, r_min_special,
+    r_min_standard, v_matrix, BisectionSettings, NoisyFailure,
+};
 use rshape::data::FrfData;
 use rshape::model::{Config, Factorization, FactorsAt};
 use rshape::mu::{mu_full_scalar, FullPlusScalar, MuSettings};
@@ -25,7 +26,7 @@ fn robot() -> Config {
 }
 
 fn robot_data(cfg: &Config) -> FrfData {
-    rshape::data::reader::read_frf_csv(cfg.data.as_ref().unwrap()).expect("configs/robot.csv reads")
+    rshape::data::read_frf_csv(cfg.data.as_ref().unwrap()).expect("configs/robot.csv reads")
 }
 
 /// Undamped natural frequencies `√(b_k/4)` of the five modes of eq. (19).

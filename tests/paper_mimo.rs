@@ -4,7 +4,7 @@ mod common;
 use common::{repo, rshape, stdout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::noise_free::min_norm_perturbation;
+use rshape::consistency::min_norm_perturbation;
 use rshape::data::read_frf_csv;
 use rshape::model::Config;
 

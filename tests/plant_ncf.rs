@@ -6,12 +6,10 @@ use common::repo;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::consistency::envelope::noise_free_envelope;
+use rshape::consistency::noise_free_envelope;
 use rshape::data::FrfData;
 use rshape::model::Config;
-use rshape::system::eig::{eigenvalues, spectral_abscissa};
-use rshape::system::ncf::NormalizedLcf;
-use rshape::system::{logspace, StateSpace};
+use rshape::system::{eigenvalues, logspace, spectral_abscissa, NormalizedLcf, StateSpace};
 use std::path::{Path, PathBuf};
 
 /// Worst normalization error ‖M̃M̃* + ÑÑ* − I‖ and worst relative error of M̃⁻¹Ñ against

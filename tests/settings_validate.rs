@@ -3,7 +3,7 @@
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::consistency::noisy::{noisy_envelope, BisectionSettings};
+use rshape::consistency::{noisy_envelope, BisectionSettings};
 use rshape::data::FrfData;
 use rshape::fit::{fit_unit, FitSettings};
 use rshape::model::Config;

@@ -5,11 +5,9 @@ mod common;
 use common::{repo, rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use rshape::model::controller::Controller;
-use rshape::model::Config;
+use rshape::model::{Config, Controller};
 use rshape::stability::{analyze, gang_of_four};
-use rshape::system::hinf::hinf_norm;
-use rshape::system::{logspace, StateSpace, TransferFunction};
+use rshape::system::{hinf_norm, logspace, StateSpace, TransferFunction};
 use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -92,9 +90,8 @@ fn random_stable(seed: u64, n: usize, p: usize, m: usize, with_d: bool) -> State
     let mut r = |_, _| rng.gen_range(-1.0..1.0);
     let a0 = DMatrix::from_fn(n, n, &mut r) * 3.0;
     // Shift to make A stable with a moderately damped slowest mode.
-    let abscissa = rshape::system::eig::spectral_abscissa(
-        &rshape::system::eig::eigenvalues(&a0, "a").unwrap(),
-    );
+    let abscissa =
+        rshape::system::spectral_abscissa(&rshape::system::eigenvalues(&a0, "a").unwrap());
     let a = a0 - DMatrix::identity(n, n) * (abscissa + 0.3);
     let b = DMatrix::from_fn(n, m, &mut r);
     let c = DMatrix::from_fn(p, n, &mut r);
@@ -459,4 +456,74 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
     );
     assert!(!out_dir.exists());
     let _ = Complex64::new(0.0, 0.0);
+}
+
+/// The title of `stability.svg` never drops the controller's name: a long model name is cut in
+/// the middle first (its beginning and end stay), the title stays within one caption line, and
+/// short titles are untouched.  End to end, the figure written by `rshape stability` carries
+/// the controller's file name.
+#[test]
+fn stability_title_keeps_the_controller_name() {
+    use rshape::pipeline::stability::{figure_title, FIGURE_TITLE_CHARS};
+    let long_name = format!(
+        "flexible robot arm {} five modes, tip sensor, revision 7",
+        "with a very long description ".repeat(3)
+    );
+    let config = |name: &str| {
+        Config::parse(
+            &format!("name = \"{name}\"\n[plant]\ntf = [[{{ num = [1], den = [1, 1, 0] }}]]\n"),
+            Path::new("t.toml"),
+        )
+        .unwrap()
+    };
+    let k = "K = robot_controller.toml";
+    let t = figure_title(&config(&long_name), k);
+    assert!(t.chars().count() <= FIGURE_TITLE_CHARS, "{t}");
+    assert!(t.ends_with(&format!(", {k}")), "{t}");
+    assert!(
+        t.contains("— flexible") && t.contains("revision 7, K") && t.contains('…'),
+        "{t}"
+    );
+    let short = figure_title(&config("robot"), k);
+    assert_eq!(short, format!("Theorem 1: 1/σ_max(T) vs |r| — robot, {k}"));
+    // An absurdly long controller name is cut in the middle too, keeping its end.
+    let long_k = format!("K = {}final.toml", "controller_".repeat(10));
+    let t = figure_title(&config(&long_name), &long_k);
+    assert!(t.chars().count() <= FIGURE_TITLE_CHARS, "{t}");
+    assert!(t.ends_with("final.toml") && t.contains("flexible"), "{t}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("configs/plant_first.toml"))
+        .unwrap()
+        .replace(
+            "name = \"integrator plus lag, plant given as a transfer function\"",
+            &format!("name = \"{long_name}\""),
+        )
+        .replace(
+            "data = \"plant_first.csv\"",
+            &format!("data = \"{}\"", repo("configs/plant_first.csv").display()),
+        );
+    let cfg = write(dir.path(), "long.toml", &text);
+    let out = dir.path().join("out");
+    let o = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        repo("configs/plant_first_controller.toml")
+            .to_str()
+            .unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(1)),
+        "{}",
+        stderr(&o)
+    );
+    let svg = std::fs::read_to_string(out.join("stability.svg")).unwrap();
+    assert!(
+        svg.contains(", K = plant_first_controller.toml\n</text>"),
+        "{}",
+        stdout(&o)
+    );
 }

@@ -7,12 +7,12 @@ mod common;
 use common::{rshape, stderr, stdout};
 use nalgebra::DMatrix;
 use rand::{Rng, SeedableRng};
-use rshape::model::controller::{Controller, Feedback};
 use rshape::model::Factorization;
+use rshape::model::{Controller, Feedback};
 use rshape::stability::{analyze, gang_of_four, Verdict};
 use rshape::synthesis::{optimum, synthesize};
-use rshape::system::hinf::hinf_norm;
-use rshape::system::ncf::NormalizedLcf;
+use rshape::system::hinf_norm;
+use rshape::system::NormalizedLcf;
 use rshape::system::{logspace, StateSpace, TransferFunction};
 use std::path::{Path, PathBuf};
 
@@ -20,6 +20,58 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
+}
+
+/// `rshape synthesize CFG ARGS… --out OUT`.
+fn synthesize_cli(cfg: &Path, args: &[&str], out: &Path) -> std::process::Output {
+    let mut all = vec!["synthesize", cfg.to_str().unwrap()];
+    all.extend_from_slice(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    rshape(&all)
+}
+
+/// `rshape synthesize CFG ARGS… --out OUT` gives a verdict, not an error (exit 0 proven
+/// robust, 1 not): its exit code, stdout and `synthesis.json`.
+fn synthesize_verdict(cfg: &Path, args: &[&str], out: &Path) -> (i32, String, serde_json::Value) {
+    let o = synthesize_cli(cfg, args, out);
+    let code = o.status.code();
+    assert!(
+        matches!(code, Some(0) | Some(1)),
+        "{}{}",
+        stdout(&o),
+        stderr(&o)
+    );
+    let text = std::fs::read_to_string(out.join("synthesis.json")).unwrap();
+    (
+        code.unwrap(),
+        stdout(&o),
+        serde_json::from_str(&text).unwrap(),
+    )
+}
+
+/// `rshape stability CFG --controller OUT/controller.toml` exits with `code`: the written
+/// controller is what `stability` reads, and it gets the verdict `synthesize` gave.
+fn assert_stability_agrees(cfg: &Path, out: &Path, code: i32) {
+    let ctl = out.join("controller.toml");
+    let s = rshape(&[
+        "stability",
+        cfg.to_str().unwrap(),
+        "--controller",
+        ctl.to_str().unwrap(),
+    ]);
+    assert_eq!(s.status.code(), Some(code), "{}{}", stdout(&s), stderr(&s));
+}
+
+/// `rshape synthesize CFG ARGS… --out OUT` refuses bad input: exit 2, one line on stderr
+/// (naming `name` when given), nothing written.
+fn assert_refused(cfg: &Path, args: &[&str], out: &Path, name: Option<&str>) {
+    let o = synthesize_cli(cfg, args, out);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
+    if let Some(name) = name {
+        assert!(stderr(&o).contains(name), "{}", stderr(&o));
+    }
+    assert!(!out.exists(), "{args:?} wrote {}", out.display());
 }
 
 /// `AX + XAᵀ + Q = 0` by the Kronecker form `(I⊗A + A⊗I)vec(X) = −vec(Q)`, dense LU.
@@ -36,7 +88,7 @@ fn lyap_kron(a: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
 fn hankel_norm(ss: &StateSpace) -> f64 {
     let p = lyap_kron(&ss.a, &(&ss.b * ss.b.transpose()));
     let q = lyap_kron(&ss.a.transpose(), &(ss.c.transpose() * &ss.c));
-    let e = rshape::system::eig::eigenvalues(&(p * q), "pq").unwrap();
+    let e = rshape::system::eigenvalues(&(p * q), "pq").unwrap();
     e.iter().map(|z| z.re).fold(0.0, f64::max).sqrt()
 }
 
@@ -65,8 +117,8 @@ fn b_opt_matches_the_hankel_norm_route_and_the_central_controller_attains_it() {
     let (mut unstable, mut matched) = (0, 0);
     for seed in 0..64u64 {
         let plant = random_plant(seed);
-        let poles = rshape::system::eig::eigenvalues(&plant.a, "p").unwrap();
-        if rshape::system::eig::spectral_abscissa(&poles) > 0.0 {
+        let poles = rshape::system::eigenvalues(&plant.a, "p").unwrap();
+        if rshape::system::spectral_abscissa(&poles) > 0.0 {
             unstable += 1;
         }
         let ncf = NormalizedLcf::new(plant.clone()).unwrap();
@@ -177,14 +229,9 @@ fn cli_writes_a_controller_that_stability_proves() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = write(dir.path(), "c.toml", &CONFIG.replace("R", "0.01"));
     let out = dir.path().join("out");
-    let o = rshape(&[
-        "synthesize",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
-    assert!(stdout(&o).contains("PROVEN robust"), "{}", stdout(&o));
+    let (code, text, syn) = synthesize_verdict(&cfg, &[], &out);
+    assert_eq!(code, 0, "{text}");
+    assert!(text.contains("PROVEN robust"), "{text}");
     for f in [
         "controller.toml",
         "controller.json",
@@ -197,37 +244,17 @@ fn cli_writes_a_controller_that_stability_proves() {
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
-    let syn: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
-            .unwrap();
     let b_opt = syn["b_opt"].as_f64().unwrap();
     let b_gk = syn["b_gk"].as_f64().unwrap();
     assert!(b_gk >= b_opt / 1.1 * (1.0 - 1e-9) && b_gk <= b_opt * (1.0 + 1e-9));
-    // The controller file is what `stability --controller` reads: the same verdict.
-    let ctl = out.join("controller.toml");
-    let s = rshape(&[
-        "stability",
-        cfg.to_str().unwrap(),
-        "--controller",
-        ctl.to_str().unwrap(),
-    ]);
-    assert_eq!(s.status.code(), Some(0), "{}{}", stdout(&s), stderr(&s));
+    assert_stability_agrees(&cfg, &out, 0);
     // An r above b_opt: no controller can be proven robust: exit 1, the reason in one line.
     let big = format!("{}", b_opt * 1.05);
     let cfg2 = write(dir.path(), "c2.toml", &CONFIG.replace("R", &big));
     let out2 = dir.path().join("out2");
-    let o = rshape(&[
-        "synthesize",
-        cfg2.to_str().unwrap(),
-        "--out",
-        out2.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(1), "{}{}", stdout(&o), stderr(&o));
-    assert!(
-        stdout(&o).contains("no controller reaches alpha >= 1"),
-        "{}",
-        stdout(&o)
-    );
+    let (code, text, _) = synthesize_verdict(&cfg2, &[], &out2);
+    assert_eq!(code, 1, "{text}");
+    assert!(text.contains("no controller reaches alpha >= 1"), "{text}");
 }
 
 #[test]
@@ -240,17 +267,7 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         vec!["--gamma-factor", "nan"],
         vec!["--r-json", "missing.json"],
     ] {
-        let mut all = vec![
-            "synthesize",
-            cfg.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ];
-        all.extend(args.iter().copied());
-        let o = rshape(&all);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-        assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
-        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+        assert_refused(&cfg, &args, &out, None);
     }
     // r not a unit (a zero in the right half-plane).
     let nonunit = write(
@@ -258,29 +275,14 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         "n.toml",
         "[plant]\ntf = [[{ num = [1], den = [1, -1] }]]\n[r]\nnum = [1, -2]\nden = [1, 3]\n",
     );
-    let o = rshape(&[
-        "synthesize",
-        nonunit.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(!out.exists());
+    assert_refused(&nonunit, &[], &out, None);
     // Not detectable: an unstable mode the output does not see.
     let undetectable = write(
         dir.path(),
         "u.toml",
         "[plant]\na = [[1, 0], [0, -1]]\nb = [[1], [1]]\nc = [[0, 1]]\nd = [[0]]\n",
     );
-    let o = rshape(&[
-        "synthesize",
-        undetectable.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
-    assert!(!out.exists());
+    assert_refused(&undetectable, &[], &out, None);
 }
 
 /// A `[model]` config (the robot's special factorization): the controller is designed for
@@ -291,27 +293,8 @@ fn special_factorization_config_is_synthesized_for_its_plant_and_proved_with_its
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let cfg = common::repo("configs/robot.toml");
-    let o = rshape(&[
-        "synthesize",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let code = o.status.code();
-    assert!(
-        matches!(code, Some(0) | Some(1)),
-        "{}{}",
-        stdout(&o),
-        stderr(&o)
-    );
-    assert!(
-        stdout(&o).contains("not the normalized ones"),
-        "{}",
-        stdout(&o)
-    );
-    let syn: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
-            .unwrap();
+    let (code, text, syn) = synthesize_verdict(&cfg, &[], &out);
+    assert!(text.contains("not the normalized ones"), "{text}");
     let b_opt = syn["b_opt"].as_f64().unwrap();
     let b_gk = syn["b_gk"].as_f64().unwrap();
     assert!(
@@ -320,13 +303,7 @@ fn special_factorization_config_is_synthesized_for_its_plant_and_proved_with_its
     );
     let poles = syn["closed_loop_poles"].as_array().unwrap();
     assert!(poles.iter().all(|z| z[0].as_f64().unwrap() < 0.0));
-    let s = rshape(&[
-        "stability",
-        cfg.to_str().unwrap(),
-        "--controller",
-        out.join("controller.toml").to_str().unwrap(),
-    ]);
-    assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+    assert_stability_agrees(&cfg, &out, code);
 }
 
 fn toml_rows(m: &DMatrix<f64>) -> String {
@@ -355,8 +332,8 @@ fn reduced_controller_is_re_proved() {
             continue;
         };
         let gm = synthesize(&ncf, 1.1).unwrap();
-        let kp = rshape::system::eig::eigenvalues(&gm.k.a, "k").unwrap();
-        if rshape::system::eig::spectral_abscissa(&kp) >= -1e-6 {
+        let kp = rshape::system::eigenvalues(&gm.k.a, "k").unwrap();
+        if rshape::system::spectral_abscissa(&kp) >= -1e-6 {
             continue;
         }
         let n = plant.states();
@@ -374,50 +351,13 @@ fn reduced_controller_is_re_proved() {
         );
         let out = dir.path().join(format!("out{seed}"));
         let reduce = (n - 1).to_string();
-        let o = rshape(&[
-            "synthesize",
-            cfg.to_str().unwrap(),
-            "--reduce",
-            &reduce,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        let code = o.status.code();
-        assert!(
-            matches!(code, Some(0) | Some(1)),
-            "{}{}",
-            stdout(&o),
-            stderr(&o)
-        );
-        assert!(
-            stdout(&o).contains("reduced by balanced truncation"),
-            "{}",
-            stdout(&o)
-        );
-        let syn: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
-                .unwrap();
+        let (code, text, syn) = synthesize_verdict(&cfg, &["--reduce", &reduce], &out);
+        assert!(text.contains("reduced by balanced truncation"), "{text}");
         assert_eq!(syn["controller_order"].as_u64(), Some(n as u64 - 1));
         assert_eq!(syn["reduction"]["from"].as_u64(), Some(n as u64));
-        let s = rshape(&[
-            "stability",
-            cfg.to_str().unwrap(),
-            "--controller",
-            out.join("controller.toml").to_str().unwrap(),
-        ]);
-        assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+        assert_stability_agrees(&cfg, &out, code);
         if done == 0 {
-            let bad = dir.path().join("bad");
-            let o = rshape(&[
-                "synthesize",
-                cfg.to_str().unwrap(),
-                "--reduce",
-                "0",
-                "--out",
-                bad.to_str().unwrap(),
-            ]);
-            assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-            assert!(!bad.exists());
+            assert_refused(&cfg, &["--reduce", "0"], &dir.path().join("bad"), None);
         }
         done += 1;
         if done == 3 {
@@ -444,25 +384,8 @@ fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
         "[weights]\nw1 = [{ num = [1, 2], den = [1, 0] }]\nw2 = [2]\n",
     );
     let out = dir.path().join("out");
-    let o = rshape(&[
-        "synthesize",
-        cfg.to_str().unwrap(),
-        "--weights",
-        w.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let code = o.status.code();
-    assert!(
-        matches!(code, Some(0) | Some(1)),
-        "{}{}",
-        stdout(&o),
-        stderr(&o)
-    );
-    assert!(stdout(&o).contains("loop shaping"), "{}", stdout(&o));
-    let syn: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
-            .unwrap();
+    let (code, text, syn) = synthesize_verdict(&cfg, &["--weights", w.to_str().unwrap()], &out);
+    assert!(text.contains("loop shaping"), "{text}");
     let kp = syn["controller_poles"].as_array().unwrap();
     assert!(
         kp.iter()
@@ -481,13 +404,7 @@ fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
         (ratio - 10.0).abs() < 0.1,
         "|K| ratio over a decade at low frequency {ratio}"
     );
-    let s = rshape(&[
-        "stability",
-        cfg.to_str().unwrap(),
-        "--controller",
-        out.join("controller.toml").to_str().unwrap(),
-    ]);
-    assert_eq!(s.status.code(), code, "{}{}", stdout(&s), stderr(&s));
+    assert_stability_agrees(&cfg, &out, code);
     for (name, text) in [
         (
             "improper.toml",
@@ -501,18 +418,7 @@ fn loop_shaping_weights_give_integral_action_and_are_proved_on_the_plant() {
     ] {
         let w = write(dir.path(), name, text);
         let bad = dir.path().join("bad");
-        let o = rshape(&[
-            "synthesize",
-            cfg.to_str().unwrap(),
-            "--weights",
-            w.to_str().unwrap(),
-            "--out",
-            bad.to_str().unwrap(),
-        ]);
-        assert_eq!(o.status.code(), Some(2), "{name}: {}", stderr(&o));
-        assert_eq!(stderr(&o).trim().lines().count(), 1, "{}", stderr(&o));
-        assert!(stderr(&o).contains(name), "{}", stderr(&o));
-        assert!(!bad.exists());
+        assert_refused(&cfg, &["--weights", w.to_str().unwrap()], &bad, Some(name));
     }
 }
 
@@ -524,18 +430,9 @@ fn fit_then_synthesize_proves_both_bounds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let cfg = common::repo("configs/plant_first.toml");
-    let o = rshape(&[
-        "synthesize",
-        cfg.to_str().unwrap(),
-        "--fit",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    let (code, text, syn) = synthesize_verdict(&cfg, &["--fit"], &out);
+    assert_eq!(code, 0, "{text}");
     assert!(out.join("r.json").is_file() && out.join("controller.toml").is_file());
-    let syn: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("synthesis.json")).unwrap())
-            .unwrap();
     let bounds = syn["bounds"].as_array().unwrap();
     assert_eq!(bounds.len(), 2);
     assert_eq!(bounds[1]["label"], "fitted");

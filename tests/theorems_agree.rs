@@ -3,7 +3,7 @@
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::consistency::noise_free::{r_min_special, r_min_standard};
+use rshape::consistency::{r_min_special, r_min_standard};
 use rshape::model::FactorsAt;
 
 fn cmat(p: usize, q: usize, v: &[f64]) -> DMatrix<Complex64> {

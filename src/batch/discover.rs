@@ -55,7 +55,7 @@ fn stem(p: &Path) -> String {
 }
 
 /// Every `*.csv` file in `dir` (not recursive), sorted by file name.
-pub fn from_dir(dir: &Path) -> Result<Vec<Dataset>> {
+pub fn discover_dir(dir: &Path) -> Result<Vec<Dataset>> {
     let rd = std::fs::read_dir(dir).map_err(|source| Error::Io {
         path: dir.to_path_buf(),
         source,
@@ -87,7 +87,7 @@ pub fn from_dir(dir: &Path) -> Result<Vec<Dataset>> {
 }
 
 /// The datasets listed in a manifest (see the module doc for the format).
-pub fn from_manifest(file: &Path) -> Result<Vec<Dataset>> {
+pub fn discover_manifest(file: &Path) -> Result<Vec<Dataset>> {
     let base = file.parent().unwrap_or(Path::new("."));
     let err = |line: usize, msg: String| Error::Data {
         path: file.to_path_buf(),

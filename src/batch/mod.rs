@@ -3,20 +3,38 @@
 //! combined envelope (pointwise maximum) and one `r` fitted above it.
 //!
 //! Output directory `OUT/`:
-//! - `summary.csv`: one row per dataset ([`summary`]);
+//! - `summary.csv`: one row per dataset ([`SummaryRow`]);
 //! - `datasets/NAME/envelope.csv`, `datasets/NAME/result.json`: per dataset;
 //! - `combined_envelope.csv`: the combined envelope ([`combine`]);
 //! - `r.json` (and the other exports of the fit): one `r` covering every dataset;
 //! - `batch.json`: counts, shard, fitted `r`, certificate, timings ([`BatchReport`]).
 //!
-//! Datasets come from a directory or a manifest ([`discover`]), can be split into shards
-//! ([`shard`]) and the shard outputs recombined ([`merge`]).
-pub mod combine;
-pub mod discover;
-pub mod merge;
-pub mod runner;
-pub mod shard;
-pub mod summary;
+//! Datasets come from a directory or a manifest ([`discover_dir`], [`discover_manifest`]),
+//! can be split into shards ([`Shard`]) and the shard outputs recombined ([`merge`]).
+//!
+//! What is here (the submodules are private; everything below is re-exported here):
+//! * the datasets: [`Dataset`], found by [`discover_dir`] (every `*.csv` of a folder) or
+//!   [`discover_manifest`] (a CSV `name,data,noise_radius`, only `data` required);
+//! * the parallel run: [`run_all`] (and [`run_one`]) with [`BatchSettings`], one
+//!   [`DatasetResult`] per dataset, one [`SummaryRow`] of `summary.csv` each;
+//! * the batch-wide stage: [`combine`] (the combined envelope, the pointwise maximum) and
+//!   [`finish`] ([`FinishInput`]; one `r` fitted above it, the exports and [`BatchReport`]);
+//! * shards: [`Shard`] (`--shard K/N`), recombined by [`merge`] or [`merge_then`]
+//!   ([`MergeOutcome`]), guarded by [`config_digest`];
+//! * exit codes [`EXIT_OK`] and [`EXIT_SOME_FAILED`].
+pub(crate) mod combine;
+pub(crate) mod discover;
+pub(crate) mod merge;
+pub(crate) mod runner;
+pub(crate) mod shard;
+pub(crate) mod summary;
+
+pub use combine::combine;
+pub use discover::{discover_dir, discover_manifest, Dataset};
+pub use merge::{merge, merge_then, MergeOutcome};
+pub use runner::{run_all, run_one, BatchSettings, DatasetResult};
+pub use shard::Shard;
+pub use summary::SummaryRow;
 
 use crate::consistency::{check, Envelope};
 use crate::error::{Error, Result};
@@ -27,10 +45,8 @@ use crate::system::TransferFunction;
 use crate::util::write_atomic;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use shard::Shard;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use summary::SummaryRow;
 
 /// Exit code when every dataset succeeded.
 pub const EXIT_OK: i32 = 0;

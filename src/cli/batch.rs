@@ -4,7 +4,8 @@
 
 use super::common::fmt_g;
 use crate::batch::{
-    self, combine::combine, discover, runner, shard::Shard, summary::SummaryRow, FinishInput,
+    self, combine, discover_dir, discover_manifest, run_all, BatchSettings, FinishInput, Shard,
+    SummaryRow,
 };
 use crate::model::Config;
 use anyhow::{anyhow, Result};
@@ -70,8 +71,8 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
         }
     }
     let all = match (&a.data_dir, &a.manifest) {
-        (Some(d), _) => discover::from_dir(d)?,
-        (None, Some(m)) => discover::from_manifest(m)?,
+        (Some(d), _) => discover_dir(d)?,
+        (None, Some(m)) => discover_manifest(m)?,
         (None, None) => unreachable!("clap requires one source"),
     };
     let shard = a
@@ -90,7 +91,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
     .flatten()
     .collect();
     let _manifest = super::common::prepare_out(&a.out, &sources)?;
-    let opts = runner::BatchSettings {
+    let opts = BatchSettings {
         noise_radius: a.noise_radius,
         per_dataset_files: !a.no_dataset_files,
     };
@@ -132,7 +133,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             }
         }
     };
-    let work = || runner::run_all(&config, &datasets, &opts, &a.out, &tick);
+    let work = || run_all(&config, &datasets, &opts, &a.out, &tick);
     let results = match a.jobs {
         // More threads than datasets only cost memory (each has its own stack).
         Some(n) => rayon::ThreadPoolBuilder::new()

@@ -165,38 +165,62 @@ pub type LabelledBound = (String, crate::system::TransferFunction);
 /// Loaded inputs with their envelope, for `--fit`.
 pub type FitInput = (Inputs, Envelope);
 
-/// The bounds a controller is judged with (`stability`, `synthesize`): the config's `[r]`,
-/// then `--r-json` as `fitted`; with `--fit`, the inputs whose envelope will be fitted,
-/// read before any output folder is touched.  A `[closed_loop]` config refuses `--fit` (it
-/// would fit its weight `V`, not a factor bound `r`).
-pub fn controller_bounds(
-    config_path: &std::path::Path,
-    config: &Config,
-    r_json: Option<&std::path::Path>,
-    fit: bool,
-    data: Option<&std::path::Path>,
-) -> Result<(Vec<LabelledBound>, Option<FitInput>)> {
-    if config.closed_loop.is_some() && fit {
-        return Err(anyhow!(
-            "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
-            config_path.display()
-        ));
+/// The bounds `r` a controller is proved with besides the config's `[r]` (`stability`,
+/// `synthesize`): the flags are defined once here and flattened into both subcommands.
+#[derive(Debug, Args)]
+pub struct BoundArgs {
+    /// A fitted r (the r.json written by `rshape run` or `rshape fit`).
+    #[arg(long)]
+    pub r_json: Option<PathBuf>,
+    /// Fit r from the config's data first (as `rshape fit`; exports go to --out).
+    #[arg(long, conflicts_with = "r_json")]
+    pub fit: bool,
+    /// Data file overriding the one in the config.
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+}
+
+impl BoundArgs {
+    /// The input files these flags name (`--r-json`, `--data`), for the output-folder policy.
+    pub fn files(&self) -> impl Iterator<Item = &std::path::Path> {
+        [self.r_json.as_deref(), self.data.as_deref()]
+            .into_iter()
+            .flatten()
     }
-    let given = r_json
-        .map(crate::pipeline::stability::read_r_json)
-        .transpose()?;
-    let rs = crate::pipeline::stability::bounds(config, given);
-    let fit_input = if fit {
-        let input = InputArgs {
-            config: config_path.to_path_buf(),
-            data: data.map(|d| d.to_path_buf()),
-            noise_radius: None,
+
+    /// The bounds a controller is judged with: the config's `[r]`, then `--r-json` as
+    /// `fitted`; with `--fit`, the inputs whose envelope will be fitted, read before any
+    /// output folder is touched.  A `[closed_loop]` config refuses `--fit` (it would fit its
+    /// weight `V`, not a factor bound `r`).
+    pub fn bounds(
+        &self,
+        config_path: &std::path::Path,
+        config: &Config,
+    ) -> Result<(Vec<LabelledBound>, Option<FitInput>)> {
+        if config.closed_loop.is_some() && self.fit {
+            return Err(anyhow!(
+                "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
+                config_path.display()
+            ));
+        }
+        let given = self
+            .r_json
+            .as_deref()
+            .map(crate::pipeline::stability::read_r_json)
+            .transpose()?;
+        let rs = crate::pipeline::stability::bounds(config, given);
+        let fit_input = if self.fit {
+            let input = InputArgs {
+                config: config_path.to_path_buf(),
+                data: self.data.clone(),
+                noise_radius: None,
+            };
+            Some(input.envelope()?)
+        } else {
+            None
         };
-        Some(input.envelope()?)
-    } else {
-        None
-    };
-    Ok((rs, fit_input))
+        Ok((rs, fit_input))
+    }
 }
 
 /// Fits `r` above the envelope of `fit_input` as `rshape fit --order auto` does (exports into

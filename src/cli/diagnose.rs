@@ -146,7 +146,47 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     Ok(0)
 }
 
+/// The text report of `diagnose`, section by section.
 fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hint_apply: bool) {
+    print_header(config, data, d);
+    if d.verdict == DiagnoseVerdict::Consistent {
+        println!("\nverdict: {}: {}", d.verdict, d.message);
+        return;
+    }
+    println!(
+        "retune (every configured parameter refit, nothing added): misfit_rms = {}, invalid_fraction = {}",
+        fmt_g(d.retuned.misfit_rms),
+        fmt_pct(d.retuned.invalid_fraction)
+    );
+    print_changes(&d.retuned.moved, "the retune moved");
+    print_candidates(d);
+    print_path(d);
+    if !d.chosen.is_empty() {
+        print_changes(
+            &d.retuned_in_chosen,
+            "with the chosen set, the joint refit moved",
+        );
+    }
+    print_dropped(d);
+    print_alternatives(d);
+    println!(
+        "\nsearch: {} nodes expanded, {} joint refits, {} s (beam {})",
+        d.search.nodes_expanded,
+        d.search.joint_refits,
+        sig(d.search.seconds),
+        d.search.beam
+    );
+    println!("verdict: {}: {}", d.verdict, d.message);
+    if hint_apply && !d.candidates.is_empty() {
+        println!(
+            "write the chosen set with: rshape diagnose {} --apply chosen --write NEW.toml (or one candidate that passes: --apply K)",
+            config.path.display()
+        );
+    }
+}
+
+/// What was compared (model, data, channels, noise) and the misfit before any change.
+fn print_header(config: &crate::model::Config, data: &Channels, d: &Diagnosis) {
     let chans = data
         .entries
         .iter()
@@ -166,60 +206,59 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         fmt_g(d.before.misfit_rms),
         fmt_pct(d.before.invalid_fraction)
     );
-    if d.verdict == DiagnoseVerdict::Consistent {
-        println!("\nverdict: {}: {}", d.verdict, d.message);
+}
+
+/// The candidates on the configured model, ranked by ΔBIC, with their parameters.
+fn print_candidates(d: &Diagnosis) {
+    if d.candidates.is_empty() {
         return;
     }
-    println!(
-        "retune (every configured parameter refit, nothing added): misfit_rms = {}, invalid_fraction = {}",
-        fmt_g(d.retuned.misfit_rms),
-        fmt_pct(d.retuned.invalid_fraction)
-    );
-    print_changes(&d.retuned.moved, "the retune moved");
-    if !d.candidates.is_empty() {
-        println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, no more invalid data):");
-        for c in &d.candidates {
-            if let Some(why) = &c.no_fit {
-                println!("{:>2}. {:<18} no fit: {why}", c.rank, c.effect);
-                continue;
-            }
-            let params = c
-                .params
-                .iter()
-                .map(|(n, v)| match c.uncertainty_2sigma.get(n) {
-                    Some(u) if u.is_finite() && *u > 0.0 => {
-                        format!("{n} = {} ± {}", sig(*v), sig(*u))
-                    }
-                    _ => format!("{n} = {}", sig(*v)),
-                })
-                .collect::<Vec<_>>()
-                .join(", ");
-            println!(
-                "{:>2}. {:<18} ΔBIC {:>10}{}  misfit_rms {} → {}  invalid {} → {}  {}{}",
-                c.rank,
-                c.effect,
-                sig(c.delta_bic),
-                if c.joint_refit { "*" } else { " " },
-                sig(c.misfit_rms_before),
-                sig(c.misfit_rms_after),
-                fmt_pct(c.invalid_fraction_before),
-                fmt_pct(c.invalid_fraction_after),
-                if c.passes { "pass" } else { "-" },
-                if c.tie_with_best {
-                    "  (tie with #1)"
-                } else {
-                    ""
-                }
-            );
-            if !params.is_empty() {
-                println!("    {params}");
-            }
-            for f in &c.flags {
-                println!("    flag: {f}");
-            }
-            println!("    {}", c.explanation);
+    println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, no more invalid data):");
+    for c in &d.candidates {
+        if let Some(why) = &c.no_fit {
+            println!("{:>2}. {:<18} no fit: {why}", c.rank, c.effect);
+            continue;
         }
+        let params = c
+            .params
+            .iter()
+            .map(|(n, v)| match c.uncertainty_2sigma.get(n) {
+                Some(u) if u.is_finite() && *u > 0.0 => {
+                    format!("{n} = {} ± {}", sig(*v), sig(*u))
+                }
+                _ => format!("{n} = {}", sig(*v)),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        println!(
+            "{:>2}. {:<18} ΔBIC {:>10}{}  misfit_rms {} → {}  invalid {} → {}  {}{}",
+            c.rank,
+            c.effect,
+            sig(c.delta_bic),
+            if c.joint_refit { "*" } else { " " },
+            sig(c.misfit_rms_before),
+            sig(c.misfit_rms_after),
+            fmt_pct(c.invalid_fraction_before),
+            fmt_pct(c.invalid_fraction_after),
+            if c.passes { "pass" } else { "-" },
+            if c.tie_with_best {
+                "  (tie with #1)"
+            } else {
+                ""
+            }
+        );
+        if !params.is_empty() {
+            println!("    {params}");
+        }
+        for f in &c.flags {
+            println!("    flag: {f}");
+        }
+        println!("    {}", c.explanation);
     }
+}
+
+/// The chosen path of the beam search and the effects of the final model.
+fn print_path(d: &Diagnosis) {
     if !d.steps.is_empty() {
         println!("\nchosen path (beam search, joint refit of every parameter at each node):");
         for s in &d.steps {
@@ -251,12 +290,10 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
             println!("  {}: {p}", e.effect);
         }
     }
-    if !d.chosen.is_empty() {
-        print_changes(
-            &d.retuned_in_chosen,
-            "with the chosen set, the joint refit moved",
-        );
-    }
+}
+
+/// The holdout verdicts and the effects dropped by the backward elimination or the holdout.
+fn print_dropped(d: &Diagnosis) {
     for h in &d.holdout {
         println!(
             "holdout {}: interleaved {}{}",
@@ -278,6 +315,10 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
     if !d.dropped.is_empty() {
         println!("dropped by the holdout: {}", d.dropped.join(", "));
     }
+}
+
+/// The runner-up sets and the ties between effects.
+fn print_alternatives(d: &Diagnosis) {
     if !d.runner_up.is_empty() {
         println!("\nrunner-up sets (BIC gap to the chosen set):");
         for r in &d.runner_up {
@@ -304,20 +345,6 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
             t.effects[1],
             sig(t.bic_gap),
             t.disambiguation
-        );
-    }
-    println!(
-        "\nsearch: {} nodes expanded, {} joint refits, {} s (beam {})",
-        d.search.nodes_expanded,
-        d.search.joint_refits,
-        sig(d.search.seconds),
-        d.search.beam
-    );
-    println!("verdict: {}: {}", d.verdict, d.message);
-    if hint_apply && !d.candidates.is_empty() {
-        println!(
-            "write the chosen set with: rshape diagnose {} --apply chosen --write NEW.toml (or one candidate that passes: --apply K)",
-            config.path.display()
         );
     }
 }

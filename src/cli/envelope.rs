@@ -1,7 +1,7 @@
 //! `rshape envelope CONFIG [--data FILE] --out DIR`: writes `DIR/envelope.csv`.
 
 use super::common::{fmt_g, fmt_omegas, InputArgs};
-use crate::report::csv::write_envelope_csv;
+use crate::report::write_envelope_csv;
 use crate::util::AtomicFile;
 use anyhow::Result;
 use clap::Args;

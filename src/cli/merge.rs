@@ -2,7 +2,7 @@
 //! Exit 0 when every merged dataset succeeded, 3 when some failed or are missing, 2 on an
 //! error.
 
-use crate::batch::{self, merge::merge_then};
+use crate::batch::{self, merge_then};
 use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;

@@ -3,8 +3,8 @@
 //! Exit 0 robustly stable for every bound given, 1 not (including a controller that does
 //! not stabilize the nominal plant), 2 error.
 
-use crate::model::controller::Controller;
 use crate::model::Config;
+use crate::model::Controller;
 use crate::pipeline::stability;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -19,15 +19,9 @@ pub struct StabilityArgs {
     /// The controller file (a [controller] table).
     #[arg(long)]
     pub controller: PathBuf,
-    /// A fitted r (the r.json written by `rshape run` or `rshape fit`).
-    #[arg(long)]
-    pub r_json: Option<PathBuf>,
-    /// Fit r from the config's data first (as `rshape fit`; exports go to --out).
-    #[arg(long, conflicts_with = "r_json")]
-    pub fit: bool,
-    /// Data file overriding the one in the config (with --fit).
-    #[arg(long)]
-    pub data: Option<PathBuf>,
+    /// `--r-json`, `--fit`, `--data`: the bounds besides the config's `[r]`.
+    #[command(flatten)]
+    pub bounds: super::common::BoundArgs,
     /// Directory for stability.svg and stability.json.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -40,7 +34,7 @@ pub struct StabilityArgs {
 pub fn run(a: &StabilityArgs) -> Result<i32> {
     let config = Config::load(&a.config)?;
     let controller = Controller::load(&a.controller)?;
-    if a.fit && a.out.is_none() {
+    if a.bounds.fit && a.out.is_none() {
         return Err(anyhow!(
             "--fit writes r.json and its exports: give --out DIR"
         ));
@@ -48,25 +42,14 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     // The controller's size is checked before anything is written.
     stability::check_controller(&config, &controller)?;
     // With --fit, the data are read and the envelope computed before the folder is touched.
-    let (mut rs, fit_input) = super::common::controller_bounds(
-        &a.config,
-        &config,
-        a.r_json.as_deref(),
-        a.fit,
-        a.data.as_deref(),
-    )?;
+    let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
     // input's folder; the previous run's listed files are cleared.
-    let inputs: Vec<&Path> = [
-        Some(a.config.as_path()),
-        Some(a.controller.as_path()),
-        a.r_json.as_deref(),
-        a.data.as_deref(),
-        config.data.as_deref(),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    let inputs: Vec<&Path> = [a.config.as_path(), a.controller.as_path()]
+        .into_iter()
+        .chain(a.bounds.files())
+        .chain(config.data.as_deref())
+        .collect();
     let _manifest = match &a.out {
         Some(out) => Some(super::common::prepare_out(out, &inputs)?),
         None => None,
@@ -77,7 +60,7 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         fit_text = text;
         rs.push(("fitted".into(), r));
     }
-    let outcome = stability::run(&config, &controller, &rs, a.data.as_deref())?;
+    let outcome = stability::run(&config, &controller, &rs, a.bounds.data.as_deref())?;
     let written = match &a.out {
         Some(out) => {
             let k = a

@@ -13,15 +13,9 @@ use std::path::{Path, PathBuf};
 pub struct SynthesizeArgs {
     /// The TOML config ([plant], or [model]/[physical] factors; its [r] is the configured bound).
     pub config: PathBuf,
-    /// A fitted r (the r.json written by `rshape run` or `rshape fit`).
-    #[arg(long)]
-    pub r_json: Option<PathBuf>,
-    /// Fit r from the config's data first (as `rshape fit`; exports go to --out).
-    #[arg(long, conflicts_with = "r_json")]
-    pub fit: bool,
-    /// Data file overriding the one in the config.
-    #[arg(long)]
-    pub data: Option<PathBuf>,
+    /// `--r-json`, `--fit`, `--data`: the bounds besides the config's `[r]`.
+    #[command(flatten)]
+    pub bounds: super::common::BoundArgs,
     /// Suboptimality: the central controller at gamma = F * gamma_min (F > 1).
     #[arg(long, default_value_t = 1.1)]
     pub gamma_factor: f64,
@@ -51,23 +45,12 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
             a.gamma_factor
         ));
     }
-    let (mut rs, fit_input) = super::common::controller_bounds(
-        &a.config,
-        &config,
-        a.r_json.as_deref(),
-        a.fit,
-        a.data.as_deref(),
-    )?;
-    let inputs: Vec<&Path> = [
-        Some(a.config.as_path()),
-        a.r_json.as_deref(),
-        a.weights.as_deref(),
-        a.data.as_deref(),
-        config.data.as_deref(),
-    ]
-    .into_iter()
-    .flatten()
-    .collect();
+    let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
+    let inputs: Vec<&Path> = std::iter::once(a.config.as_path())
+        .chain(a.bounds.files())
+        .chain(a.weights.as_deref())
+        .chain(config.data.as_deref())
+        .collect();
     // Everything that can fail on bad input is checked before the folder is touched: the
     // synthesis itself runs in memory first.
     let settings = synthesize::SynthesisSettings {
@@ -83,14 +66,11 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         },
     };
     let controller_path = a.out.join("controller.toml");
-    let dry = synthesize::run(
-        &config,
-        &a.config,
-        &rs,
-        &settings,
-        a.data.as_deref(),
-        &controller_path,
-    )?;
+    let data = a.bounds.data.as_deref();
+    let prove = |rs: &[(String, crate::system::TransferFunction)]| {
+        synthesize::run(&config, &a.config, rs, &settings, data, &controller_path)
+    };
+    let dry = prove(&rs)?;
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     // Without --fit the run above is the outcome; with it, the proof is repeated with the
     // fitted r added.
@@ -101,14 +81,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
             let (text, r) = super::common::fit_bound("synthesize --fit", input, &a.out)?;
             fit_text = text;
             rs.push(("fitted".into(), r));
-            synthesize::run(
-                &config,
-                &a.config,
-                &rs,
-                &settings,
-                a.data.as_deref(),
-                &controller_path,
-            )?
+            prove(&rs)?
         }
     };
     let written = synthesize::write_outputs(&a.out, &outcome)?;

@@ -1,22 +1,5 @@
-//! The TOML config: the nominal factorization, the bound `r`, the data file and the noise.
-//!
-//! ```toml
-//! name = "paper MIMO example"
-//! data = "paper_mimo.csv"            # relative to this file; --data overrides it
-//!
-//! [model]
-//! factorization = "standard"         # or "special"
-//! m = [[{ num = [1, 2], den = [1, 1] }, { num = [1, 3], den = [1, 2] }],
-//!      [0,                              { num = [1, 1], den = [1, 2] }]]
-//! n = [[{ num = [1], den = [1, 1] }, { num = [2], den = [1, 1] }, 0],
-//!      [0, { num = [1], den = [1, 3] }, { num = [2], den = [1, 2] }]]
-//!
-//! [r]
-//! num = [1e-8, 0.3]
-//! den = [1, 1]
-//! ```
-//!
-//! Unknown keys are errors (a typo must not be silently ignored).
+//! The TOML config: the nominal factorization, the bound `r`, the data file and the noise
+//! (the format is in [`Config`]'s documentation).
 
 use super::factorization::Factorization;
 use crate::error::{Error, Result};
@@ -100,7 +83,7 @@ pub struct RSection {
     pub den: Vec<f64>,
 }
 
-/// The `[noise]` table (see [`crate::model::noise`] for how the keys are resolved).
+/// The `[noise]` table (see [`crate::model::resolve_noise`] for how the keys are resolved).
 ///
 /// ```toml
 /// [noise]
@@ -183,6 +166,24 @@ pub struct RawConfig {
 }
 
 /// A loaded, validated config.
+///
+/// ```toml
+/// name = "paper MIMO example"
+/// data = "paper_mimo.csv"            # relative to this file; --data overrides it
+///
+/// [model]
+/// factorization = "standard"         # or "special"
+/// m = [[{ num = [1, 2], den = [1, 1] }, { num = [1, 3], den = [1, 2] }],
+///      [0,                              { num = [1, 1], den = [1, 2] }]]
+/// n = [[{ num = [1], den = [1, 1] }, { num = [2], den = [1, 1] }, 0],
+///      [0, { num = [1], den = [1, 3] }, { num = [2], den = [1, 2] }]]
+///
+/// [r]
+/// num = [1e-8, 0.3]
+/// den = [1, 1]
+/// ```
+///
+/// Unknown keys are errors (a typo must not be silently ignored).
 #[derive(Debug, Clone)]
 pub struct Config {
     /// The file it came from.

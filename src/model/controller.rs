@@ -1,15 +1,4 @@
-//! A controller `K` read from a TOML file with a `[controller]` table, in the same three
-//! forms as `[plant]` (a transfer-function matrix, inline `a`, `b`, `c`, `d`, or a JSON
-//! state-space file):
-//!
-//! ```toml
-//! [controller]
-//! tf = [[{ num = [2, 1], den = [1, 10] }]]   # m × p: plant inputs × plant outputs
-//! feedback = "negative"                       # u = −K·y (default); "positive": u = +K·y
-//! ```
-//!
-//! The type is general: any consumer that needs `K` as a state-space system (the
-//! robust-stability test, closed-loop data) can use it.
+//! A controller `K` read from a TOML file with a `[controller]` table ([`Controller`]).
 
 use super::config::TfEntry;
 use super::plant::PlantSection;
@@ -62,7 +51,18 @@ struct ControllerFile {
     controller: ControllerSection,
 }
 
-/// A loaded controller.
+/// A loaded controller, read from a TOML file with a `[controller]` table in the same three
+/// forms as `[plant]` (a transfer-function matrix, inline `a`, `b`, `c`, `d`, or a JSON
+/// state-space file):
+///
+/// ```toml
+/// [controller]
+/// tf = [[{ num = [2, 1], den = [1, 10] }]]   # m × p: plant inputs × plant outputs
+/// feedback = "negative"                       # u = −K·y (default); "positive": u = +K·y
+/// ```
+///
+/// The type is general: any consumer that needs `K` as a state-space system (the
+/// robust-stability test, closed-loop data) can use it.
 #[derive(Debug, Clone)]
 pub struct Controller {
     /// The file it came from.

@@ -145,7 +145,7 @@ impl Factorization {
     }
 
     /// The standard factorization by the normalized left coprime factors of a state-space
-    /// plant (`M̃M̃* + ÑÑ* = I`, see [`crate::system::ncf`]).
+    /// plant (`M̃M̃* + ÑÑ* = I`, see [`crate::system::NormalizedLcf`]).
     pub fn normalized(ncf: NormalizedLcf) -> Self {
         let (p, m) = ncf.shape();
         let zeros = |r: usize, c: usize| {

@@ -1,17 +1,5 @@
-//! Noise models of the measurements (Boulet & Francis 1998, Sec. III, eqs. (4)–(5)).
-//!
-//! A datum `φ_i` is the true response plus a complex noise in the disk
-//! `W_i = {w : |w| < L_a,i}` (eq. (5)).  The radius comes from one of three places:
-//!
-//! 1. a global radius `L_a`: the CLI flag `--noise-radius X`, or `[noise] radius = X`;
-//! 2. the time-domain `L∞` model of Sec. III, `[noise] output_bound = M`: every datum gets the
-//!    radius of the largest disk inside its uncertainty set `U` ([`linf_disk_radius`]);
-//! 3. per-frequency radii: `[noise] std_file` (radius `std_factor·std`, default 3σ) or a
-//!    `noise_radius` column in the data file.
-//!
-//! **Precedence** ([`resolve_noise`]): CLI flag > config (`radius`, `output_bound` or
-//! `std_file`, which exclude each other) > data column.  When none is given there is no
-//! noise model (use the noise-free theorems).
+//! Noise models of the measurements (Boulet & Francis 1998, Sec. III, eqs. (4)–(5)); the
+//! three sources and their precedence are in [`resolve_noise`]'s documentation.
 
 use super::Config;
 use crate::data::std_file::read_std_csv;
@@ -161,8 +149,21 @@ pub fn is_noise_free(
     }
 }
 
-/// Resolves the noise model with precedence CLI flag > config > data column (see the module
-/// documentation).  `Ok(None)` when no noise is given anywhere.
+/// Resolves the noise model with precedence CLI flag > config > data column.  `Ok(None)`
+/// when no noise is given anywhere.
+///
+/// A datum `φ_i` is the true response plus a complex noise in the disk
+/// `W_i = {w : |w| < L_a,i}` (eq. (5)).  The radius comes from one of three places:
+///
+/// 1. a global radius `L_a`: the CLI flag `--noise-radius X`, or `[noise] radius = X`;
+/// 2. the time-domain `L∞` model of Sec. III, `[noise] output_bound = M`: every datum gets the
+///    radius of the largest disk inside its uncertainty set `U` ([`linf_disk_radius`]);
+/// 3. per-frequency radii: `[noise] std_file` (radius `std_factor·std`, default 3σ) or a
+///    `noise_radius` column in the data file.
+///
+/// **Precedence**: CLI flag > config (`radius`, `output_bound` or
+/// `std_file`, which exclude each other) > data column.  When none is given there is no
+/// noise model (use the noise-free theorems).
 ///
 /// `data` must be the SISO data the envelope will use.  The config's `std_file` belongs to
 /// the config's own data file; for other data (`--data`), `<data stem>_std.csv` beside them

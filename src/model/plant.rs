@@ -1,16 +1,4 @@
-//! The `[plant]` table: a plain plant whose normalized left coprime factors rshape computes
-//! (see [`crate::system::ncf`] for the formulas and why this normalization is canonical).
-//!
-//! ```toml
-//! [plant]                       # one of the three forms:
-//! tf = [[{ num = [1], den = [1, 0.2, 4] }, 0.5]]   # a transfer-function matrix, or
-//! # a = [[0, 1], [-4, -0.2]]    # inline state space (rows), with b, c, d, or
-//! # b = [[0], [1]]
-//! # c = [[1, 0]]
-//! # d = [[0]]
-//! # file = "model.json"         # JSON {"A": [[..]], "B": .., "C": .., "D": ..}
-//! # reduce_order = 20           # optional: balanced truncation of a stable plant first
-//! ```
+//! The `[plant]` table ([`PlantSection`]).
 
 use super::config::TfEntry;
 use super::factorization::Factorization;
@@ -20,7 +8,19 @@ use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The `[plant]` table.
+/// The `[plant]` table: a plain plant whose normalized left coprime factors rshape computes
+/// (see [`NormalizedLcf`] for the formulas and why this normalization is canonical).
+///
+/// ```toml
+/// [plant]                       # one of the three forms:
+/// tf = [[{ num = [1], den = [1, 0.2, 4] }, 0.5]]   # a transfer-function matrix, or
+/// # a = [[0, 1], [-4, -0.2]]    # inline state space (rows), with b, c, d, or
+/// # b = [[0], [1]]
+/// # c = [[1, 0]]
+/// # d = [[0]]
+/// # file = "model.json"         # JSON {"A": [[..]], "B": .., "C": .., "D": ..}
+/// # reduce_order = 20           # optional: balanced truncation of a stable plant first
+/// ```
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlantSection {

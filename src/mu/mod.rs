@@ -22,9 +22,15 @@
 //! search feeds its top right singular vector (unscaled) to this bound; at the optimal `d`,
 //! `h = 0` makes both ratios equal `σ̄`, closing the gap.  Degenerate cases (optimum at
 //! `d → 0` or `∞`, repeated `σ̄`) have their own candidates; see [`mu_full_scalar`].
+//!
+//! What is here: [`mu_full_scalar`] (and [`mu_full_scalar_from`], warm-started) on the
+//! structure [`FullPlusScalar`] with [`MuSettings`], giving [`MuBounds`] and a [`MuStatus`];
+//! [`mu_two_scalar`], the closed form for two complex scalar blocks.
 
 mod search;
-pub mod two_scalar;
+pub(crate) mod two_scalar;
+
+pub use two_scalar::mu_two_scalar;
 
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector, SVD};

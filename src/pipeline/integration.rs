@@ -1,6 +1,6 @@
 //! The points where the pipeline meets the noise model and the μ test (Theorem 4,
-//! [`crate::model::noise`], [`crate::consistency::noisy`], [`crate::mu`]) and the fit of `r`
-//! ([`crate::fit`], [`crate::report::export`]).  Everything that depends on those modules
+//! [`crate::model::resolve_noise`], [`crate::consistency::noisy_envelope`], [`crate::mu`]) and the fit of `r`
+//! ([`crate::fit`], [`crate::report::write_fit_exports`]).  Everything that depends on those modules
 //! goes through the functions here.
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);

@@ -137,20 +137,29 @@ pub fn run(
     })
 }
 
+/// Longest title of `stability.svg` in characters: one line of the caption at its font size
+/// (about 860 of the figure's 960 pixels).
+pub const FIGURE_TITLE_CHARS: usize = 92;
+
 /// The title of `stability.svg`: it names the model and the controller (a figure travels
-/// without its folder), at most 80 characters.
+/// without its folder), at most [`FIGURE_TITLE_CHARS`] characters.  The controller's name is
+/// never dropped: a long model name is shortened first, in the middle (`…`), keeping at least
+/// 16 of its characters; only then is the controller's name shortened in the middle too.
 pub fn figure_title(config: &Config, controller: &str) -> String {
+    use crate::report::fmt::ellipsize_middle;
     let name = config
         .raw
         .name
         .clone()
         .unwrap_or_else(|| config.path.display().to_string());
-    let title = format!("Theorem 1: 1/σ_max(T) vs |r| — {name}, {controller}");
-    if title.chars().count() > 80 {
-        format!("{}…", title.chars().take(79).collect::<String>())
-    } else {
-        title
-    }
+    let prefix = "Theorem 1: 1/σ_max(T) vs |r| — ";
+    let fixed = prefix.chars().count() + ", ".chars().count();
+    let room = FIGURE_TITLE_CHARS.saturating_sub(fixed);
+    let controller_chars = controller.chars().count();
+    let name_room = room.saturating_sub(controller_chars).max(16);
+    let name = ellipsize_middle(&name, name_room);
+    let controller = ellipsize_middle(controller, room.saturating_sub(name.chars().count()));
+    format!("{prefix}{name}, {controller}")
 }
 
 /// Writes `stability.svg` (titled `title`, see [`figure_title`]) and `stability.json` into

@@ -47,19 +47,8 @@ pub fn batch_svg(inp: &BatchFigureInput, sym: &Symbols) -> Result<String> {
         + usize::from(!inp.datasets.is_empty())
         + usize::from(conf.is_some())
         + usize::from(fit.is_some());
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        let (plot, below) = root.split_vertically(SIZE.1);
-        let mut leg = Legend::default();
-        let mut chart = loglog_chart(
-            &plot,
-            inp.title,
-            (xlo, xhi),
-            (ylo, yhi),
-            "magnitude (absolute, unitless)",
-        )?;
+    let y_desc = "magnitude (absolute, unitless)";
+    loglog_figure(inp.title, (xlo, xhi), (ylo, yhi), y_desc, rows, |p| {
         let pts = |om: &[f64], v: &[f64]| -> Vec<(f64, f64)> {
             om.iter()
                 .zip(v)
@@ -72,13 +61,13 @@ pub fn batch_svg(inp: &BatchFigureInput, sym: &Symbols) -> Result<String> {
         let shade = |k: usize| PALETTE[2 + k % (PALETTE.len() - 2)].mix(0.55);
         for (k, (om, v)) in inp.datasets.iter().enumerate() {
             let col = shade(k);
-            chart
+            p.chart
                 .draw_series(LineSeries::new(pts(om, v), col.stroke_width(1)))
                 .map_err(plot_err)?;
         }
         if !inp.datasets.is_empty() {
             let col = shade(0);
-            leg.add(
+            p.legend.add(
                 format!(
                     "{wmin} per datum of each of the {} datasets (one colour each)",
                     inp.datasets.len()
@@ -87,41 +76,24 @@ pub fn batch_svg(inp: &BatchFigureInput, sym: &Symbols) -> Result<String> {
             );
         }
         let s = ShapeStyle::from(&BLACK).stroke_width(2);
-        chart
+        p.chart
             .draw_series(LineSeries::new(pts(inp.combined.0, inp.combined.1), s))
             .map_err(plot_err)?;
-        leg.add(
+        p.legend.add(
             format!("combined envelope: the largest {wmin} over the datasets"),
             move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
         );
-        if let Some(c) = &conf {
-            let s = ShapeStyle::from(&C_BLUE).stroke_width(3);
-            chart
-                .draw_series(LineSeries::new(pts(inp.grid, c), s))
-                .map_err(plot_err)?;
-            leg.add(
-                format!(
-                    "|{w}(jω)|, configured {w} = {}",
-                    tf_label(inp.r_configured.expect("set"))
-                ),
-                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
-            );
+        if let (Some(r), Some(c)) = (inp.r_configured, &conf) {
+            let label = format!("|{w}(jω)|, configured {w} = {}", tf_label(r));
+            p.weight(pts(inp.grid, c), WeightCurve::Configured, label)?;
         }
-        if let Some(f) = &fit {
-            let s = ShapeStyle::from(&C_ORANGE).stroke_width(3);
-            chart
-                .draw_series(DashedLineSeries::new(pts(inp.grid, f), 12, 4, s))
-                .map_err(plot_err)?;
-            leg.add(
-                format!(
-                    "|{w}(jω)|, fitted {w} = {} (one {w} for all datasets)",
-                    tf_label(inp.r_fitted.expect("set"))
-                ),
-                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+        if let (Some(r), Some(f)) = (inp.r_fitted, &fit) {
+            let label = format!(
+                "|{w}(jω)|, fitted {w} = {} (one {w} for all datasets)",
+                tf_label(r)
             );
+            p.weight(pts(inp.grid, f), WeightCurve::Fitted, label)?;
         }
-        leg.draw(&below)?;
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }

@@ -43,21 +43,10 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                 .any(|(i, m)| *m > 1.0 && !inp.a1_failing.get(i).copied().unwrap_or(false)),
         ) + usize::from(inp.a1_failing.iter().any(|f| *f))
             + usize::from(inp.mu.iter().any(|m| *m <= 1.0));
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        let (plot, below) = root.split_vertically(SIZE.1);
-        let mut leg = Legend::default();
-        let mut chart = loglog_chart(
-            &plot,
-            inp.title,
-            (xlo, xhi),
-            (ylo, yhi),
-            &format!("{mu_name} (dimensionless)"),
-        )?;
+    let y_desc = format!("{mu_name} (dimensionless)");
+    loglog_figure(inp.title, (xlo, xhi), (ylo, yhi), &y_desc, rows, |p| {
         let s = C_GREY.stroke_width(2);
-        chart
+        p.chart
             .draw_series(DashedLineSeries::new(
                 vec![(xlo, 1.0), (xhi, 1.0)],
                 10,
@@ -65,7 +54,7 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
                 s,
             ))
             .map_err(plot_err)?;
-        leg.add(
+        p.legend.add(
             "μ = 1: consistent above, inconsistent at or below",
             move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
         );
@@ -79,21 +68,21 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
             })
             .collect();
         // A thin line through the data guides the eye; the markers carry the verdict.
-        chart
+        p.chart
             .draw_series(LineSeries::new(
                 pts.iter().map(|p| (p.0, p.1)),
                 C_BLUE.mix(0.35).stroke_width(1),
             ))
             .map_err(plot_err)?;
         if pts.iter().any(|p| p.2 && p.3) {
-            chart
+            p.chart
                 .draw_series(
                     pts.iter()
                         .filter(|p| p.2 && p.3)
                         .map(|p| Circle::new((p.0, p.1), 3, C_BLUE.filled())),
                 )
                 .map_err(plot_err)?;
-            leg.add(
+            p.legend.add(
                 format!("{mu_name} per datum, configured {w} (consistent)"),
                 |(x, y)| Circle::new((x + 12, y), 4, C_BLUE.filled()),
             );
@@ -101,13 +90,13 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
         let n_inadmissible = pts.iter().filter(|p| p.2 && !p.3).count();
         if n_inadmissible > 0 {
             let sq = |(x, y): (i32, i32)| [(x - 4, y - 4), (x + 4, y + 4)];
-            chart
+            p.chart
                 .draw_series(pts.iter().filter(|p| p.2 && !p.3).map(|p| {
                     EmptyElement::at((p.0, p.1))
                         + Rectangle::new(sq((0, 0)), C_PURPLE.stroke_width(2))
                 }))
                 .map_err(plot_err)?;
-            leg.add(
+            p.legend.add(
 format!(
                     "{mu_name} > 1 but A1 fails ({n_inadmissible} data): configured {w} NOT ADMISSIBLE, no verdict"
                 ),
@@ -116,21 +105,20 @@ move |(x, y)| {
                 });
         }
         if pts.iter().any(|p| !p.2) {
-            chart
+            p.chart
                 .draw_series(pts.iter().filter(|p| !p.2).map(|p| {
                     EmptyElement::at((p.0, p.1))
                         + Circle::new((0, 0), 6, C_RED.stroke_width(2))
                         + Cross::new((0, 0), 4, C_RED.stroke_width(2))
                 }))
                 .map_err(plot_err)?;
-            leg.add(format!("{mu_name} ≤ 1: FAILING datum"), |(x, y)| {
-                EmptyElement::at((x + 12, y))
-                    + Circle::new((0, 0), 6, C_RED.stroke_width(2))
-                    + Cross::new((0, 0), 4, C_RED.stroke_width(2))
-            });
+            p.legend
+                .add(format!("{mu_name} ≤ 1: FAILING datum"), |(x, y)| {
+                    EmptyElement::at((x + 12, y))
+                        + Circle::new((0, 0), 6, C_RED.stroke_width(2))
+                        + Cross::new((0, 0), 4, C_RED.stroke_width(2))
+                });
         }
-        leg.draw(&below)?;
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }

@@ -28,17 +28,11 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
         .filter(|v| v.is_finite() && **v > 0.0);
     let (ylo, yhi) = log_range(all, 2.0).unwrap_or((0.01, 100.0));
     let rows = inp.r.len() + 1;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, size_with_legend(rows)).into_drawing_area();
-        root.fill(&WHITE).map_err(plot_err)?;
-        let (plot, below) = root.split_vertically(SIZE.1);
-        let mut leg = Legend::default();
-        let mut chart = loglog_chart(&plot, inp.title, (xlo, xhi), (ylo, yhi), "magnitude")?;
+    loglog_figure(inp.title, (xlo, xhi), (ylo, yhi), "magnitude", rows, |p| {
         // Limits are purple and dashed, as the A1 limit of r_vs_delta.svg; the configured r
         // is blue and the fitted r orange in every figure.
         let s = C_PURPLE.stroke_width(3);
-        chart
+        p.chart
             .draw_series(DashedLineSeries::new(
                 inp.omega
                     .iter()
@@ -50,7 +44,7 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
                 s,
             ))
             .map_err(plot_err)?;
-        leg.add(
+        p.legend.add(
             "1/σ_max(T(jω)): largest |r| proven robust (Theorem 1)",
             move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
         );
@@ -64,7 +58,7 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
                 others[k % others.len()]
             }
             .stroke_width(3);
-            chart
+            p.chart
                 .draw_series(LineSeries::new(
                     inp.omega
                         .iter()
@@ -73,12 +67,10 @@ pub fn stability_svg(inp: &StabilityInput) -> Result<String> {
                     c,
                 ))
                 .map_err(plot_err)?;
-            leg.add(format!("|r(jω)|, {label}"), move |(x, y)| {
+            p.legend.add(format!("|r(jω)|, {label}"), move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 24, y)], c)
             });
         }
-        leg.draw(&below)?;
-        root.present().map_err(plot_err)?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }

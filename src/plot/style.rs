@@ -299,6 +299,85 @@ pub fn loglog_chart<'a, 'b>(
     Ok(chart)
 }
 
+/// A log-log plot being drawn: the chart to put the series on and the legend that collects
+/// their entries (drawn below the plot when the figure is finished).
+pub struct LogLogPlot<'a, 'b> {
+    /// The chart (caption, axes and mesh of [`loglog_chart`]).
+    pub chart: LogLogChart<'a, 'b>,
+    /// The legend strip below the plot.
+    pub legend: Legend<'a, SVGBackend<'b>>,
+    // The chart borrows the drawing area of a backend that lives longer ('b: 'a).
+    _area: std::marker::PhantomData<&'a SVGBackend<'b>>,
+}
+
+/// A log-log figure with its legend strip below, as an SVG document: the caption, axes and
+/// mesh of [`loglog_chart`] over `x` × `y`, then `draw` puts the series on the chart and their
+/// entries in the legend (of `legend_rows` entries, which sets the figure's height).
+pub fn loglog_figure<F>(
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+    y_desc: &str,
+    legend_rows: usize,
+    draw: F,
+) -> Result<String>
+where
+    F: for<'a, 'b> FnOnce(&mut LogLogPlot<'a, 'b>) -> Result<()>,
+{
+    let mut svg = String::new();
+    {
+        let root =
+            SVGBackend::with_string(&mut svg, size_with_legend(legend_rows)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let (plot, below) = root.split_vertically(SIZE.1);
+        let mut p = LogLogPlot {
+            chart: loglog_chart(&plot, title, x, y, y_desc)?,
+            legend: Legend::default(),
+            _area: std::marker::PhantomData,
+        };
+        draw(&mut p)?;
+        p.legend.draw(&below)?;
+        root.present().map_err(plot_err)?;
+    }
+    Ok(svg)
+}
+
+/// Which weight a curve shows: the configured one (solid blue) or the fitted one (dashed
+/// orange), the same in every figure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WeightCurve {
+    /// The configured `r` (or `V`).
+    Configured,
+    /// The fitted `r` (or `V`).
+    Fitted,
+}
+
+impl LogLogPlot<'_, '_> {
+    /// Draws `|w(jω)|` at `points` in the look of `kind` and adds its legend entry `label`.
+    pub fn weight(
+        &mut self,
+        points: Vec<(f64, f64)>,
+        kind: WeightCurve,
+        label: String,
+    ) -> Result<()> {
+        let s = match kind {
+            WeightCurve::Configured => ShapeStyle::from(&C_BLUE).stroke_width(3),
+            WeightCurve::Fitted => ShapeStyle::from(&C_ORANGE).stroke_width(3),
+        };
+        match kind {
+            WeightCurve::Configured => self.chart.draw_series(LineSeries::new(points, s)),
+            WeightCurve::Fitted => self
+                .chart
+                .draw_series(DashedLineSeries::new(points, 12, 4, s)),
+        }
+        .map_err(plot_err)?;
+        self.legend.add(label, move |(x, y)| {
+            PathElement::new(vec![(x, y), (x + 24, y)], s)
+        });
+        Ok(())
+    }
+}
+
 /// The mesh shared by the log-log figures: frequency in rad/s on x, `y_desc` on y, ticks at
 /// 1-2-5, light grid lines.
 pub fn loglog_mesh<X, Y>(

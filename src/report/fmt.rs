@@ -124,6 +124,24 @@ pub fn fmt_pct(x: f64) -> String {
     format!("{:.1} %", 100.0 * x)
 }
 
+/// `s` in at most `max` characters: cut in the middle with `…` when longer, so that both its
+/// beginning and its end stay readable (a long model name keeps its distinguishing tail).
+pub fn ellipsize_middle(s: &str, max: usize) -> String {
+    let n = s.chars().count();
+    if n <= max {
+        return s.to_string();
+    }
+    if max == 0 {
+        return String::new();
+    }
+    let keep = max - 1;
+    let head = keep.div_ceil(2);
+    let tail = keep - head;
+    let first: String = s.chars().take(head).collect();
+    let last: String = s.chars().skip(n - tail).collect();
+    format!("{first}…{last}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

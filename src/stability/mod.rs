@@ -7,18 +7,27 @@
 //! stabilized by `K` iff
 //! 1. `K` internally stabilizes the loop of Fig. 1 (tested here on the eigenvalues of the
 //!    closed-loop state matrix), and
-//! 2. `‖r·T‖∞ ≤ 1` with `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹` ([`factor_loop`]); for the
+//! 2. `‖r·T‖∞ ≤ 1` with `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹` ([`theorem1_system`]); for the
 //!    standard factorization `T = [−K; I](I + GK)⁻¹M̃⁻¹` (the paper writes `(I − GK)⁻¹`
 //!    for `u = +K·y`; the norm is the same).
 //!
 //! The robust-stability margin `α* = 1/‖r·T‖∞` is the largest scale of `r` still proven
-//! robust; it is computed **exactly** as an H∞ norm ([`crate::system::hinf`]), and a grid
+//! robust; it is computed **exactly** as an H∞ norm ([`crate::system::hinf_norm`]), and a grid
 //! curve `1/σ_max(T(jω))` is computed independently from the factor values for the figure.
 //! For normalized factors `‖T‖∞` equals `1/b(G, K)`, the normalized-coprime-factor
 //! stability margin `b(G, K) = 1/‖[K; I](I + GK)⁻¹[I G]‖∞`: the crate computes both as a
 //! cross-check.
-pub mod factor_loop;
-pub mod theorem1;
+//!
+//! What is here (the submodules are private; everything below is re-exported here):
+//! [`analyze`] (the whole test: [`RobustStability`] with its [`Verdict`], the proven margin
+//! and the grid curve [`GridCurve`] of [`MarginRow`]s, cross-checked within
+//! [`CROSS_CHECK_RTOL`]), [`decide`] (the verdict from the norm's bounds), and the systems
+//! it is computed on: [`theorem1_system`] (`r·T` of condition 2), [`gang_of_four`],
+//! [`plant_system`], [`modal_system`] and the grid value [`t_sigma_max`].
+pub(crate) mod factor_loop;
+pub(crate) mod theorem1;
 
 pub use factor_loop::{gang_of_four, modal_system, plant_system, t_sigma_max, theorem1_system};
-pub use theorem1::{analyze, decide, GridCurve, MarginRow, RobustStability, Verdict};
+pub use theorem1::{
+    analyze, decide, GridCurve, MarginRow, RobustStability, Verdict, CROSS_CHECK_RTOL,
+};

@@ -6,7 +6,7 @@
 //!
 //! * the control Riccati equation `ĀᵀX + XĀ − XBR⁻¹BᵀX + CᵀS⁻¹C = 0`,
 //! * the filter Riccati equation `ĀZ + ZĀᵀ − ZCᵀS⁻¹CZ + BR⁻¹Bᵀ = 0` (the `Y` of
-//!   [`crate::system::ncf`]),
+//!   [`crate::system::NormalizedLcf`]),
 //!
 //! the largest normalized-coprime-factor stability margin any controller attains is, in
 //! closed form (eq. (9.64)),

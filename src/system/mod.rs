@@ -1,22 +1,41 @@
 //! Linear time-invariant systems: polynomials, transfer functions, transfer-function
 //! matrices and state-space models, all evaluated on the imaginary axis.
-pub mod compensated;
-pub mod dense_inverse;
-pub mod eig;
-pub mod freq_eval;
-pub mod golden;
-pub mod hinf;
-pub mod interconnect;
-pub mod linalg;
-pub mod ncf;
-pub mod polynomial;
-pub mod realization;
-pub mod riccati;
-pub mod state_space;
-pub mod tf_matrix;
-pub mod transfer_function;
+//!
+//! What is here (the submodules are private; everything below is re-exported here):
+//! * models: [`Polynomial`] (with its [`Roots`]), [`TransferFunction`], [`TfMatrix`],
+//!   [`StateSpace`], and [`FreqEvaluator`] for accurate responses of large state-space models;
+//! * norms and spectra: [`hinf_norm`] (exact H∞ norm, [`HinfNorm`], accuracy [`HINF_RTOL`]),
+//!   [`eigenvalues`] and [`spectral_abscissa`] (capped real Schur form), [`spectral_norm`]
+//!   and [`extreme_singular_values`];
+//! * Riccati and Lyapunov equations: [`care`] ([`CareSolution`], [`care_residual`]) and
+//!   [`lyapunov`];
+//! * factorizations and loops: [`NormalizedLcf`] (normalized left coprime factors of a
+//!   plant) and [`negative_feedback`] (the loop `u = −K·y`);
+//! * grids: [`logspace`].
+pub(crate) mod compensated;
+pub(crate) mod dense_inverse;
+pub(crate) mod eig;
+pub(crate) mod freq_eval;
+pub(crate) mod golden;
+pub(crate) mod hinf;
+pub(crate) mod interconnect;
+pub(crate) mod linalg;
+pub(crate) mod ncf;
+pub(crate) mod polynomial;
+pub(crate) mod realization;
+pub(crate) mod riccati;
+pub(crate) mod state_space;
+pub(crate) mod tf_matrix;
+pub(crate) mod transfer_function;
 
-pub use polynomial::Polynomial;
+pub use eig::{eigenvalues, spectral_abscissa};
+pub use freq_eval::FreqEvaluator;
+pub use hinf::{hinf_norm, HinfNorm, HINF_RTOL};
+pub use interconnect::negative_feedback;
+pub use linalg::{extreme_singular_values, spectral_norm};
+pub use ncf::NormalizedLcf;
+pub use polynomial::{Polynomial, Roots};
+pub use riccati::{care, care_residual, lyapunov, CareSolution};
 pub use state_space::StateSpace;
 pub use tf_matrix::TfMatrix;
 pub use transfer_function::TransferFunction;

@@ -15,7 +15,7 @@ impl StateSpace {
     }
 
     /// The same system after diagonal balancing of `A` (an exact similarity by powers of
-    /// two, see [`super::eig::balancing`]).
+    /// two, see `balancing` in `eig.rs`).
     pub fn balanced(&self) -> StateSpace {
         let d = super::eig::balancing(&self.a);
         StateSpace {

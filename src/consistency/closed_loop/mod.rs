@@ -1,17 +1,39 @@
 //! Closed-loop envelopes (Crowder & de Callafon): per datum, the smallest `|V(jω_i)|`
 //! consistent with closed-loop frequency-response data `Φ_i = Y_i/R_i` — noise-free
-//! ([`noise_free`], Theorem 1, Corollaries 1–2, SISO and MIMO) or noisy SISO ([`noisy`],
-//! Theorem 2).  The result is an ordinary [`Envelope`] (no A1 limit: the closed-loop model
+//! (Theorem 1, Corollaries 1–2, SISO and MIMO) or noisy SISO
+//! (Theorem 2).  The result is an ordinary [`Envelope`] (no A1 limit: the closed-loop model
 //! has none), so the check, the certified fit and the figures of the open-loop path apply.
-pub mod noise_free;
-pub mod noisy;
+//!
+//! What is here (the submodules are private; everything below is re-exported here):
+//! * the envelope: [`closed_loop_envelope`] ([`ClosedLoopReport`], [`ClosedLoopDatum`]) and
+//!   the per-datum `μ` of a given `V`, [`mu_per_datum`];
+//! * noise-free data (Theorem 1, Corollaries 1–2): the perturbation [`delta_bar`]
+//!   ([`DeltaBar`]) and its identities — [`recover_plant`], [`closed_loop_map`],
+//!   [`perturbed_plant`], [`delta_bar_from_plant`], the printed Corollary 1
+//!   [`delta_bar_corollary1_printed`], the interconnection [`lft_m`] and [`upper_lft`] of
+//!   eq. (6), Theorem 1's [`theorem1_n11`]; thresholds [`UNINFORMATIVE_SENSITIVITY`] and
+//!   [`SINGULAR_E`];
+//! * noisy SISO data (Theorem 2): [`v_min_noisy`] ([`ClosedLoopNoisyDatum`],
+//!   [`NoisyRoute`]) by the closed form [`v_min_eq18`] or a `μ` bisection
+//!   [`v_min_mu_bisection`] ([`VBisectionSettings`]) on [`theorem2_g1`] and [`mu_at`].
+pub(crate) mod noise_free;
+pub(crate) mod noisy;
+
+pub use noise_free::{
+    closed_loop_map, delta_bar, delta_bar_corollary1_printed, delta_bar_from_plant, lft_m,
+    perturbed_plant, recover_plant, theorem1_n11, upper_lft, DeltaBar, SINGULAR_E,
+    UNINFORMATIVE_SENSITIVITY,
+};
+pub use noisy::{
+    mu_at, theorem2_g1, v_min_eq18, v_min_mu_bisection, v_min_noisy, ClosedLoopNoisyDatum,
+    NoisyRoute, VBisectionSettings,
+};
 
 use super::envelope::{Envelope, EnvelopeMethod};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::closed_loop::ClosedLoopModel;
 use crate::system::TransferFunction;
-use noisy::{theorem2_g1, v_min_noisy, ClosedLoopNoisyDatum, VBisectionSettings};
 use serde::Serialize;
 
 /// Per-datum diagnostics of the closed-loop envelope.
@@ -113,7 +135,7 @@ pub fn closed_loop_envelope(
     let mut rows = Vec::with_capacity(data.len());
     for (i, (&omega, phi)) in data.omega.iter().zip(&data.response).enumerate() {
         let at = at_or_err(model, data, omega)?;
-        let nf = noise_free::delta_bar(&at, phi);
+        let nf = delta_bar(&at, phi);
         let noisy = match radii {
             Some(r) => {
                 let rho = r[i];
@@ -172,7 +194,7 @@ pub fn mu_per_datum(
         .map(|((&w, phi), &rho)| {
             let at = at_or_err(model, data, w)?;
             Ok(match theorem2_g1(&at, phi[(0, 0)], rho) {
-                Some(g1) => noisy::mu_at(&g1, v.freq(w).norm()),
+                Some(g1) => mu_at(&g1, v.freq(w).norm()),
                 None => f64::INFINITY,
             })
         })

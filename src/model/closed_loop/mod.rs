@@ -25,11 +25,27 @@
 //! ```
 //!
 //! At load time both loops `(P̂, C)` and `(P̂, C̄)` are checked for internal stability
-//! ([`stability::check_loop`]): the paper needs both (`M` of eq. (6) is stable iff `C̄`
+//! ([`check_loop`]): the paper needs both (`M` of eq. (6) is stable iff `C̄`
 //! stabilizes `P̂`).
-pub mod physical_nominal;
-pub mod stability;
-pub mod stability_ss;
+//!
+//! What is here (the submodules are private; everything below is re-exported here):
+//! * the model: [`ClosedLoopModel`] (from the config's [`ClosedLoopSection`] by
+//!   [`from_raw`]), its right factors [`RightFactors`] (of a modal nominal model by
+//!   [`rcf_from_modal`]) and their values at one frequency, [`ClosedLoopAt`];
+//! * internal stability of a loop: [`check_loop`] and [`check_loop_with`] (the route,
+//!   [`LoopRoute`]: the scaled determinant [`scaled_determinant`] up to [`MAX_LOOP_SIZE`],
+//!   the state-space eigenvalues [`check_lambda`] up to [`MAX_STATES`]), failing with
+//!   [`LoopInstability`]; [`is_stable`] for a transfer-function matrix.
+pub(crate) mod physical_nominal;
+pub(crate) mod stability;
+pub(crate) mod stability_ss;
+
+pub use physical_nominal::rcf_from_modal;
+pub use stability::{
+    check_loop, check_loop_with, is_stable, scaled_determinant, LoopInstability, LoopRoute,
+    MAX_LOOP_SIZE,
+};
+pub use stability_ss::{check_lambda, MAX_STATES};
 
 use super::config::TfEntry;
 use crate::system::{TfMatrix, TransferFunction};
@@ -236,7 +252,7 @@ impl ClosedLoopModel {
     }
 
     /// As [`Self::build`], with the nominal's factors given from outside (`[physical]`,
-    /// see [`physical_nominal`]) when `[closed_loop]` does not give the plant itself.
+    /// see [`rcf_from_modal`]) when `[closed_loop]` does not give the plant itself.
     pub fn build_with_plant(
         s: &ClosedLoopSection,
         nominal: Option<RightFactors>,

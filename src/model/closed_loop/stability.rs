@@ -28,7 +28,7 @@ use crate::system::{Polynomial, TfMatrix, TransferFunction};
 
 /// Largest `m + p` of the exact polynomial route (cofactor expansion is `(m+p)!`); larger
 /// loops go through the eigenvalues of a state-space realization of `Λ⁻¹`
-/// ([`super::stability_ss`]).
+/// ([`check_lambda`](super::check_lambda)).
 pub const MAX_LOOP_SIZE: usize = 7;
 
 /// Why a loop is not internally stable.
