@@ -77,6 +77,9 @@ pub enum IterationStatus {
     /// The iteration cap was reached first: `γ_opt` is achievable, the gap to `γ_lower`
     /// is wider than asked.
     IterationCap,
+    /// The optimum is the `ω = ∞` bound `σ̄(D₁₁₁₂)` (a lower bound on `γ_opt` for every
+    /// controller), reached by the controller to 1e-6: `γ_lower` is that bound.
+    AtInfinity,
     /// The controller reaches a level below one the Riccati equations declared not
     /// achievable (their Hamiltonians are ill-conditioned near the optimum): `γ_opt` is the
     /// controller's level, `γ_lower` falls back to the a-priori bound.
@@ -363,7 +366,14 @@ pub fn weighted_plant(
             d: DMatrix::from_element(1, 1, r.at_infinity()),
         }
     } else {
-        StateSpace::from_tf(r).balanced()
+        // A Gramian-balanced realization: the companion form of a fitted r (poles and zeros
+        // spread over decades) makes the Hamiltonians too ill-conditioned for the Riccati
+        // solver.
+        let companion = StateSpace::from_tf(r).balanced();
+        companion
+            .balanced_truncation(companion.states())
+            .map(|(b, _)| b)
+            .unwrap_or(companion)
     };
     let r_max = hinf_norm(&raw)?.upper;
     let r_min = 1.0 / hinf_norm(&raw.inverse("r")?)?.upper;
@@ -467,7 +477,15 @@ pub fn synthesize_weighted(
     // A level the controller is proven to reach is achievable: near the ω = ∞ bound the
     // Riccati equations fail before the optimum (their Hamiltonians blow up), and the
     // controller may do better than the last level the bisection could certify.
-    let (hi, lo) = if achieved < lo {
+    let floor = {
+        let (_, _, mu, pz, _) = np.plant.dims();
+        let d1112 = np.plant.d11.rows(0, pz - mu).into_owned();
+        d1112.svd(false, false).singular_values.max()
+    };
+    let (hi, lo) = if achieved <= floor * (1.0 + 1e-6) {
+        status = IterationStatus::AtInfinity;
+        (achieved, floor)
+    } else if achieved < lo {
         status = IterationStatus::RiccatiLimited;
         (achieved, lo_apriori.min(achieved))
     } else {
