@@ -29,14 +29,18 @@ fn random_plant(seed: u64) -> StateSpace {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let n = rng.gen_range(1..=4);
     let p = if seed % 4 < 2 { 1 } else { 2 };
-    let m = if seed % 4 == 0 || seed % 4 == 3 { 1 } else { 2 };
+    let m = if seed.is_multiple_of(4) || seed % 4 == 3 {
+        1
+    } else {
+        2
+    };
     let mut r = |_, _| rng.gen_range(-1.0..1.0);
     let a0 = DMatrix::from_fn(n, n, &mut r) * 2.0;
-    let shift = if seed % 3 == 0 { 1.0 } else { -0.7 };
+    let shift = if seed.is_multiple_of(3) { 1.0 } else { -0.7 };
     let a = a0 - DMatrix::identity(n, n) * shift;
     let b = DMatrix::from_fn(n, m, &mut r);
     let c = DMatrix::from_fn(p, n, &mut r);
-    let d = if seed % 2 == 0 {
+    let d = if seed.is_multiple_of(2) {
         DMatrix::from_fn(p, m, &mut r) * 0.5
     } else {
         DMatrix::zeros(p, m)

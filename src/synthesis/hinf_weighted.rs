@@ -229,7 +229,7 @@ pub fn gamma_test(
             .eigenvalues
             .max()
     };
-    if !(rho < g2 * (1.0 - 1e-12)) {
+    if rho.is_nan() || rho >= g2 * (1.0 - 1e-12) {
         return Err(GammaFailure::Coupling);
     }
     let f = -r_lu
