@@ -320,9 +320,9 @@ fn dynamic_r_optimum_matches_a_second_realization_and_the_controller_attains_it(
             && rep.margins[1].verdict == Verdict::NotRobust
             && (rep.margins[0].alpha * (1.0 - 1e-4) - 1.0).abs() < 1e-4;
         // Nearly unstabilizable plants (b_opt < 0.05, γ_opt in the hundreds) strain the
-        // Theorem 1 test's own evaluation of the loop (seed 20: its grid, from the factors'
-        // transfer functions, reads 1.55× the state-space norm); they are reported, the
-        // others must be proved.
+        // Theorem 1 test's own evaluation of the loop (one such seed: its grid, from the
+        // factors' transfer functions, read 1.55× the state-space norm); they are reported,
+        // the others must be proved.
         if !proved {
             assert!(
                 b_opt < 0.05,
