@@ -430,7 +430,7 @@ fn fit_then_synthesize_proves_both_bounds() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let cfg = common::repo("configs/plant_first.toml");
-    let (code, text, syn) = synthesize_verdict(&cfg, &["--fit"], &out);
+    let (code, text, syn) = synthesize_verdict(&cfg, &["--fit", "--method", "gm"], &out);
     assert_eq!(code, 0, "{text}");
     assert!(out.join("r.json").is_file() && out.join("controller.toml").is_file());
     let bounds = syn["bounds"].as_array().unwrap();
@@ -441,4 +441,46 @@ fn fit_then_synthesize_proves_both_bounds() {
         bounds[1]["alpha"].as_f64().unwrap(),
     );
     assert!(af > ac && ac >= 1.0, "configured {ac}, fitted {af}");
+    // With --method hinf the controller is the H∞ optimum for the fitted r: its
+    // optimum is at least the Glover–McFarlane controller's margin with that r (a
+    // candidate), the controller at γ = 1.1·γ_opt reaches at least α_opt/1.1, Theorem 1
+    // proves it, and the figure of merit is reported.
+    let out2 = dir.path().join("out2");
+    let r_json = out.join("r.json");
+    let o = rshape(&[
+        "synthesize",
+        cfg.to_str().unwrap(),
+        "--r-json",
+        r_json.to_str().unwrap(),
+        "--method",
+        "hinf",
+        "--out",
+        out2.to_str().unwrap(),
+    ]);
+    let syn: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out2.join("synthesis.json")).unwrap())
+            .unwrap();
+    assert_eq!(syn["method"], "hinf_weighted", "{}", stdout(&o));
+    let h = &syn["hinf"]["synthesis"];
+    assert_eq!(syn["hinf"]["r"], "fitted");
+    let alpha_opt = h["alpha_opt"].as_f64().unwrap();
+    let fitted = &syn["bounds"][1];
+    assert_eq!(fitted["label"], "fitted");
+    let alpha = fitted["alpha"].as_f64().unwrap();
+    assert!(
+        alpha_opt >= af * (1.0 - 1e-6),
+        "H∞ optimum {alpha_opt} below the GM controller's {af}"
+    );
+    assert!(
+        alpha >= alpha_opt / 1.1 * (1.0 - 1e-6) && alpha <= alpha_opt * (1.0 + 1e-6),
+        "{alpha} vs {alpha_opt}"
+    );
+    assert!((alpha - h["alpha_achieved"].as_f64().unwrap()).abs() < 1e-6 * alpha);
+    assert_eq!(fitted["verdict"], "robust");
+    assert!(
+        stdout(&o).contains("H∞ synthesis with the fitted r as weight"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(syn["merit"]["peak_sensitivity"].as_f64().unwrap() >= 1.0);
 }

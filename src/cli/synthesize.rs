@@ -27,12 +27,26 @@ pub struct SynthesizeArgs {
     /// margin is re-proved on the reduced controller).
     #[arg(long)]
     pub reduce: Option<usize>,
+    /// Method: `gm` (Glover–McFarlane, the default) or `hinf` (the H∞ optimum with the fitted
+    /// r, else the configured r, as weight when that r is frequency dependent; Glover–McFarlane
+    /// otherwise).
+    #[arg(long, value_enum, default_value = "gm")]
+    pub method: MethodArg,
     /// Output directory (created if needed).
     #[arg(long)]
     pub out: PathBuf,
     /// Print synthesis.json's content instead of the summary.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--method`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Glover–McFarlane.
+    Gm,
+    /// H∞ with a frequency-dependent r as weight, else Glover–McFarlane.
+    Hinf,
 }
 
 /// Runs `rshape synthesize`.
@@ -56,6 +70,10 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     let settings = synthesize::SynthesisSettings {
         gamma_factor: a.gamma_factor,
         reduce: a.reduce,
+        method: match a.method {
+            MethodArg::Hinf => synthesize::Method::Hinf,
+            MethodArg::Gm => synthesize::Method::GloverMcfarlane,
+        },
         weights: match &a.weights {
             Some(w) => Some(crate::synthesis::Weights::load(
                 w,

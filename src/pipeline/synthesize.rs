@@ -30,6 +30,24 @@ pub struct SynthesisSettings {
     pub reduce: Option<usize>,
     /// Loop-shaping weights: synthesize for `W₂·G·W₁`, return `W₁·K∞·W₂`.
     pub weights: Option<crate::synthesis::Weights>,
+    /// The method: by default the H∞ optimum for a frequency-dependent `r`.
+    pub method: Method,
+}
+
+/// Which controller to synthesize.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Glover–McFarlane (the optimum for a constant bound) whatever `r`: a closed form,
+    /// well conditioned, robust to every `r` in proportion to `b(G,K)`.
+    #[default]
+    GloverMcfarlane,
+    /// The H∞ optimum `min_K ‖r·T‖∞` for the design bound (the fitted `r` when given, else
+    /// the configured one) when it is frequency dependent and no weights are given;
+    /// Glover–McFarlane otherwise. It maximizes the margin for that `r` only: where `r` is
+    /// tiny (a model exact at DC) the controller may give up performance and margin for any
+    /// other bound there, so it is asked for explicitly.
+    Hinf,
 }
 
 impl Default for SynthesisSettings {
@@ -38,6 +56,7 @@ impl Default for SynthesisSettings {
             gamma_factor: 1.1,
             reduce: None,
             weights: None,
+            method: Method::GloverMcfarlane,
         }
     }
 }
@@ -62,7 +81,9 @@ pub struct BoundResult {
     pub label: String,
     /// Whether `r` is a constant (then the Glover–McFarlane controller is the optimum).
     pub constant: bool,
-    /// For a constant `r`: the best margin any controller attains, `b_opt/|r|`.
+    /// The best margin any controller attains: `b_opt/|r|` for a constant `r`, `1/γ_opt` of
+    /// the H∞ synthesis for the frequency-dependent `r` it was designed for (normalized
+    /// factors only).
     pub alpha_opt: Option<f64>,
     /// The Theorem 1 margin `α*` of the synthesized controller (certified lower bound in
     /// `stability.json`).
@@ -88,6 +109,11 @@ pub struct SynthesisOutcome {
     pub notes: Vec<String>,
     /// The order reduction, when asked for and done.
     pub reduction: Option<Reduction>,
+    /// The closed loop's figure of merit (sensitivity bandwidth and peak).
+    pub merit: crate::synthesis::merit::Merit,
+    /// The H∞ synthesis with a frequency-dependent `r` and the label of that `r`, when the
+    /// controller comes from it (then `gm.k` is this controller; `gm` keeps `b_opt`).
+    pub hinf: Option<(String, crate::synthesis::WeightedController)>,
 }
 
 /// The normalized factors the synthesis works on: those of the config's `[plant]`, else
@@ -134,13 +160,57 @@ pub fn run(
         }
     };
     let shaped = settings.weights.is_some();
+    // The design bound: the last one given (the fitted r when there is one).
+    let design = rs
+        .last()
+        .filter(|(_, r)| !shaped && settings.method == Method::Hinf && !is_constant(r));
+    let mut fallback = None;
+    let hinf = match design {
+        Some((label, r)) => {
+            let ws = crate::synthesis::WeightedSettings {
+                gamma_factor: settings.gamma_factor,
+                ..Default::default()
+            };
+            // A failure falls back to the Glover–McFarlane controller, with a note.
+            match crate::synthesis::synthesize_weighted(&ncf, r, &ws) {
+                Ok(h) => {
+                    // The proof must be able to run on it (a controller spanning many
+                    // decades can defeat the loop's eigenvalue iteration): else fall back.
+                    let probe = Controller {
+                        path: controller_path.to_path_buf(),
+                        k: h.k.clone(),
+                        feedback: Feedback::Negative,
+                    };
+                    match stab::run(config, &probe, rs, data) {
+                        Ok(_) => {
+                            gm.k = h.k.clone();
+                            Some((label.clone(), h))
+                        }
+                        Err(e) => {
+                            fallback = Some(format!(
+                                "the Theorem 1 test failed on the H∞ controller for the {label} r ({e}); the controller is the Glover–McFarlane one"
+                            ));
+                            None
+                        }
+                    }
+                }
+                Err(e) => {
+                    fallback = Some(format!(
+                        "the H∞ synthesis with the {label} r failed ({e}); the controller is the Glover–McFarlane one"
+                    ));
+                    None
+                }
+            }
+        }
+        None => None,
+    };
     let reduction = match settings.reduce {
         Some(order) if order < gm.k.states() => {
             let from = gm.k.states();
             let abscissa = spectral_abscissa(&eigenvalues(&gm.k.a, "controller poles")?);
             if abscissa.is_nan() || abscissa >= 0.0 {
                 return Err(Error::Invalid(format!(
-                    "--reduce {order}: the central controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce"
+                    "--reduce {order}: the controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce"
                 )));
             }
             let (kr, hsv) = gm.k.balanced_truncation(order)?;
@@ -160,7 +230,7 @@ pub fn run(
         feedback: Feedback::Negative,
     };
     let stability = stab::run(config, &controller, rs, data)?;
-    let mut notes = Vec::new();
+    let mut notes: Vec<String> = fallback.into_iter().collect();
     let normalized = config.factorization.realization.is_some();
     if !normalized {
         notes.push(
@@ -174,7 +244,7 @@ pub fn run(
     }
     let mut bounds = Vec::new();
     for (row, (label, r)) in stability.report.margins.iter().zip(rs) {
-        let constant = r.num.degree() == 0 && r.den.degree() == 0;
+        let constant = is_constant(r);
         // α* = b(G,K)/|r| holds for normalized factors only.
         let alpha_opt =
             (constant && normalized && !shaped).then(|| gm.b_opt / r.at_infinity().abs());
@@ -186,12 +256,31 @@ pub fn run(
                 fmt_g(a)
             ));
         }
-        if !constant && normalized {
+        let designed = hinf.as_ref().map(|(l, _)| l.as_str());
+        if !constant && normalized && designed.is_none() {
             notes.push(format!(
                 "{label} r is frequency dependent: the controller is the Glover–McFarlane optimum for a constant bound; its Theorem 1 margin with this r is {}",
                 fmt_g(row.alpha)
             ));
         }
+        if let Some(d) = designed.filter(|d| *d != label) {
+            notes.push(format!(
+                "{label} r: the controller is the H∞ optimum for the {d} r; its Theorem 1 margin with this r is {}",
+                fmt_g(row.alpha)
+            ));
+        }
+        let alpha_opt = match &hinf {
+            Some((l, h)) if l == label && normalized => {
+                if h.alpha_opt < 1.0 {
+                    notes.push(format!(
+                        "{label} r: no controller reaches alpha >= 1 (best alpha 1/gamma_opt = {})",
+                        fmt_g(h.alpha_opt)
+                    ));
+                }
+                Some(h.alpha_opt)
+            }
+            _ => alpha_opt,
+        };
         bounds.push(BoundResult {
             label: label.clone(),
             constant,
@@ -202,7 +291,9 @@ pub fn run(
     }
     let controller_poles = eigenvalues(&gm.k.a, "controller poles")?;
     let robust = stability.robust;
+    let merit = crate::synthesis::merit::merit(&ncf.plant, &gm.k);
     Ok(SynthesisOutcome {
+        merit,
         gm,
         stability,
         bounds,
@@ -210,6 +301,7 @@ pub fn run(
         robust,
         notes,
         reduction,
+        hinf,
     })
 }
 
@@ -232,9 +324,10 @@ fn toml_matrix(m: &DMatrix<f64>) -> String {
 
 /// `controller.toml`: the `[controller]` table (`u = −K·y`) that `stability --controller`
 /// reads.
-pub fn controller_toml(k: &StateSpace, gm: &GmController) -> String {
+pub fn controller_toml(k: &StateSpace, gm: &GmController, hinf: bool) -> String {
     format!(
-        "# Glover–McFarlane central controller from rshape synthesize:\n# b_opt = {:?}, gamma = {:?} (gamma_min = {:?}); loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
+        "# {} central controller from rshape synthesize:\n# b_opt = {:?}, gamma = {:?} (gamma_min = {:?}); loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
+        if hinf { "H∞ (r as weight)" } else { "Glover–McFarlane" },
         gm.b_opt,
         gm.gamma,
         gm.gamma_min,
@@ -296,7 +389,8 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
     });
     let rep = &o.stability.report;
     let synthesis = serde_json::json!({
-        "method": "glover_mcfarlane",
+        "method": if o.hinf.is_some() { "hinf_weighted" } else { "glover_mcfarlane" },
+        "hinf": o.hinf.as_ref().map(|(label, h)| serde_json::json!({"r": label, "synthesis": h})),
         "b_opt": o.gm.b_opt,
         "gamma_min": o.gm.gamma_min,
         "gamma": o.gm.gamma,
@@ -308,6 +402,7 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
         "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
         "reduction": &o.reduction,
+        "merit": &o.merit,
         "bounds": &o.bounds,
         "robust": o.robust,
         "notes": &o.notes,
@@ -316,7 +411,10 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         serde_json::to_string_pretty(v).map_err(|e| Error::Invalid(format!("json: {e}")))
     };
     let files = [
-        ("controller.toml", controller_toml(k, &o.gm)),
+        (
+            "controller.toml",
+            controller_toml(k, &o.gm, o.hinf.is_some()),
+        ),
         ("controller.json", json(&state_space)?),
         ("controller.m", script(k, "%", "", "ss(A, B, C, D)", false)),
         (
@@ -360,6 +458,25 @@ pub fn text(o: &SynthesisOutcome) -> String {
         fmt_g(o.gm.gamma),
         o.gm.k.states()
     );
+    if let Some((label, h)) = &o.hinf {
+        let _ = writeln!(
+            s,
+            "H∞ synthesis with the {label} r as weight: gamma_opt = {} (alpha_opt = {}; {} gamma tests, {}), central controller at gamma = {} ({} states), its ||r*T||_inf = {} (alpha {})",
+            fmt_g(h.gamma_opt),
+            fmt_g(h.alpha_opt),
+            h.steps.len(),
+            match h.status {
+                crate::synthesis::hinf_weighted::IterationStatus::Converged => "converged",
+                crate::synthesis::hinf_weighted::IterationStatus::IterationCap => "iteration cap reached",
+                crate::synthesis::hinf_weighted::IterationStatus::RiccatiLimited => "Riccati-limited: gamma_opt is the controller's verified level",
+                crate::synthesis::hinf_weighted::IterationStatus::AtInfinity => "the optimum is the bound at omega = inf",
+            },
+            fmt_g(h.gamma),
+            h.k.states(),
+            fmt_g(h.gamma_achieved),
+            fmt_g(h.alpha_achieved)
+        );
+    }
     if let Some(r) = &o.reduction {
         let _ = writeln!(
             s,
@@ -373,15 +490,26 @@ pub fn text(o: &SynthesisOutcome) -> String {
         if let Some(a) = b.alpha_opt {
             let _ = writeln!(
                 s,
-                "{} r (constant): best attainable alpha = b_opt/|r| = {}",
+                "{} r{}: best attainable alpha = {}",
                 b.label,
-                fmt_g(a)
+                if b.constant { " (constant)" } else { "" },
+                if b.constant {
+                    format!("b_opt/|r| = {}", fmt_g(a))
+                } else {
+                    format!("1/gamma_opt = {}", fmt_g(a))
+                }
             );
         }
     }
     for n in &o.notes {
         let _ = writeln!(s, "{n}");
     }
+    let _ = writeln!(
+        s,
+        "closed loop: bandwidth (sigma_max(S) = -3 dB) {} rad/s, peak sensitivity Ms = {}",
+        o.merit.bandwidth.map_or("-".to_string(), fmt_g),
+        fmt_g(o.merit.peak_sensitivity)
+    );
     let _ = writeln!(s, "proof (Theorem 1 on the synthesized controller):");
     s.push_str(&stab::text(&o.stability));
     let _ = writeln!(
@@ -396,4 +524,9 @@ pub fn text(o: &SynthesisOutcome) -> String {
         }
     );
     s
+}
+
+/// Whether `r` is a constant.
+fn is_constant(r: &TransferFunction) -> bool {
+    r.num.degree() == 0 && r.den.degree() == 0
 }
