@@ -13,15 +13,15 @@ mod common;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rand::{Rng, SeedableRng};
-use rshape::model::controller::{Controller, Feedback};
 use rshape::model::Factorization;
+use rshape::model::{Controller, Feedback};
 use rshape::stability::{analyze, Verdict};
 use rshape::synthesis::generalized_plant::{normalize, GeneralizedPlant};
 use rshape::synthesis::hinf_weighted::{gamma_test, weighted_plant, IterationStatus};
 use rshape::synthesis::{optimum, synthesize_weighted, WeightedSettings};
-use rshape::system::eig::{eigenvalues, spectral_abscissa};
-use rshape::system::ncf::NormalizedLcf;
-use rshape::system::{logspace, StateSpace, TransferFunction};
+use rshape::system::{
+    eigenvalues, logspace, spectral_abscissa, NormalizedLcf, StateSpace, TransferFunction,
+};
 use std::path::PathBuf;
 
 /// A random plant: stable or unstable, SISO or MIMO, with or without feedthrough.
