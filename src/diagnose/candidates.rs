@@ -219,7 +219,9 @@ impl Cand {
         let s = Complex64::new(0.0, omega);
         let one = Complex64::new(1.0, 0.0);
         let mode_term = |w: f64, z: f64, rho: f64| rho / (s * s + 2.0 * z * w * s + w * w);
-        let (p, m) = (base.n_outputs(), base.n_inputs());
+        // The model's size only where a residue is needed (counting it walks every term, and
+        // this runs per datum of every residual).
+        let size = || (base.n_outputs(), base.n_inputs());
         match self {
             Cand::Delay(sel) if sel.hits(entry) => *path *= (-s * th[0].abs()).exp(),
             Cand::Lag(sel) if sel.hits(entry) => *path /= one + s / th[0].exp(),
@@ -238,6 +240,7 @@ impl Cand {
             Cand::Mode => *core += mode_term(th[0].exp(), clamp_zeta(th[1].exp()), th[2 + ch]),
             Cand::ModeShift(i) | Cand::Damping(i) => {
                 let md = &base.mode[*i];
+                let (p, m) = size();
                 let rho = residue(&md.output_gain, &md.input_gain, md.mass, p, m, entry);
                 let (w, z) = match self {
                     Cand::ModeShift(_) => (th[0].exp(), md.zeta),
@@ -248,6 +251,7 @@ impl Cand {
             Cand::Integrator(order) => *core += th[ch] / s.powi(*order as i32),
             Cand::Friction(i) => {
                 let r = &base.rigid_body[*i];
+                let (p, m) = size();
                 let rho = residue(&r.output_gain, &r.input_gain, r.mass, p, m, entry);
                 let p0 = r.friction_pole.unwrap_or(0.0);
                 *core += rho / (s * (s + th[0].exp())) - rho / (s * (s + p0));

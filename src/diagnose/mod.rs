@@ -45,6 +45,7 @@ pub mod revision;
 pub mod search;
 mod slots;
 mod starts;
+mod varpro;
 pub mod ties;
 
 pub use channels::{misfit_channels, Channels};

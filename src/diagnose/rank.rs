@@ -1,6 +1,7 @@
 //! Screening the candidates on top of a model (each fitted alone, the model fixed) and their
 //! physical plausibility (where two fitted models can be told apart: [`super::ties`]).
 
+use rayon::prelude::*;
 use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
 use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
@@ -233,8 +234,10 @@ impl Problem<'_> {
     pub(super) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
         let all: Vec<usize> = (0..self.f()).collect();
         let ln2f = (2.0 * self.n_data() as f64).ln();
+        // Each candidate is fitted alone, independently of the others: in parallel (the
+        // indexed collect keeps the catalogue's order before the sort).
         let mut out: Vec<Screened> = cands
-            .iter()
+            .par_iter()
             .map(|c| {
                 let (mods, v, jtj) = self.fit_candidate(*c, &all);
                 let measures = self.measures(&mods);
