@@ -45,8 +45,8 @@ pub mod revision;
 pub mod search;
 mod slots;
 mod starts;
-mod varpro;
 pub mod ties;
+mod varpro;
 
 pub use channels::{misfit_channels, Channels};
 pub use engine::{

@@ -1,12 +1,12 @@
 //! Screening the candidates on top of a model (each fitted alone, the model fixed) and their
 //! physical plausibility (where two fitted models can be told apart: [`super::ties`]).
 
-use rayon::prelude::*;
 use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
 use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
 use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// ΔBIC a candidate needs to be accepted.

@@ -24,10 +24,10 @@
 
 use super::channels::Channels;
 use super::fit::lm_box_jac;
-use super::varpro::VarPro;
 use super::slots::{
     anchor_value, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
 };
+use super::varpro::VarPro;
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;

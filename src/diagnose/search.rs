@@ -193,9 +193,8 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
             let refit: Vec<bool> = screened
                 .iter()
                 .map(|sc| {
-                    let promising = sc.no_fit.is_none()
-                        && sc.flags.is_empty()
-                        && sc.delta_bic > MIN_DELTA_BIC;
+                    let promising =
+                        sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
                     let go = promising && tried <= s.beam;
                     tried += usize::from(go);
                     go
