@@ -55,7 +55,7 @@ where
 pub type JacobianFn<'a> = dyn Fn(&[f64], &[f64], &mut DMatrix<f64>) -> bool + 'a;
 
 /// [`lm_box`] with a Jacobian supplied by the caller (an analytic or variable-projection
-/// one, [`super::varpro`]); the forward-difference one wherever `jac` declines.
+/// one, as the retune uses); the forward-difference one wherever `jac` declines.
 #[allow(clippy::too_many_arguments)]
 pub fn lm_box_jac<F>(
     f: F,
