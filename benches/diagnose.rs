@@ -1,12 +1,20 @@
-//! `diagnose` of a three-effect plant on 400 data: a servo (rigid body, modes at 77 and
-//! 190 Hz) whose data carry an added mode (900 rad/s), a lag and a delay, 2 % noise.
-//! The whole search: retune, beam search (beam 3, up to 3 effects), final holdout.
+//! `diagnose` speed (issue 26).
+//!
+//! * `three_effects_400_data`: a servo (rigid body, modes at 77 and 190 Hz) whose data carry
+//!   an added mode (900 rad/s), a lag and a delay, 2 % noise. The whole search: retune, beam
+//!   search (beam 3, up to 3 effects), final holdout.
+//! * `one_step_six_modes_1000x3`: one step on a free–free beam measured at one point with
+//!   the hammer at three (1 output × 3 inputs, 1000 lines 20–1000 Hz, the six bending modes
+//!   of ../shared/data/pyuff-accelerance at ζ = 1–6e-4); the model has the six modes 0.5 %
+//!   off and the data a seventh, weak one.
+//! * `siso_step_1200`: one step on one channel of the same beam, 1200 lines, three modes in
+//!   the model and a fourth in the data.
 //!
 //! Run: `cargo bench --bench diagnose -- --sample-count 3`.
 use num_complex::Complex64;
 use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
 use rshape::model::physical::{
-    EffectKind, EffectSpec, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
+    EffectKind, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
 
 fn main() {
@@ -22,6 +30,100 @@ fn mode(w: f64, z: f64, rho: f64) -> ModeSpec {
         input_gain: Gains::Scalar(1.0),
         output_gain: Gains::Scalar(rho),
     }
+}
+
+/// Deterministic noise inside the disk of radius `r` (a fixed pattern of radii and angles).
+fn noisy(k: usize, v: Complex64, r: f64) -> Complex64 {
+    let u = ((k * 7919) % 1000) as f64 / 1000.0;
+    let a = ((k * 104_729) % 1000) as f64 / 1000.0 * std::f64::consts::TAU;
+    v + Complex64::from_polar(r * u.sqrt(), a)
+}
+
+/// The beam: bending modes (Hz, ζ) and mode shapes at the three hammer points.
+const BEAM: [(f64, f64, [f64; 3]); 6] = [
+    (52.0, 6e-4, [1.0, 0.6, -0.5]),
+    (142.0, 3e-4, [1.0, -0.3, 0.4]),
+    (279.0, 2e-4, [1.0, 0.2, 0.9]),
+    (460.0, 1.5e-4, [1.0, -0.7, 0.3]),
+    (687.0, 1e-4, [1.0, 0.5, -0.8]),
+    (959.0, 1.2e-4, [1.0, 0.9, 0.6]),
+];
+
+/// A beam mode (peak `|G| ≈ 10` at the driving point), `ω_n` times `shift`.
+fn beam_mode(j: usize, shift: f64, n_in: usize) -> ModeSpec {
+    let (f, z, b) = BEAM[j];
+    let w = std::f64::consts::TAU * f * shift;
+    ModeSpec {
+        name: None,
+        omega_n: w,
+        zeta: z,
+        mass: 1.0,
+        input_gain: if n_in == 1 {
+            Gains::Scalar(1.0)
+        } else {
+            Gains::Vector(b[..n_in].to_vec())
+        },
+        output_gain: Gains::Scalar(20.0 * z * w * w),
+    }
+}
+
+/// `(model, data)`: the model has modes `model_modes` 0.5 % off, the data those and
+/// `extra` exact, with noise inside a radius of 3 % of |G| plus a floor.
+fn beam(
+    n_in: usize,
+    lines: usize,
+    model_modes: &[usize],
+    extra: &[usize],
+) -> (PhysicalModel, Channels) {
+    let d = Feedthrough::Matrix(vec![[0.1, 0.07, 0.06][..n_in].to_vec()]);
+    let model = PhysicalModel {
+        mode: model_modes
+            .iter()
+            .map(|j| beam_mode(*j, 1.005, n_in))
+            .collect(),
+        feedthrough: Some(if n_in == 1 {
+            Feedthrough::Scalar(0.1)
+        } else {
+            d.clone()
+        }),
+        ..Default::default()
+    };
+    let mut truth = PhysicalModel {
+        mode: model_modes
+            .iter()
+            .map(|j| beam_mode(*j, 1.0, n_in))
+            .collect(),
+        ..model.clone()
+    };
+    truth
+        .mode
+        .extend(extra.iter().map(|j| beam_mode(*j, 1.0, n_in)));
+    let omega: Vec<f64> = (0..lines)
+        .map(|k| std::f64::consts::TAU * (20.0 + 980.0 * k as f64 / (lines - 1) as f64))
+        .collect();
+    let entries: Vec<(usize, usize)> = (0..n_in).map(|i| (0, i)).collect();
+    let (mut g, mut radius) = (Vec::new(), Vec::new());
+    for e in &entries {
+        let clean: Vec<Complex64> = omega.iter().map(|w| truth.eval(*w)[*e]).collect();
+        let r: Vec<f64> = clean.iter().map(|v| 0.03 * v.norm() + 0.006).collect();
+        g.push(
+            clean
+                .iter()
+                .enumerate()
+                .map(|(k, v)| noisy(k + 1000 * e.1, *v, r[k]))
+                .collect(),
+        );
+        radius.push(r);
+    }
+    let data = Channels {
+        path: "bench".into(),
+        omega,
+        entries,
+        g,
+        radius,
+        radius_source: vec!["bench".into(); n_in],
+    };
+    (model, data)
 }
 
 fn problem() -> (PhysicalModel, Channels) {
@@ -77,5 +179,48 @@ fn three_effects_400_data(bencher: divan::Bencher) {
         let d = diagnose_channels(&base, &data, &SearchSettings::default()).unwrap();
         assert!(!d.chosen.is_empty());
         d
+    });
+}
+
+#[divan::bench(sample_count = 3)]
+fn one_step_six_modes_1000x3(bencher: divan::Bencher) {
+    // The six modes in the model (0.5 % off); the data carry a seventh, weak one.
+    let (base, mut data) = beam(3, 1000, &[0, 1, 2, 3, 4, 5], &[]);
+    for ch in 0..3 {
+        for k in 0..data.len() {
+            let w = data.omega[k];
+            // A seventh mode at 380 Hz, a tenth of the others' peak.
+            let s = Complex64::new(0.0, w);
+            let w7 = std::f64::consts::TAU * 380.0;
+            let b = [1.0, -0.4, 0.7][ch];
+            data.g[ch][k] += 2.0 * 2e-4 * w7 * w7 * b / (s * s + 2.0 * 2e-4 * w7 * s + w7 * w7);
+        }
+    }
+    bencher.bench(|| {
+        diagnose_channels(
+            &base,
+            &data,
+            &SearchSettings {
+                max_effects: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap()
+    });
+}
+
+#[divan::bench(sample_count = 3)]
+fn siso_step_1200(bencher: divan::Bencher) {
+    let (base, data) = beam(1, 1200, &[0, 1, 2], &[3]);
+    bencher.bench(|| {
+        diagnose_channels(
+            &base,
+            &data,
+            &SearchSettings {
+                max_effects: 1,
+                ..Default::default()
+            },
+        )
+        .unwrap()
     });
 }

@@ -43,6 +43,9 @@ pub struct DiagnoseArgs {
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also print where the time went: a table of the search's phases.
+    #[arg(long)]
+    pub verbose: bool,
 }
 
 fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
@@ -143,6 +146,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         return Ok(0);
     }
     print_text(config, &data, &d, a.apply.is_none());
+    if a.verbose {
+        print_phases(&d.search);
+    }
     Ok(0)
 }
 
@@ -347,6 +353,32 @@ fn print_alternatives(d: &Diagnosis) {
             t.disambiguation
         );
     }
+}
+
+/// Where the time went (`--verbose`): the wall time of each phase of the search.
+fn print_phases(s: &crate::diagnose::engine::SearchStats) {
+    println!("\ntime per phase (wall clock):");
+    println!("  {:<22} {:>9} {:>6} {:>7}", "phase", "s", "runs", "share");
+    let total = s.seconds.max(1e-12);
+    let mut sum = 0.0;
+    for p in &s.phases {
+        sum += p.seconds;
+        println!(
+            "  {:<22} {:>9.3} {:>6} {:>6.1}%",
+            p.phase,
+            p.seconds,
+            p.count,
+            100.0 * p.seconds / total
+        );
+    }
+    println!(
+        "  {:<22} {:>9.3} {:>6} {:>6.1}%",
+        "other (report, σ)",
+        (s.seconds - sum).max(0.0),
+        "",
+        100.0 * (s.seconds - sum).max(0.0) / total
+    );
+    println!("  {:<22} {:>9.3}", "total", s.seconds);
 }
 
 /// The configured parameters a refit moved, as a table (a common gain as one row).

@@ -204,6 +204,29 @@ impl Cand {
         }
     }
 
+    /// The parameters [`Cand::modify_natural`] uses, from the internal ones `th` (appended
+    /// to `out`): `exp` of the log-parameters, `|τ|`, `ζ` clamped.  A residual computes them
+    /// once per model instead of once per datum.
+    pub fn natural(&self, th: &[f64], out: &mut Vec<f64>) {
+        let start = out.len();
+        out.extend_from_slice(th);
+        let nat = &mut out[start..];
+        match self {
+            Cand::Delay(_) => nat[0] = th[0].abs(),
+            Cand::Lag(_)
+            | Cand::NmpZero(_)
+            | Cand::Zoh(_)
+            | Cand::ModeShift(_)
+            | Cand::Friction(_) => nat[0] = th[0].exp(),
+            Cand::Damping(_) => nat[0] = clamp_zeta(th[0].exp()),
+            Cand::Mode => {
+                nat[0] = th[0].exp();
+                nat[1] = clamp_zeta(th[1].exp());
+            }
+            _ => {}
+        }
+    }
+
     /// Modifies `(core, path)` of channel `ch` (model entry `entry`) at `ω` with parameters
     /// `th`; `base` gives the modes that `ModeShift`, `Damping` and `Friction` refer to.
     #[allow(clippy::too_many_arguments)]
@@ -217,43 +240,64 @@ impl Cand {
         core: &mut Complex64,
         path: &mut Complex64,
     ) {
+        let mut nat = Vec::with_capacity(th.len());
+        self.natural(th, &mut nat);
+        self.modify_natural(&nat, base, omega, ch, entry, core, path);
+    }
+
+    /// [`Cand::modify`] with the parameters of [`Cand::natural`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn modify_natural(
+        &self,
+        nat: &[f64],
+        base: &PhysicalModel,
+        omega: f64,
+        ch: usize,
+        entry: (usize, usize),
+        core: &mut Complex64,
+        path: &mut Complex64,
+    ) {
         let s = Complex64::new(0.0, omega);
         let one = Complex64::new(1.0, 0.0);
         let mode_term = |w: f64, z: f64, rho: f64| rho / (s * s + 2.0 * z * w * s + w * w);
-        let (p, m) = (base.n_outputs(), base.n_inputs());
+        // The model's size only where a residue is needed (counting it walks every term, and
+        // this runs per datum of every residual).
+        let size = || (base.n_outputs(), base.n_inputs());
         match self {
-            Cand::Delay(sel) if sel.hits(entry) => *path *= (-s * th[0].abs()).exp(),
-            Cand::Lag(sel) if sel.hits(entry) => *path /= one + s / th[0].exp(),
-            Cand::Gain(sel) if sel.hits(entry) => *path *= th[0],
+            Cand::Delay(sel) if sel.hits(entry) => *path *= (-s * nat[0]).exp(),
+            Cand::Lag(sel) if sel.hits(entry) => *path /= one + s / nat[0],
+            Cand::Gain(sel) if sel.hits(entry) => *path *= nat[0],
             Cand::Sign(sel) if sel.hits(entry) => *path = -*path,
             Cand::NmpZero(sel) if sel.hits(entry) => {
-                let z = th[0].exp();
+                let z = nat[0];
                 *path *= (one - s / z) / (one + s / z)
             }
             Cand::Zoh(sel) if sel.hits(entry) => {
-                let t = th[0].exp();
+                let t = nat[0];
                 let x = omega * t / 2.0;
                 let sinc = if x.abs() < 1e-8 { 1.0 } else { x.sin() / x };
                 *path *= (-s * t / 2.0).exp() * sinc
             }
-            Cand::Mode => *core += mode_term(th[0].exp(), clamp_zeta(th[1].exp()), th[2 + ch]),
+            Cand::Mode => *core += mode_term(nat[0], nat[1], nat[2 + ch]),
             Cand::ModeShift(i) | Cand::Damping(i) => {
                 let md = &base.mode[*i];
+                let (p, m) = size();
                 let rho = residue(&md.output_gain, &md.input_gain, md.mass, p, m, entry);
                 let (w, z) = match self {
-                    Cand::ModeShift(_) => (th[0].exp(), md.zeta),
-                    _ => (md.omega_n, clamp_zeta(th[0].exp())),
+                    Cand::ModeShift(_) => (nat[0], md.zeta),
+                    _ => (md.omega_n, nat[0]),
                 };
                 *core += mode_term(w, z, rho) - mode_term(md.omega_n, md.zeta, rho);
             }
-            Cand::Integrator(order) => *core += th[ch] / s.powi(*order as i32),
+            Cand::Integrator(order) => *core += nat[ch] / s.powi(*order as i32),
             Cand::Friction(i) => {
                 let r = &base.rigid_body[*i];
+                let (p, m) = size();
                 let rho = residue(&r.output_gain, &r.input_gain, r.mass, p, m, entry);
                 let p0 = r.friction_pole.unwrap_or(0.0);
-                *core += rho / (s * (s + th[0].exp())) - rho / (s * (s + p0));
+                *core += rho / (s * (s + nat[0])) - rho / (s * (s + p0));
             }
-            Cand::Feedthrough => *core += th[ch],
+            Cand::Feedthrough => *core += nat[ch],
             _ => {}
         }
     }

@@ -31,8 +31,8 @@ pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
 pub use super::rank::candidate_list;
 pub use super::report::{
-    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Retuned,
-    SearchStats, Tie,
+    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, PhaseTime,
+    Phases, Retuned, SearchStats, Tie,
 };
 use super::retune::retune_within;
 use super::search::{roots, search, Node, SearchResult, SearchSettings};
@@ -71,11 +71,12 @@ pub fn diagnose_channels(
     }
     let before = measures(base, data)?;
     let n = data.n_data();
-    let mk_stats = |expanded, joint_refits| SearchStats {
+    let mk_stats = |expanded, joint_refits, phases: Phases| SearchStats {
         beam: s.beam,
         nodes_expanded: expanded,
         joint_refits,
         seconds: t0.elapsed().as_secs_f64(),
+        phases: phases.0,
     };
     if before.consistent() {
         return Ok(Diagnosis {
@@ -104,17 +105,21 @@ pub fn diagnose_channels(
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
             cost_test: Some([n as f64, before.v]),
-            search: mk_stats(0, 0),
+            search: mk_stats(0, 0, Phases::default()),
             final_model: base.clone(),
         });
     }
-    let [configured, retuned_node] = roots(base, data)?;
+    let mut phases = Phases::default();
+    let [configured, retuned_node] = phases.time("retune", || roots(base, data))?;
     let root_model = retuned_node.model.clone();
     let retuned = retuned_node.measures;
     let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
     let res = search(vec![configured, retuned_node], data, s)?;
+    for p in &res.phases.0 {
+        phases.add(p.phase, p.seconds, p.count);
+    }
     // First-level candidates: the retune, and each effect on top of it.
     let root = Root {
         base,
@@ -123,16 +128,23 @@ pub fn diagnose_channels(
         retuned,
         v_ret,
     };
-    let mut candidates = ranked_candidates(&root, &res, data)?;
+    let mut candidates = phases.time("first level", || ranked_candidates(&root, &res, data))?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
     let mut node = res.nodes[res.chosen].clone();
-    let (holdout, dropped) = drop_failing_holdout(base, &mut node, &res.nodes, data)?;
-    let eliminated = super::backward::eliminate(base, &mut node, &res.nodes, data)?;
-    final_refit(&mut node, base, data)?;
+    let (holdout, dropped) = phases.time("holdout", || {
+        drop_failing_holdout(base, &mut node, &res.nodes, data)
+    })?;
+    let eliminated = phases.time("backward elimination", || {
+        super::backward::eliminate(base, &mut node, &res.nodes, data)
+    })?;
+    phases.time("final refit", || final_refit(&mut node, base, data))?;
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
-    let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
-    ties.extend(candidate_ties(&mut candidates, &ties, data));
+    let ties = phases.time("ties", || {
+        let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
+        ties.extend(candidate_ties(&mut candidates, &ties, data));
+        ties
+    });
     let after = node.measures;
     let verdict = if !node.effects.is_empty() {
         DiagnoseVerdict::EffectsFound
@@ -169,7 +181,7 @@ pub fn diagnose_channels(
         ),
         retuned_in_chosen: changes(base, &node.model, data),
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
-        search: mk_stats(res.expanded, res.joint_refits),
+        search: mk_stats(res.expanded, res.joint_refits, phases),
         final_model: node.model,
     })
 }

@@ -46,6 +46,29 @@ pub fn lm_box<F>(
 where
     F: Fn(&[f64], &mut Vec<f64>),
 {
+    lm_box_jac(f, &|_, _, _| false, theta0, typ, lo, hi, max_iter)
+}
+
+/// A Jacobian supplied by the caller: `jac(θ, r(θ), J)` fills `J` (`∂r/∂θ`, rows of `r`,
+/// one column per parameter) and returns `true`, or returns `false` to have the
+/// forward-difference Jacobian used at this point instead.
+pub type JacobianFn<'a> = dyn Fn(&[f64], &[f64], &mut DMatrix<f64>) -> bool + 'a;
+
+/// [`lm_box`] with a Jacobian supplied by the caller (an analytic or variable-projection
+/// one, as the retune uses); the forward-difference one wherever `jac` declines.
+#[allow(clippy::too_many_arguments)]
+pub fn lm_box_jac<F>(
+    f: F,
+    jac_fn: &JacobianFn<'_>,
+    theta0: &[f64],
+    typ: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    max_iter: usize,
+) -> LmResult
+where
+    F: Fn(&[f64], &mut Vec<f64>),
+{
     let n = theta0.len();
     let mut theta: Vec<f64> = (0..n).map(|i| theta0[i].clamp(lo[i], hi[i])).collect();
     let mut r = Vec::new();
@@ -63,6 +86,9 @@ where
     let mut jac = DMatrix::<f64>::zeros(m, n);
     let mut rp = Vec::new();
     let jacobian = |theta: &[f64], r: &[f64], jac: &mut DMatrix<f64>, rp: &mut Vec<f64>| {
+        if jac_fn(theta, r, jac) {
+            return;
+        }
         let mut t = theta.to_vec();
         for i in 0..n {
             let h = 1e-7 * theta[i].abs().max(typ[i]).max(1e-300);

@@ -48,6 +48,7 @@ pub mod search;
 mod slots;
 mod starts;
 pub mod ties;
+mod varpro;
 
 pub use channels::{misfit_channels, Channels};
 pub use engine::{

@@ -155,6 +155,31 @@ impl<'a> Problem<'a> {
         k: Option<usize>,
         omega: f64,
     ) -> (Complex64, Complex64) {
+        self.parts_nat(mods, &self.naturals_of(mods), ch, k, omega)
+    }
+
+    /// The natural parameters of every effect of `mods`, concatenated ([`Cand::natural`]).
+    fn naturals_of(&self, mods: &Mods) -> Vec<f64> {
+        let n_ch = self.n_ch();
+        let mut nat = Vec::with_capacity(mods.theta.len());
+        let mut off = 0;
+        for c in &mods.cands {
+            let n = c.n_params(n_ch);
+            c.natural(&mods.theta[off..off + n], &mut nat);
+            off += n;
+        }
+        nat
+    }
+
+    /// [`Problem::parts`] with the natural parameters `nat` of `mods` computed once.
+    fn parts_nat(
+        &self,
+        mods: &Mods,
+        nat: &[f64],
+        ch: usize,
+        k: Option<usize>,
+        omega: f64,
+    ) -> (Complex64, Complex64) {
         let entry = self.data.entries[ch];
         let (mut core, mut path) = match k {
             Some(k) => (self.core0[ch][k], self.path0[ch][k]),
@@ -167,8 +192,8 @@ impl<'a> Problem<'a> {
         let n_ch = self.n_ch();
         for c in &mods.cands {
             let n = c.n_params(n_ch);
-            c.modify(
-                &mods.theta[off..off + n],
+            c.modify_natural(
+                &nat[off..off + n],
                 self.base,
                 omega,
                 ch,
@@ -181,24 +206,16 @@ impl<'a> Problem<'a> {
         (core, path)
     }
 
-    /// Model response of channel `ch` at datum `k`, or at any `ω` with `k = None`.
-    pub(super) fn eval_at(
-        &self,
-        mods: &Mods,
-        ch: usize,
-        k: Option<usize>,
-        omega: f64,
-    ) -> Complex64 {
-        let (c, p) = self.parts(mods, ch, k, omega);
-        c * p
-    }
-
     /// Model response at the data, `[ch][k]`.
     pub fn response(&self, mods: &Mods) -> Vec<Vec<Complex64>> {
+        let nat = self.naturals_of(mods);
         (0..self.n_ch())
             .map(|ch| {
                 (0..self.f())
-                    .map(|k| self.eval_at(mods, ch, Some(k), self.data.omega[k]))
+                    .map(|k| {
+                        let (c, p) = self.parts_nat(mods, &nat, ch, Some(k), self.data.omega[k]);
+                        c * p
+                    })
                     .collect()
             })
             .collect()
@@ -206,10 +223,11 @@ impl<'a> Problem<'a> {
 
     pub(super) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
         out.clear();
+        let nat = self.naturals_of(mods);
         for ch in 0..self.n_ch() {
             for &k in mask {
-                let e = (self.data.g[ch][k] - self.eval_at(mods, ch, Some(k), self.data.omega[k]))
-                    * self.inv_sigma[ch][k];
+                let (c, p) = self.parts_nat(mods, &nat, ch, Some(k), self.data.omega[k]);
+                let e = (self.data.g[ch][k] - c * p) * self.inv_sigma[ch][k];
                 out.push(e.re);
                 out.push(e.im);
             }

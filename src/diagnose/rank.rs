@@ -6,6 +6,7 @@ use super::channels::Channels;
 use super::problem::{Measures, Mods, Problem};
 use crate::model::physical::{PhysicalModel, Quantity};
 use nalgebra::DMatrix;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// ΔBIC a candidate needs to be accepted.
@@ -273,8 +274,10 @@ impl Problem<'_> {
     pub(super) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
         let all: Vec<usize> = (0..self.f()).collect();
         let ln2f = (2.0 * self.n_data() as f64).ln();
+        // Each candidate is fitted alone, independently of the others: in parallel (the
+        // indexed collect keeps the catalogue's order before the sort).
         let mut out: Vec<Screened> = cands
-            .iter()
+            .par_iter()
             .map(|c| {
                 let (mods, v, jtj) = self.fit_candidate(*c, &all);
                 let measures = self.measures(&mods);

@@ -198,6 +198,50 @@ pub struct SearchStats {
     pub joint_refits: usize,
     /// Wall time, s.
     pub seconds: f64,
+    /// Wall time of each phase, in the order they ran (`--verbose` prints the table).
+    pub phases: Vec<PhaseTime>,
+}
+
+/// The wall time of one phase of `diagnose`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PhaseTime {
+    /// What ran: `retune`, `screen` (each candidate fitted alone), `joint refits` (with
+    /// their consistency polish), `first level`, `holdout`, `backward elimination`,
+    /// `final refit`, `ties`, `report`.
+    pub phase: &'static str,
+    /// Seconds.
+    pub seconds: f64,
+    /// How many times it ran (screened nodes, refits).
+    pub count: usize,
+}
+
+/// Accumulates [`PhaseTime`]s.
+#[derive(Debug, Clone, Default)]
+pub struct Phases(pub Vec<PhaseTime>);
+
+impl Phases {
+    /// Adds `seconds` (and `count` runs) to `phase`.
+    pub fn add(&mut self, phase: &'static str, seconds: f64, count: usize) {
+        match self.0.iter_mut().find(|p| p.phase == phase) {
+            Some(p) => {
+                p.seconds += seconds;
+                p.count += count;
+            }
+            None => self.0.push(PhaseTime {
+                phase,
+                seconds,
+                count,
+            }),
+        }
+    }
+
+    /// Runs `f`, adding its wall time to `phase`.
+    pub fn time<T>(&mut self, phase: &'static str, f: impl FnOnce() -> T) -> T {
+        let t = std::time::Instant::now();
+        let out = f();
+        self.add(phase, t.elapsed().as_secs_f64(), 1);
+        out
+    }
 }
 
 /// The verdict of `diagnose` (serialized in snake_case).

@@ -23,10 +23,11 @@
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use super::channels::Channels;
-use super::fit::lm_box;
+use super::fit::lm_box_jac;
 use super::slots::{
     anchor_value, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
 };
+use super::varpro::VarPro;
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -59,7 +60,7 @@ fn solve_linear(m: &mut PhysicalModel, lin: &[Lin], data: &Channels, mask: &[usi
 }
 
 /// [`solve_linear`], returning the weighted residual (real and imaginary parts).
-fn solve_linear_res(
+pub(super) fn solve_linear_res(
     m: &mut PhysicalModel,
     lin: &[Lin],
     data: &Channels,
@@ -191,16 +192,26 @@ pub fn retune_within(
         for i in 0..m.mode.len() {
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
-            for j in 0..33 {
+            let grid = (0..33).flat_map(|j| {
                 let w = w0 * MODE_BOX.powf(-1.0 + j as f64 / 16.0);
-                for z in [z0, 0.003, 0.01, 0.03, 0.1] {
-                    let mut t = start.clone();
-                    t.mode[i].omega_n = w;
-                    t.mode[i].zeta = z;
-                    let v = solve_linear(&mut t, &lin, data, mask);
-                    if v < best.0 {
-                        best = (v, w, z);
+                [z0, 0.003, 0.01, 0.03, 0.1].map(|z| (w, z))
+            });
+            // The other columns factored once, each grid point's cost from the mode's own
+            // columns projected off them ([`super::varpro::ModeGrid`]); the full least
+            // squares at every point where they are rank-deficient.
+            let fast = super::varpro::ModeGrid::new(&start, i, &lin, data, mask);
+            for (w, z) in grid {
+                let v = match &fast {
+                    Some(g) => g.cost(&start, w, z),
+                    None => {
+                        let mut t = start.clone();
+                        t.mode[i].omega_n = w;
+                        t.mode[i].zeta = z;
+                        solve_linear(&mut t, &lin, data, mask)
                     }
+                };
+                if v < best.0 {
+                    best = (v, w, z);
                 }
             }
             start.mode[i].omega_n = best.1;
@@ -237,7 +248,23 @@ pub fn retune_within(
             out.clear();
             out.extend(solve_linear_res(&mut mm, &lin, data, mask).iter());
         };
-        let res = lm_box(resid, &theta0, &typ, &lo, &hi, 200);
+        let vp = VarPro {
+            start: &start,
+            nl: &nl,
+            lin: &lin,
+            data,
+            mask,
+            typ: &typ,
+        };
+        let res = lm_box_jac(
+            resid,
+            &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| vp.jacobian(th, j),
+            &theta0,
+            &typ,
+            &lo,
+            &hi,
+            200,
+        );
         model_at(&res.theta)
     };
     let n_params = lin.len() + nl.len();

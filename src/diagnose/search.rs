@@ -32,10 +32,11 @@ use super::problem::{Measures, Problem};
 use super::rank::{
     candidate_list, improves, modes_at_band_edge, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC,
 };
-use super::report::Step;
+use super::report::{Phases, Step};
 use super::retune::{retune, retune_within, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
+use rayon::prelude::*;
 
 /// Search settings.
 #[derive(Debug, Clone, Copy)]
@@ -106,6 +107,8 @@ pub struct SearchResult {
     pub expanded: usize,
     /// Joint refits.
     pub joint_refits: usize,
+    /// Wall time of the screens and of the joint refits.
+    pub phases: Phases,
 }
 
 /// Writes effect `c` with parameters `th` into `m`.
@@ -165,6 +168,7 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let (mut expanded, mut joint_refits) = (0, 0);
+    let mut phases = Phases::default();
     for depth in 1..=s.max_effects {
         if level.iter().any(|i| nodes[*i].measures.consistent()) {
             break;
@@ -178,20 +182,46 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                 .into_iter()
                 .filter(|c| *c == Cand::Mode || !used.contains(c))
                 .collect();
-            let screened = p.screen(&cands, node.measures);
+            let screened = phases.time("screen", || p.screen(&cands, node.measures));
             expanded += 1;
+            // The `beam + 1` best promising candidates are written into the model and every
+            // parameter refit jointly: independent refits, run in parallel (rayon's indexed
+            // collect keeps their order, so the result does not depend on the scheduling).
             let mut tried = 0;
-            for sc in &screened {
-                let promising =
-                    sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
+            let refit: Vec<bool> = screened
+                .iter()
+                .map(|sc| {
+                    let promising =
+                        sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
+                    let go = promising && tried <= s.beam;
+                    tried += usize::from(go);
+                    go
+                })
+                .collect();
+            let t_refit = std::time::Instant::now();
+            let refits: Vec<Option<Result<_>>> = screened
+                .par_iter()
+                .zip(&refit)
+                .map(|(sc, go)| {
+                    go.then(|| {
+                        let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
+                        let r = retune_within(&added, &anchor, data, None, node.configured);
+                        let v_fit = r.v_after;
+                        let n_params = r.n_params;
+                        settle(r.model, &anchor, data).map(|(model, m)| (model, m, v_fit, n_params))
+                    })
+                })
+                .collect();
+            phases.add(
+                "joint refits",
+                t_refit.elapsed().as_secs_f64(),
+                refit.iter().filter(|g| **g).count(),
+            );
+            for (sc, refit) in screened.iter().zip(refits) {
                 let mut child_node = None;
-                if promising && tried <= s.beam {
-                    tried += 1;
-                    let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                    let r = retune_within(&added, &anchor, data, None, node.configured);
+                if let Some(refit) = refit {
                     joint_refits += 1;
-                    let v_fit = r.v_after;
-                    let (model, m) = settle(r.model, &anchor, data)?;
+                    let (model, m, v_fit, n_refit) = refit?;
                     let n_new = sc.cand.n_params(data.n_ch());
                     // Against the best of the node and (for the configured model) its retune.
                     let ref_v = if node.configured {
@@ -234,16 +264,16 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                             delta_bic: d_bic,
                             misfit_rms_before_refit: sc.measures.misfit_rms,
                             invalid_fraction_before_refit: sc.measures.invalid_fraction,
-                            n_refit: r.n_params,
+                            n_refit,
                             ties: vec![],
                         });
                         let child = Node {
                             effects,
-                            bic: bic(v_fit, r.n_params, data),
+                            bic: bic(v_fit, n_refit, data),
                             model,
                             measures: m,
                             v_fit,
-                            n_params: r.n_params,
+                            n_params: n_refit,
                             steps,
                             configured: false,
                         };
@@ -315,5 +345,6 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
         first_level,
         expanded,
         joint_refits,
+        phases,
     })
 }

@@ -1,0 +1,587 @@
+//! The Jacobian of the variable-projection residual of [`super::retune`] (Golub & Pereyra
+//! 1973; Kaufman 1975 for the notation), from one Householder QR per point instead of one
+//! per parameter.
+//!
+//! With the linear slots solved, the residual is `r(θ) = P⊥(θ) y`, `P⊥ = I − A A⁺`, `A(θ)`
+//! the weighted design matrix of the linear slots ([`super::slots::design`]).  Its exact
+//! derivative along a nonlinear parameter `θ_k` (Golub & Pereyra, eq. (4.3)) is
+//!
+//! `∂r/∂θ_k = −P⊥ A_k x − (A⁺)ᵀ A_kᵀ r`,   `A_k = ∂A/∂θ_k`, `x = A⁺ y`.
+//!
+//! With `Ã = A S = Q R` (columns scaled to unit norm, `S` diagonal; thin Householder QR of
+//! each independent block, [`super::slots::blocks`]), `P⊥ v = v − Q Qᵀ v` and
+//! `(A⁺)ᵀ w = Q R⁻ᵀ S w`.  `A_k` is analytic where the parameter acts on a few columns: a
+//! mode's `ln ω_n` and `ln ζ` on its own columns,
+//! `∂/∂ln ω_n [1/d(s)] = −(2ζω_n s + 2ω_n²)/d(s)²`, `∂/∂ln ζ [1/d(s)] = −2ζω_n s/d(s)²`,
+//! `d(s) = s² + 2ζω_n s + ω_n²`; an input gain `b_i` on its term's columns, rows of input
+//! `i`, `∂/∂b_i = 1/b_i` times the entry.  Path effects (delays, lags, …) and friction poles
+//! change every column of a channel: their `A_k` is a forward difference of the design
+//! matrix alone (no factorization).  Where a block is rank-deficient (a pivot below
+//! `1e-12` of the largest, where the least squares drops a column) the caller falls back to
+//! the forward-difference Jacobian of the whole residual.
+
+use super::channels::Channels;
+use super::slots::{blocks, design, gains_of, set_nl, Lin, Nl, Term};
+use crate::model::physical::PhysicalModel;
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+
+/// One independent block of the least squares, factored: `Ã_b = Q R`.
+struct Block {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    q: DMatrix<f64>,
+    r: DMatrix<f64>,
+    scale: Vec<f64>,
+}
+
+/// The variable-projection problem of a refit: the model with its nonlinear slots `nl` at
+/// `θ` and its linear slots `lin` solved on the data at `mask`.
+pub(super) struct VarPro<'a> {
+    pub start: &'a PhysicalModel,
+    pub nl: &'a [Nl],
+    pub lin: &'a [Lin],
+    pub data: &'a Channels,
+    pub mask: &'a [usize],
+    /// Typical magnitudes of the nonlinear parameters (forward-difference steps).
+    pub typ: &'a [f64],
+}
+
+/// The column-scaled Householder QR of `a` (`a S = Q R`, thin): `(Q, R, scale)`, or `None`
+/// when it is rank-deficient (a pivot below `1e-12` of the largest, where the least squares
+/// drops a column) or has more columns than rows.
+fn factor_block(mut a: DMatrix<f64>) -> Option<(DMatrix<f64>, DMatrix<f64>, Vec<f64>)> {
+    let n = a.ncols();
+    if a.nrows() < n {
+        return None;
+    }
+    let scale: Vec<f64> = (0..n)
+        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
+        .collect();
+    for (j, s) in scale.iter().enumerate() {
+        a.column_mut(j).scale_mut(1.0 / s);
+    }
+    let qr = a.qr();
+    let r = qr.r();
+    let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    if !rmax.is_finite() || (0..n).any(|i| r[(i, i)].abs() <= 1e-12 * rmax) {
+        return None;
+    }
+    Some((qr.q(), r, scale))
+}
+
+/// [`factor_block`] of every block of `a`, or `None` when one is rank-deficient.
+fn factor(
+    a: &DMatrix<f64>,
+    lin: &[Lin],
+    data: &Channels,
+    rows_per_ch: usize,
+) -> Option<Vec<Block>> {
+    let mut out = Vec::new();
+    for (chs, cols) in blocks(lin, data) {
+        if cols.is_empty() {
+            continue;
+        }
+        let rows: Vec<usize> = chs
+            .iter()
+            .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
+            .collect();
+        let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+        let (q, r, scale) = factor_block(ab)?;
+        out.push(Block {
+            rows,
+            cols,
+            q,
+            r,
+            scale,
+        });
+    }
+    Some(out)
+}
+
+impl VarPro<'_> {
+    /// The model at `θ`.
+    fn model(&self, th: &[f64]) -> PhysicalModel {
+        let mut mm = self.start.clone();
+        for (s, x) in self.nl.iter().zip(th) {
+            set_nl(&mut mm, *s, *x);
+        }
+        mm
+    }
+
+    /// `∂A/∂θ_k` as `(column, derivative)` pairs (the columns it changes), analytic where
+    /// the module documentation says so, else a forward difference of the design matrix.
+    fn d_design(
+        &self,
+        mm: &PhysicalModel,
+        a: &DMatrix<f64>,
+        th: &[f64],
+        k: usize,
+    ) -> Vec<(usize, DVector<f64>)> {
+        let rows_per_ch = 2 * self.mask.len();
+        let s_at =
+            |row: usize| Complex64::new(0.0, self.data.omega[self.mask[(row % rows_per_ch) / 2]]);
+        // Columns of term `t`, with a complex factor per row (`None`: the row is untouched).
+        let scaled = |t: Term, f: &dyn Fn(usize) -> Option<Complex64>| {
+            self.lin
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| matches!(l, Lin::Out(u, _) if *u == t))
+                .map(|(j, _)| {
+                    let mut d = DVector::<f64>::zeros(a.nrows());
+                    for row in (0..a.nrows()).step_by(2) {
+                        if let Some(fac) = f(row) {
+                            let c = Complex64::new(a[(row, j)], a[(row + 1, j)]) * fac;
+                            d[row] = c.re;
+                            d[row + 1] = c.im;
+                        }
+                    }
+                    (j, d)
+                })
+                .collect::<Vec<_>>()
+        };
+        match self.nl[k] {
+            Nl::ModeW(i) | Nl::ModeZ(i) => {
+                let (w, z) = (mm.mode[i].omega_n, mm.mode[i].zeta);
+                let by_w = matches!(self.nl[k], Nl::ModeW(_));
+                scaled(Term::Mode(i), &|row| {
+                    let s = s_at(row);
+                    let den = s * s + 2.0 * z * w * s + w * w;
+                    let num = if by_w {
+                        2.0 * z * w * s + 2.0 * w * w
+                    } else {
+                        2.0 * z * w * s
+                    };
+                    Some(-num / den)
+                })
+            }
+            Nl::In(t, i) => {
+                let b = gains_of(mm, t).1.to_vec(mm.n_inputs())[i];
+                if b != 0.0 && b.is_finite() {
+                    let inv = Complex64::new(1.0 / b, 0.0);
+                    return scaled(t, &|row| {
+                        (self.data.entries[row / rows_per_ch].1 == i).then_some(inv)
+                    });
+                }
+                self.forward_difference(a, th, k)
+            }
+            Nl::RigidPole(_) | Nl::Delay(_) | Nl::LogEffect(_) => self.forward_difference(a, th, k),
+        }
+    }
+
+    fn forward_difference(
+        &self,
+        a: &DMatrix<f64>,
+        th: &[f64],
+        k: usize,
+    ) -> Vec<(usize, DVector<f64>)> {
+        let h = 1e-7 * th[k].abs().max(self.typ[k]).max(1e-300);
+        let mut t = th.to_vec();
+        t[k] += h;
+        let (ah, _) = design(&self.model(&t), self.lin, self.data, self.mask);
+        (0..a.ncols())
+            .map(|j| (j, (ah.column(j) - a.column(j)) / h))
+            .collect()
+    }
+
+    /// Fills `jac` with `∂r/∂θ` at `θ` (the residual `r = y − A x`, rows as
+    /// [`super::slots::design`]); `false` when a block is rank-deficient or the solution is
+    /// not finite.
+    pub fn jacobian(&self, th: &[f64], jac: &mut DMatrix<f64>) -> bool {
+        let mm = self.model(th);
+        let (a, y) = design(&mm, self.lin, self.data, self.mask);
+        let rows_per_ch = 2 * self.mask.len();
+        let Some(fact) = factor(&a, self.lin, self.data, rows_per_ch) else {
+            return false;
+        };
+        let n = self.lin.len();
+        let mut x = DVector::<f64>::zeros(n);
+        for b in &fact {
+            let yb = DVector::from_fn(b.rows.len(), |i, _| y[b.rows[i]]);
+            let qty = b.q.tr_mul(&yb);
+            let Some(z) = b.r.solve_upper_triangular(&qty) else {
+                return false;
+            };
+            for (i, j) in b.cols.iter().enumerate() {
+                x[*j] = z[i] / b.scale[i];
+            }
+        }
+        if x.iter().any(|v| !v.is_finite()) || jac.nrows() != a.nrows() {
+            return false;
+        }
+        let res = &y - &a * &x;
+        // U = [A_k x]_k (every row), T = [A_kᵀ r]_k: one column per parameter, so the
+        // projections below are two matrix products per block.
+        let kk = self.nl.len();
+        let mut u_all = DMatrix::<f64>::zeros(a.nrows(), kk);
+        let mut t_all = DMatrix::<f64>::zeros(n, kk);
+        for k in 0..kk {
+            for (j, d) in &self.d_design(&mm, &a, th, k) {
+                u_all.column_mut(k).axpy(x[*j], d, 1.0);
+                t_all[(*j, k)] = d.dot(&res);
+            }
+        }
+        let m = a.nrows();
+        if let [b] = fact.as_slice() {
+            if b.rows.len() == m && b.rows.iter().enumerate().all(|(i, r)| i == *r) {
+                // One block over every row (one output, or SISO): no gather, no scatter.
+                let w = DMatrix::from_fn(n, kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
+                let Some(z) = b.r.tr_solve_upper_triangular(&w) else {
+                    return false;
+                };
+                let c = z - b.q.tr_mul(&u_all);
+                jac.copy_from(&u_all);
+                jac.gemm(1.0, &b.q, &c, 1.0);
+                jac.neg_mut();
+                return jac.iter().all(|v| v.is_finite());
+            }
+        }
+        jac.fill(0.0);
+        for b in &fact {
+            let ub = DMatrix::from_fn(b.rows.len(), kk, |i, k| u_all[(b.rows[i], k)]);
+            let w = DMatrix::from_fn(b.cols.len(), kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
+            // −(P⊥ U + Q R⁻ᵀ S T) = −(U + Q (Z − Qᵀ U)), Z = R⁻ᵀ S T.
+            let Some(z) = b.r.tr_solve_upper_triangular(&w) else {
+                return false;
+            };
+            let c = z - b.q.tr_mul(&ub);
+            let col = ub + &b.q * c;
+            for k in 0..kk {
+                for (i, row) in b.rows.iter().enumerate() {
+                    jac[(*row, k)] = -col[(i, k)];
+                }
+            }
+        }
+        jac.iter().all(|v| v.is_finite())
+    }
+}
+
+/// The cost of the least squares as one mode's `ω_n`, `ζ` move (the rough placement of
+/// [`super::retune`]): the other columns `A_o` are factored once (`A_o S = Q R`), and at
+/// each point the mode's columns `a` are projected off them,
+/// `V(ω_n, ζ) = ‖r_o − Q_b Q_bᵀ r_o‖²`, `r_o = P⊥_o y`, `b = P⊥_o a = Q_b R_b`: the cost of
+/// the full least squares, in `O(m n)` per point instead of `O(m n²)`.
+pub(super) struct ModeGrid<'a> {
+    mode: usize,
+    own: Vec<Lin>,
+    data: &'a Channels,
+    mask: &'a [usize],
+    q: DMatrix<f64>,
+    r_o: DVector<f64>,
+}
+
+impl<'a> ModeGrid<'a> {
+    /// `None` when the mode has no column or the other columns are rank-deficient.
+    pub fn new(
+        m: &PhysicalModel,
+        mode: usize,
+        lin: &[Lin],
+        data: &'a Channels,
+        mask: &'a [usize],
+    ) -> Option<Self> {
+        let is_own = |l: &Lin| matches!(l, Lin::Out(Term::Mode(i), _) if *i == mode);
+        let own: Vec<Lin> = lin.iter().copied().filter(is_own).collect();
+        let others: Vec<Lin> = lin.iter().copied().filter(|l| !is_own(l)).collect();
+        if own.is_empty() {
+            return None;
+        }
+        let (a, y) = design(m, &others, data, mask);
+        let (q, r_o) = if others.is_empty() {
+            (DMatrix::zeros(y.len(), 0), y)
+        } else {
+            // One factorization over every row (the blocks change nothing in the span).
+            let (q, _, _) = factor_block(a)?;
+            let r_o = &y - &q * q.tr_mul(&y);
+            (q, r_o)
+        };
+        Some(Self {
+            mode,
+            own,
+            data,
+            mask,
+            q,
+            r_o,
+        })
+    }
+
+    /// The least-squares cost with the mode at `(ω_n, ζ)`.
+    pub fn cost(&self, m: &PhysicalModel, w: f64, z: f64) -> f64 {
+        let mut t = m.clone();
+        t.mode[self.mode].omega_n = w;
+        t.mode[self.mode].zeta = z;
+        let (a, _) = design(&t, &self.own, self.data, self.mask);
+        let b = if self.q.ncols() == 0 {
+            a
+        } else {
+            &a - &self.q * self.q.tr_mul(&a)
+        };
+        // The residual itself, not ‖r_o‖² − ‖Q_bᵀ r_o‖² (no cancellation on a close fit).
+        let v = match factor_block(b) {
+            Some((qb, _, _)) => (&self.r_o - &qb * qb.tr_mul(&self.r_o)).norm_squared(),
+            None => self.r_o.norm_squared(),
+        };
+        if v.is_finite() {
+            v
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::retune::solve_linear_res;
+    use super::super::slots::{get_nl, slots};
+    use super::*;
+    use crate::model::physical::{
+        EffectKind, EffectSpec, Feedthrough, Gains, ModeSpec, PoleAtZeroSpec,
+    };
+
+    fn mode(w: f64, z: f64, b: [f64; 3]) -> ModeSpec {
+        ModeSpec {
+            name: None,
+            omega_n: w,
+            zeta: z,
+            mass: 1.3,
+            input_gain: Gains::Vector(b.to_vec()),
+            output_gain: Gains::Scalar(50.0),
+        }
+    }
+
+    /// One output, three inputs: a rigid body with friction, two light modes, a
+    /// feedthrough, an input delay and a lag on input 2.
+    fn model(scale: f64) -> PhysicalModel {
+        let mut delay = EffectSpec::new(EffectKind::Delay);
+        delay.tau_s = Some(1.0e-4 * scale);
+        let mut lag = EffectSpec::new(EffectKind::Lag);
+        lag.omega_c = Some(2500.0 * scale);
+        lag.channel = Some(2);
+        PhysicalModel {
+            rigid_body: vec![PoleAtZeroSpec {
+                friction_pole: Some(20.0 * scale),
+                name: None,
+                mass: 2.0,
+                input_gain: Gains::Vector(vec![1.0, 0.7, -0.4]),
+                output_gain: Gains::Scalar(100.0),
+            }],
+            mode: vec![
+                mode(300.0 * scale, 0.01, [1.0, -0.5 * scale, 0.8]),
+                mode(950.0 / scale, 0.003 * scale, [1.0, 0.9, -0.3 / scale]),
+            ],
+            feedthrough: Some(Feedthrough::Matrix(vec![vec![1e-3, 2e-3, -1e-3]])),
+            effect: vec![delay, lag],
+            ..Default::default()
+        }
+    }
+
+    fn channels(truth: &PhysicalModel) -> Channels {
+        let omega = crate::system::logspace(100.0, 3000.0, 150);
+        let entries = vec![(0, 0), (0, 1), (0, 2)];
+        let g: Vec<Vec<Complex64>> = entries
+            .iter()
+            .map(|e| omega.iter().map(|w| truth.eval(*w)[*e]).collect())
+            .collect();
+        let radius = g
+            .iter()
+            .map(|c| c.iter().map(|x| 0.01 * x.norm() + 1e-4).collect())
+            .collect();
+        Channels {
+            path: "test".into(),
+            omega,
+            entries,
+            g,
+            radius,
+            radius_source: vec![String::new(); 3],
+        }
+    }
+
+    /// The variable-projection Jacobian against central differences of the residual with
+    /// the linear slots solved by the refit's own least squares (an independent route:
+    /// no derivative formula, one QR per point).
+    #[test]
+    fn the_jacobian_matches_central_differences_of_the_projected_residual() {
+        let data = channels(&model(1.07));
+        let start = model(1.0);
+        let (lin, nl) = slots(&start, &data);
+        assert!(nl.len() >= 10, "{nl:?}");
+        let mask: Vec<usize> = (0..data.len()).collect();
+        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
+        let typ: Vec<f64> = th.iter().map(|x| x.abs().max(1e-3)).collect();
+        let vp = VarPro {
+            start: &start,
+            nl: &nl,
+            lin: &lin,
+            data: &data,
+            mask: &mask,
+            typ: &typ,
+        };
+        let resid = |t: &[f64]| {
+            let mut m = vp.model(t);
+            solve_linear_res(&mut m, &lin, &data, &mask)
+        };
+        let rows = resid(&th).len();
+        let mut jac = DMatrix::zeros(rows, nl.len());
+        assert!(vp.jacobian(&th, &mut jac));
+        let r_norm = resid(&th).norm();
+        for k in 0..nl.len() {
+            // Fourth-order central differences (truncation ~(h/ζ)⁴, rounding ~ε‖r‖/h).
+            let h = 1e-5 * th[k].abs().max(typ[k]);
+            let at = |d: f64| {
+                let mut t = th.clone();
+                t[k] += d;
+                resid(&t)
+            };
+            let cd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
+            let err = (jac.column(k) - &cd).norm();
+            assert!(
+                err <= 1e-6 * cd.norm() + 1e-9 * r_norm,
+                "{:?}: |J − CD| = {err:e}, |CD| = {:e}, |r| = {r_norm:e}",
+                nl[k],
+                cd.norm()
+            );
+        }
+    }
+
+    /// Two copies of one mode make the design rank-deficient: the Jacobian declines (the
+    /// refit then differentiates the whole residual).
+    #[test]
+    fn a_rank_deficient_design_declines() {
+        let mut start = model(1.0);
+        start.mode[1] = start.mode[0].clone();
+        start.effect.clear();
+        let data = channels(&model(1.0));
+        let (lin, nl) = slots(&start, &data);
+        let mask: Vec<usize> = (0..data.len()).collect();
+        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
+        let typ = vec![1.0; nl.len()];
+        let vp = VarPro {
+            start: &start,
+            nl: &nl,
+            lin: &lin,
+            data: &data,
+            mask: &mask,
+            typ: &typ,
+        };
+        let mut jac = DMatrix::zeros(2 * 3 * data.len(), nl.len());
+        assert!(!vp.jacobian(&th, &mut jac));
+    }
+
+    /// The rough placement's cost by projection equals the full least squares' cost (QR of
+    /// every column at every point) over a grid that crosses the mode's resonance.
+    #[test]
+    fn the_mode_grid_cost_is_the_full_least_squares_cost() {
+        use super::super::retune::solve_linear_res;
+        let data = channels(&model(1.07));
+        let start = model(1.0);
+        let (lin, _) = slots(&start, &data);
+        let mask: Vec<usize> = (0..data.len()).collect();
+        for i in 0..2 {
+            let g = ModeGrid::new(&start, i, &lin, &data, &mask).expect("full rank");
+            let w0 = start.mode[i].omega_n;
+            for j in 0..9 {
+                let w = w0 * 1.3f64.powf(-1.0 + j as f64 / 4.0);
+                for z in [1e-3, 0.01, 0.1] {
+                    let mut t = start.clone();
+                    t.mode[i].omega_n = w;
+                    t.mode[i].zeta = z;
+                    let full = solve_linear_res(&mut t, &lin, &data, &mask).norm_squared();
+                    let fast = g.cost(&start, w, z);
+                    assert!(
+                        (fast - full).abs() <= 1e-9 * full,
+                        "mode {i} at ({w}, {z}): {fast} vs {full}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Two outputs, one input: one least-squares block per output (the gather–scatter
+    /// path), against fourth-order central differences.
+    #[test]
+    fn the_jacobian_matches_with_one_block_per_output() {
+        let two = |scale: f64| {
+            let mut delay = EffectSpec::new(EffectKind::Delay);
+            delay.tau_s = Some(1.0e-4 * scale);
+            let m = |w: f64, z: f64, c: [f64; 2]| ModeSpec {
+                name: None,
+                omega_n: w,
+                zeta: z,
+                mass: 1.0,
+                input_gain: Gains::Scalar(1.0),
+                output_gain: Gains::Vector(c.to_vec()),
+            };
+            PhysicalModel {
+                rigid_body: vec![PoleAtZeroSpec {
+                    friction_pole: None,
+                    name: None,
+                    mass: 2.0,
+                    input_gain: Gains::Scalar(1.0),
+                    output_gain: Gains::Vector(vec![100.0, -60.0]),
+                }],
+                mode: vec![
+                    m(400.0 * scale, 0.02, [40.0, -30.0]),
+                    m(1300.0 / scale, 0.005 * scale, [20.0, 25.0]),
+                ],
+                feedthrough: Some(Feedthrough::Matrix(vec![vec![1e-3], vec![-2e-3]])),
+                effect: vec![delay],
+                ..Default::default()
+            }
+        };
+        let truth = two(1.05);
+        let omega = crate::system::logspace(100.0, 3000.0, 120);
+        let entries = vec![(0, 0), (1, 0)];
+        let g: Vec<Vec<Complex64>> = entries
+            .iter()
+            .map(|e| omega.iter().map(|w| truth.eval(*w)[*e]).collect())
+            .collect();
+        let radius = g
+            .iter()
+            .map(|c| c.iter().map(|x| 0.01 * x.norm() + 1e-4).collect())
+            .collect();
+        let data = Channels {
+            path: "test".into(),
+            omega,
+            entries,
+            g,
+            radius,
+            radius_source: vec![String::new(); 2],
+        };
+        let start = two(1.0);
+        let (lin, nl) = slots(&start, &data);
+        assert_eq!(blocks(&lin, &data).len(), 2);
+        let mask: Vec<usize> = (0..data.len()).collect();
+        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
+        let typ: Vec<f64> = th.iter().map(|x| x.abs().max(1e-3)).collect();
+        let vp = VarPro {
+            start: &start,
+            nl: &nl,
+            lin: &lin,
+            data: &data,
+            mask: &mask,
+            typ: &typ,
+        };
+        let resid = |t: &[f64]| {
+            let mut m = vp.model(t);
+            solve_linear_res(&mut m, &lin, &data, &mask)
+        };
+        let r_norm = resid(&th).norm();
+        let mut jac = DMatrix::zeros(4 * data.len(), nl.len());
+        assert!(vp.jacobian(&th, &mut jac));
+        for k in 0..nl.len() {
+            let h = 1e-5 * th[k].abs().max(typ[k]);
+            let at = |d: f64| {
+                let mut t = th.clone();
+                t[k] += d;
+                resid(&t)
+            };
+            let cd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
+            let err = (jac.column(k) - &cd).norm();
+            assert!(
+                err <= 1e-6 * cd.norm() + 1e-9 * r_norm,
+                "{:?}: |J − CD| = {err:e}, |CD| = {:e}",
+                nl[k],
+                cd.norm()
+            );
+        }
+    }
+}
