@@ -300,6 +300,7 @@ impl<'a> OrderSearch<'a> {
                 &self.init,
                 mask,
                 set.max_solver_iter,
+                set.thorough,
             );
             self.lp_solves += rounds;
             if st != SolverStatus::Solved {

@@ -39,7 +39,8 @@ pub(crate) fn minimax_level(
                  events: &mut Vec<SolverEvent>,
                  lp: &mut usize,
                  mask: &mut Vec<bool>| {
-        let (st, s, a, b, rounds) = max_slack(phi, grid, t, init, mask, set.max_solver_iter);
+        let (st, s, a, b, rounds) =
+            max_slack(phi, grid, t, init, mask, set.max_solver_iter, set.thorough);
         *lp += rounds;
         if st != SolverStatus::Solved {
             let (kind, action) = if st.has_solution() {
@@ -214,7 +215,7 @@ fn blocking_families(phi: &[Vec<f64>], grid: &[GridPoint], init: &[bool], max_it
             })
             .collect();
         let mut mask = Vec::new();
-        let (st, s, _, _, _) = max_slack(phi, &relaxed, 1e24, init, &mut mask, max_iter);
+        let (st, s, _, _, _) = max_slack(phi, &relaxed, 1e24, init, &mut mask, max_iter, false);
         if st.has_solution() && s >= 0.0 {
             found.push(name);
         }

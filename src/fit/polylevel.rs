@@ -131,6 +131,9 @@ impl<'a> LevelLp<'a> {
     /// costs 2–3× per solve, on every level when always on (2000 data, orders 0–8: 3.3 s CPU
     /// always on, 1.3 s on a doubt only).
     fn level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
+        if self.set.thorough {
+            return self.level_with(t, events, true);
+        }
         let before = events.len();
         match self.level_with(t, events, false) {
             Level::Doubt => {
@@ -250,6 +253,10 @@ impl<'a> LevelLp<'a> {
             // before bisecting, rather than bisecting all the way from `t = 1`.
             let mut hi = probe;
             let mut feasible = vec![(hi, x)];
+            if self.set.thorough {
+                // The reference route bisects from `t = 1`.
+                return Some((0.0, hi, feasible));
+            }
             let mut step = 2.0 * tol;
             while hi > tol {
                 let at = (hi - step).max(0.0);
