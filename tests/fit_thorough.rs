@@ -18,7 +18,7 @@ mod common;
 
 use common::repo;
 use rshape::fit::order::OrderRow;
-use rshape::model::controller::Controller;
+use rshape::model::Controller;
 use rshape::{fit_auto, read_frf_csv, Config, FitResult, FitSettings};
 
 struct Route {
