@@ -17,7 +17,8 @@ pub struct CompareArgs {
     /// SISO channel of MIMO data, `OUT,IN` (1-based); overrides the config's [channel].
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
-    /// Write the Bode overlay (data and model) to this SVG file.
+    /// Write the Bode overlay (data with their noise band, model as a line, unwrapped phase)
+    /// to this SVG file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// Also test the data against a second experiment (data-vs-data consistency: do the

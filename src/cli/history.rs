@@ -1,5 +1,6 @@
 //! `rshape history CONFIG... [--data FILE] [--noise-radius X] [--svg FILE] [--json]`: the
-//! error measures across model revisions, as a table and an error-vs-revision SVG.
+//! error measures across model revisions, as a table and an SVG of the error after each added
+//! effect.
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::{channel_arg, run_compare};
@@ -24,7 +25,7 @@ pub struct HistoryArgs {
     /// SISO channel `OUT,IN`.
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
-    /// Write the error-vs-revision figure here.
+    /// Write the figure of the error after each revision (labelled by the effect it added) here.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// JSON on stdout.
@@ -91,9 +92,10 @@ pub fn run(a: &HistoryArgs) -> Result<i32> {
             .map(|c| revision_label(&text(c), &stem(c)))
             .collect();
         let title = format!(
-            "{}: error after each added effect, on {}",
+            "{}: error after each added effect, on {}{}",
             model_name(&text(&a.configs[0]), &stem(&a.configs[0])),
-            revs[0].data
+            revs[0].data,
+            ch.map_or(String::new(), |(o, i)| format!(" (channel {o},{i})"))
         );
         error_history(
             path,

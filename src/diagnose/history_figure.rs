@@ -155,10 +155,14 @@ pub fn history_svg(
         .cloned()
         .filter(|v| *v > 0.0)
         .fold(f64::INFINITY, f64::min)
-        .min(1.0)
-        .max(1e-6)
+        .clamp(1e-6, 1.0)
         / 1.5;
-    let hi = misfit_rms.iter().cloned().fold(1.0, f64::max) * 1.5;
+    // Up to the next power of ten, so the top of the axis carries a label.
+    let hi = 10f64.powf(
+        (misfit_rms.iter().cloned().fold(1.0, f64::max) * 1.2)
+            .log10()
+            .ceil(),
+    );
     let (w, caption_h, panel, x_area) = (960u32, 40u32, 270u32, 80u32);
     let mut svg = String::new();
     {

@@ -262,10 +262,11 @@ pub fn tf_label(tf: &crate::system::TransferFunction) -> String {
     }
 }
 
-/// Estimated width in pixels of `text` in the sans-serif font of size `font` (0.62 em per
-/// character: digits and lower-case letters of common sans fonts are narrower).
+/// Estimated width in pixels of `text` in the sans-serif font of size `font`: the SVG backend
+/// writes the size as `font/1.24` px, and 0.62 em per character of that is wider than the
+/// digits and lower-case letters of common sans fonts.
 pub fn text_width(text: &str, font: u32) -> f64 {
-    text.chars().count() as f64 * 0.62 * font as f64
+    text.chars().count() as f64 * 0.5 * font as f64
 }
 
 /// A tick label of an axis whose ticks were chosen by [`log_axis_ticks`]: the shortest
@@ -286,7 +287,7 @@ pub fn fmt_tick(v: f64) -> String {
 /// Tick values for a log axis over `[lo, hi]` drawn `width` pixels wide with labels of
 /// `font` pixels: the densest of the usual sets (mantissas 1; 1-2-5; 1-2-3-5; 1…9; then
 /// linear steps 1-2-2.5-5 × 10ᵏ for narrow ranges) whose labels, centred on their ticks,
-/// keep at least 8 px apart, with at most 12 ticks.  Labels never overlap
+/// keep at least 8 px apart, with at most 8 ticks (on ties the earlier set).  Labels never overlap
 /// (`800.900.01000.0` was the plotters default on a narrow band).
 pub fn log_axis_ticks(lo: f64, hi: f64, width: f64, font: u32) -> Vec<f64> {
     if !(lo > 0.0 && hi > lo && lo.is_finite() && hi.is_finite()) {
@@ -335,10 +336,15 @@ pub fn log_axis_ticks(lo: f64, hi: f64, width: f64, font: u32) -> Vec<f64> {
             sets.push(t);
         }
     }
-    sets.into_iter()
-        .filter(|t| t.len() <= 12 && fits(t))
-        .max_by_key(|t| t.len())
-        .unwrap_or_default()
+    // The first (most log-like) of the densest sets that fit, with at most 8 ticks: more
+    // makes a log axis look linear at its top end.
+    let mut best: Vec<f64> = Vec::new();
+    for t in sets {
+        if t.len() <= 8 && t.len() > best.len() && fits(&t) {
+            best = t;
+        }
+    }
+    best
 }
 
 /// Draws `labels` centred at pixel abscissas `x` below the pixel row `y` on `area`; labels
