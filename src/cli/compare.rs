@@ -3,7 +3,7 @@
 use super::common::{fmt_g, InputArgs};
 use crate::diagnose::agreement::{data_vs_data, AgreementVerdict};
 use crate::diagnose::compare::{compare, prepare, Band, CompareReport, CompareVerdict, PlantModel};
-use crate::diagnose::figures::bode_overlay;
+use crate::diagnose::figures::{bode_overlay, dense_grid, BodeData, ModelCurve};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -17,7 +17,8 @@ pub struct CompareArgs {
     /// SISO channel of MIMO data, `OUT,IN` (1-based); overrides the config's [channel].
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
-    /// Write the Bode overlay (data and model) to this SVG file.
+    /// Write the Bode overlay (data with their noise band, model as a line, unwrapped phase)
+    /// to this SVG file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// Also test the data against a second experiment (data-vs-data consistency: do the
@@ -116,15 +117,36 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     }
     let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?)?;
     if let Some(path) = &a.svg {
-        let gm = siso.model_response(&model)?;
         let invalid: Vec<bool> = rep.rows.iter().map(|r| r.invalid).collect();
+        // The model is drawn on a dense grid (it can be evaluated anywhere); a frequency
+        // where it cannot be evaluated breaks the line.
+        let grid = dense_grid(&siso.omega);
+        let gm = grid
+            .iter()
+            .map(|w| {
+                model
+                    .eval(*w)
+                    .map(|g| g[siso.model_entry])
+                    .unwrap_or(num_complex::Complex64::new(f64::NAN, f64::NAN))
+            })
+            .collect();
         bode_overlay(
             path,
-            &format!("{} vs {}", rep.config, rep.data),
-            &siso.omega,
-            &siso.g,
-            &invalid,
-            &[("model".to_string(), gm)],
+            &format!(
+                "{} vs {} (channel {},{})",
+                rep.config, rep.data, siso.channel.0, siso.channel.1
+            ),
+            &BodeData {
+                omega: &siso.omega,
+                g: &siso.g,
+                radius: siso.radius.as_deref(),
+                invalid: &invalid,
+            },
+            &[ModelCurve {
+                name: "model".into(),
+                omega: grid,
+                g: gm,
+            }],
         )?;
         rep.figure = Some(path.display().to_string());
     }

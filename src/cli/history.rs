@@ -1,9 +1,10 @@
 //! `rshape history CONFIG... [--data FILE] [--noise-radius X] [--svg FILE] [--json]`: the
-//! error measures across model revisions, as a table and an error-vs-revision SVG.
+//! error measures across model revisions, as a table and an SVG of the error after each added
+//! effect.
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::{channel_arg, run_compare};
-use crate::diagnose::figures::error_history;
+use crate::diagnose::history_figure::{error_history, model_name, revision_label};
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
@@ -24,7 +25,7 @@ pub struct HistoryArgs {
     /// SISO channel `OUT,IN`.
     #[arg(long, value_delimiter = ',')]
     pub channel: Option<Vec<usize>>,
-    /// Write the error-vs-revision figure here.
+    /// Write the figure of the error after each revision (labelled by the effect it added) here.
     #[arg(long)]
     pub svg: Option<PathBuf>,
     /// JSON on stdout.
@@ -80,9 +81,25 @@ pub fn run(a: &HistoryArgs) -> Result<i32> {
         });
     }
     if let Some(path) = &a.svg {
-        let labels: Vec<String> = (0..revs.len()).map(|k| format!("rev {k}")).collect();
+        let text = |p: &PathBuf| std::fs::read_to_string(p).unwrap_or_default();
+        let stem = |p: &PathBuf| {
+            p.file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned())
+        };
+        let labels: Vec<String> = a
+            .configs
+            .iter()
+            .map(|c| revision_label(&text(c), &stem(c)))
+            .collect();
+        let title = format!(
+            "{}: error after each added effect, on {}{}",
+            model_name(&text(&a.configs[0]), &stem(&a.configs[0])),
+            revs[0].data,
+            ch.map_or(String::new(), |(o, i)| format!(" (channel {o},{i})"))
+        );
         error_history(
             path,
+            &title,
             &labels,
             &revs.iter().map(|r| r.misfit_rms).collect::<Vec<_>>(),
             &revs

@@ -19,8 +19,8 @@
 //!   consistency polish; [`ties`]: sets the data cannot tell apart; [`holdout`]: the
 //!   final set checked on held-out data;
 //! * [`engine`]: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
-//!   [`apply_candidate`]); [`report`]: what it reports; [`figures`]: Bode overlay and
-//!   error-vs-revision SVGs.
+//!   [`apply_candidate`]); [`report`]: what it reports; [`figures`]: Bode overlay of `compare`;
+//!   [`history_figure`]: the error after each revision (`history`).
 pub mod compare;
 pub mod figures;
 
@@ -36,6 +36,7 @@ pub mod factor_form;
 pub mod final_effects;
 mod first_level;
 pub mod fit;
+pub mod history_figure;
 pub mod holdout;
 pub mod plant_form;
 pub mod polish;
