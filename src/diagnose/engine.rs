@@ -125,8 +125,15 @@ pub fn diagnose_channels(
     };
     let mut candidates = ranked_candidates(&root, &res, data)?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
-    let mut node = res.nodes[res.chosen].clone();
-    let (holdout, dropped) = drop_failing_holdout(base, &mut node, &res.nodes, data)?;
+    // When the holdout drops part of the chosen set, the next-best sets are tried.
+    let super::holdout::Passing {
+        mut node,
+        holdout,
+        dropped,
+        ..
+    } = super::holdout::first_passing(&res.nodes, res.chosen, |n| {
+        drop_failing_holdout(base, n, &res.nodes, data)
+    })?;
     let eliminated = super::backward::eliminate(base, &mut node, &res.nodes, data)?;
     final_refit(&mut node, base, data)?;
     let runner_up = runner_ups(&res);
