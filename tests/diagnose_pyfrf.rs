@@ -232,7 +232,11 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
     let d4 = &steps[3];
     assert_eq!(d4.dropped, ["mode"], "{}", d4.message);
     assert_eq!(d4.chosen, ["feedthrough"], "{}", d4.message);
-    assert!(d4.holdout.iter().all(|h| h.interleaved_ok), "{:?}", d4.holdout);
+    assert!(
+        d4.holdout.iter().all(|h| h.interleaved_ok),
+        "{:?}",
+        d4.holdout
+    );
     assert!(d4.after.misfit_rms < d4.before.misfit_rms);
     assert!(d4.after.invalid_fraction < d4.before.invalid_fraction);
     assert_eq!(d4.final_model.mode.len(), 3);

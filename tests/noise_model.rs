@@ -226,7 +226,9 @@ fn noise_coherence_source_matches_the_closed_form() {
     // Other data: the coherence file beside them, `<stem>_coherence.csv`.
     write("e.csv", "freq_hz,re_1_1,im_1_1\n10,0,1\n");
     let other = rshape::data::read_frf_csv(&dir.path().join("e.csv")).unwrap();
-    let missing = resolve_noise(None, Some(&cfg), &other).unwrap_err().to_string();
+    let missing = resolve_noise(None, Some(&cfg), &other)
+        .unwrap_err()
+        .to_string();
     assert!(missing.contains("e_coherence.csv"), "{missing}");
     write("e_coherence.csv", "freq_hz,coh_1_1\n10,0.8\n");
     let r = noise_radii(None, Some(&cfg), &other).unwrap().unwrap();
@@ -258,11 +260,23 @@ fn noise_coherence_bad_input() {
         ("coherence = \"coh.csv\"", "needs averages"),
         ("coherence = \"coh.csv\"\naverages = 0", "averages = 0"),
         ("coherence = \"coh.csv\"\naverages = -3", "averages = -3"),
-        ("coherence = \"coh.csv\"\naverages = 2\ncoverage = 0.0", "coverage = 0"),
-        ("coherence = \"coh.csv\"\naverages = 2\ncoverage = nan", "coverage = NaN"),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\ncoverage = 0.0",
+            "coverage = 0",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\ncoverage = nan",
+            "coverage = NaN",
+        ),
         ("averages = 2", "averages is only used with coherence"),
-        ("radius = 0.1\ncoverage = 2.0", "coverage is only used with coherence"),
-        ("coherence = \"coh.csv\"\naverages = 2\nradius = 0.1", "coherence or radius"),
+        (
+            "radius = 0.1\ncoverage = 2.0",
+            "coverage is only used with coherence",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\nradius = 0.1",
+            "coherence or radius",
+        ),
         (
             "coherence = \"coh.csv\"\naverages = 2\nstd_file = \"s.csv\"",
             "coherence or std_file",
@@ -277,11 +291,7 @@ fn noise_coherence_bad_input() {
         assert!(!msg.contains('\n'), "{keys}: {msg}");
     }
     let data = rshape::data::read_frf_csv(&dir.path().join("d.csv")).unwrap();
-    let cfg = Config::parse(
-        &with("coherence = \"coh.csv\"\naverages = 5"),
-        &cfg_path,
-    )
-    .unwrap();
+    let cfg = Config::parse(&with("coherence = \"coh.csv\"\naverages = 5"), &cfg_path).unwrap();
     for (body, needle) in [
         ("freq_hz,coh_1_1\n10,0.9\n20,1.2\n", "coh.csv:3:"),
         ("freq_hz,coh_1_1\n10,0\n20,0.9\n", "coh.csv:2:"),

@@ -51,7 +51,11 @@ pub fn h1_random_error(coherence: f64, averages: u32) -> f64 {
 
 /// Reads a file of `<prefix>_i_j` columns; `check(v)` says why a value (not the frequency)
 /// is refused.
-fn read_columns(path: &Path, prefix: &str, check: impl Fn(f64) -> Option<String>) -> Result<StdData> {
+fn read_columns(
+    path: &Path,
+    prefix: &str,
+    check: impl Fn(f64) -> Option<String>,
+) -> Result<StdData> {
     let text = super::table::read_text(path)?;
     let table = Table::parse(&text, path, &format!("freq_hz,{prefix}_1_1"))?;
     let err = |line: usize, msg: String| table.err(line, msg);
@@ -65,7 +69,12 @@ fn read_columns(path: &Path, prefix: &str, check: impl Fn(f64) -> Option<String>
             .and_then(|r| r.split_once('_'))
             .and_then(|(i, j)| Some((i.parse::<usize>().ok()?, j.parse::<usize>().ok()?)))
             .filter(|(i, j)| *i >= 1 && *j >= 1)
-            .ok_or_else(|| err(hline, format!("unknown column `{name}`: expected {prefix}_i_j")))?;
+            .ok_or_else(|| {
+                err(
+                    hline,
+                    format!("unknown column `{name}`: expected {prefix}_i_j"),
+                )
+            })?;
         cols.push(key);
     }
     let mut out = StdData {

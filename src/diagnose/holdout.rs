@@ -45,7 +45,10 @@ pub fn alternatives(nodes: &[Node], chosen: usize, cap: usize) -> Vec<usize> {
     order.sort_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic));
     let mut out: Vec<usize> = Vec::new();
     for i in order {
-        if !out.iter().any(|o| same_set(&nodes[*o].effects, &nodes[i].effects)) {
+        if !out
+            .iter()
+            .any(|o| same_set(&nodes[*o].effects, &nodes[i].effects))
+        {
             out.push(i);
         }
     }
