@@ -240,6 +240,16 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
     assert!(d4.after.misfit_rms < d4.before.misfit_rms);
     assert!(d4.after.invalid_fraction < d4.before.invalid_fraction);
     assert_eq!(d4.final_model.mode.len(), 3);
+    // The runner-ups are the other sets: the one kept is not among them, the dropped one is.
+    assert!(
+        !d4.runner_up.iter().any(|r| r.effects == d4.chosen),
+        "{:?}",
+        d4.runner_up
+    );
+    assert!(d4
+        .runner_up
+        .iter()
+        .any(|r| r.effects == ["mode"] && r.bic_gap < 0.0));
     // The 1/s term on an accelerance is flagged as implausible, never applied.
     for d in &steps {
         for c in d.candidates.iter().filter(|c| c.effect == "integrator") {

@@ -114,7 +114,7 @@ pub fn diagnose_channels(
     let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
-    let res = search(vec![configured, retuned_node], data, s)?;
+    let mut res = search(vec![configured, retuned_node], data, s)?;
     // First-level candidates: the retune, and each effect on top of it.
     let root = Root {
         base,
@@ -130,10 +130,12 @@ pub fn diagnose_channels(
         mut node,
         holdout,
         dropped,
-        ..
+        replaced_by,
     } = super::holdout::first_passing(&res.nodes, res.chosen, |n| {
         drop_failing_holdout(base, n, &res.nodes, data)
     })?;
+    // Runner-ups and ties are then relative to the set kept.
+    res.chosen = replaced_by.unwrap_or(res.chosen);
     let eliminated = super::backward::eliminate(base, &mut node, &res.nodes, data)?;
     final_refit(&mut node, base, data)?;
     let runner_up = runner_ups(&res);
