@@ -79,6 +79,26 @@ impl Kind {
 
 const ENV: &str = "envelope {dir}/model.toml --out {dir}/out";
 
+/// The SISO config with `[noise] coherence = "coh.csv"` and `keys`, and the coherence file
+/// `coh` (`freq_hz_unused`: a valid one at the data's frequencies).
+fn coherence_kind(
+    name: &'static str,
+    code: i32,
+    keys: &str,
+    coh: &str,
+    needles: &[&'static str],
+) -> Kind {
+    let coh = if coh == "freq_hz_unused" {
+        "omega_rad_s,coh_1_1\n0.1,0.9\n1,0.99\n10,0.999\n"
+    } else {
+        coh
+    };
+    kind(name, code, ENV, needles)
+        .config(format!("{SISO}[noise]\ncoherence = \"coh.csv\"\n{keys}\n"))
+        .data(siso_data("", &[]))
+        .file("coh.csv", coh.to_string())
+}
+
 fn csv_kinds() -> Vec<Kind> {
     let paper = |name, code, body: String, needles: &[&'static str]| {
         kind(name, code, ENV, needles)
@@ -348,6 +368,55 @@ fn csv_kinds() -> Vec<Kind> {
         kind("CSV: a noise radius larger than |G|", 0, ENV, &[])
             .config(SISO)
             .data(siso_data(",noise_radius", &[",10", ",10", ",10"])),
+        coherence_kind(
+            "noise: coherence file, valid",
+            0,
+            "averages = 5",
+            "freq_hz_unused",
+            &[],
+        ),
+        coherence_kind(
+            "noise: a coherence above 1",
+            2,
+            "averages = 5",
+            "omega_rad_s,coh_1_1\n0.1,0.9\n1,1.2\n10,0.9\n",
+            &["coh.csv:3", "coh_1_1", "not a coherence in (0, 1]"],
+        ),
+        coherence_kind(
+            "noise: a coherence of 0",
+            2,
+            "averages = 5",
+            "omega_rad_s,coh_1_1\n0.1,0\n1,0.9\n10,0.9\n",
+            &["coh.csv:2", "not a coherence in (0, 1]"],
+        ),
+        coherence_kind(
+            "noise: coherence at other frequencies than the data",
+            2,
+            "averages = 5",
+            "omega_rad_s,coh_1_1\n0.1,0.9\n2,0.9\n10,0.9\n",
+            &["coh.csv", "omega = 1 rad/s", "must match the FRF file"],
+        ),
+        coherence_kind(
+            "noise: coherence without averages",
+            2,
+            "coverage = 3",
+            "freq_hz_unused",
+            &["model.toml", "needs averages"],
+        ),
+        coherence_kind(
+            "noise: averages = 0",
+            2,
+            "averages = 0",
+            "freq_hz_unused",
+            &["model.toml", "averages = 0", "integer ≥ 1"],
+        ),
+        coherence_kind(
+            "noise: coverage = -1",
+            2,
+            "averages = 5\ncoverage = -1",
+            "freq_hz_unused",
+            &["model.toml", "coverage = -1", "> 0"],
+        ),
         kind(
             "CSV: the data file is missing",
             2,

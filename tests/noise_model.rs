@@ -173,3 +173,140 @@ fn noise_config_keys() {
     let typo = base.replace("radius = 0.06", "raduis = 0.06");
     assert!(Config::parse(&typo, p).is_err());
 }
+
+/// `[noise] coherence`: the radius of each datum is `coverage·ε·|H|` with the H1 random
+/// error `ε = √(1 − γ²)/(|γ|·√(2n))` (Bendat & Piersol, Table 9.6), checked against values
+/// worked by hand: γ² = 0.8, n = 2 → ε = √(0.2/(0.8·4)) = 1/4; γ² = 0.5, n = 2 →
+/// ε = √(0.5/(0.5·4)) = 1/2; γ² = 1 → 0.  Precedence: the source beats the data column and
+/// loses to the CLI flag; `coverage` defaults to 3; other data use `<stem>_coherence.csv`.
+#[test]
+fn noise_coherence_source_matches_the_closed_form() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &str| std::fs::write(dir.path().join(name), body).unwrap();
+    // |H| = 0.5, 2 and 5 (3-4-5 triangle).
+    write(
+        "d.csv",
+        "freq_hz,re_1_1,im_1_1,noise_radius\n10,0.5,0,0.01\n20,0,2,0.02\n30,3,-4,0.03\n",
+    );
+    write("coh.csv", "freq_hz,coh_1_1\n10,0.8\n20,0.5\n30,1\n40,0.9\n");
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let with = |keys: &str| {
+        base.replace("data = \"robot.csv\"", "data = \"d.csv\"")
+            .replace("radius = 0.06", keys)
+    };
+    let cfg_path = dir.path().join("c.toml");
+    let data = rshape::data::read_frf_csv(&dir.path().join("d.csv")).unwrap();
+    let cfg = Config::parse(
+        &with("coherence = \"coh.csv\"\naverages = 2\ncoverage = 2.0"),
+        &cfg_path,
+    )
+    .unwrap();
+    let r = resolve_noise(None, Some(&cfg), &data).unwrap().unwrap();
+    assert_eq!(r.source, NoiseSource::ConfigCoherence);
+    let expected = [2.0 * 0.25 * 0.5, 2.0 * 0.5 * 2.0, 0.0];
+    for (got, want) in r.radii.iter().zip(expected) {
+        assert!((got - want).abs() <= 1e-15, "{:?} vs {expected:?}", r.radii);
+    }
+    assert!(r.description.contains("coh_1_1"), "{}", r.description);
+    // Default coverage 3: the radii scale by 3/2.
+    let k3 = Config::parse(&with("coherence = \"coh.csv\"\naverages = 2"), &cfg_path).unwrap();
+    let r3 = noise_radii(None, Some(&k3), &data).unwrap().unwrap();
+    assert!((r3[0] - 1.5 * expected[0]).abs() <= 1e-15, "{r3:?}");
+    // n = 8 instead of 2: ε halves.
+    let n8 = Config::parse(&with("coherence = \"coh.csv\"\naverages = 8"), &cfg_path).unwrap();
+    let r8 = noise_radii(None, Some(&n8), &data).unwrap().unwrap();
+    assert!((r8[1] - 0.5 * r3[1]).abs() <= 1e-15, "{r8:?} vs {r3:?}");
+    // The CLI flag beats it.
+    assert_eq!(
+        noise_radii(Some(0.03), Some(&cfg), &data).unwrap(),
+        Some(vec![0.03; 3])
+    );
+    // Other data: the coherence file beside them, `<stem>_coherence.csv`.
+    write("e.csv", "freq_hz,re_1_1,im_1_1\n10,0,1\n");
+    let other = rshape::data::read_frf_csv(&dir.path().join("e.csv")).unwrap();
+    let missing = resolve_noise(None, Some(&cfg), &other)
+        .unwrap_err()
+        .to_string();
+    assert!(missing.contains("e_coherence.csv"), "{missing}");
+    write("e_coherence.csv", "freq_hz,coh_1_1\n10,0.8\n");
+    let r = noise_radii(None, Some(&cfg), &other).unwrap().unwrap();
+    assert!((r[0] - 2.0 * 0.25).abs() <= 1e-15, "{r:?}");
+}
+
+/// Bad `[noise] coherence` input: every key validated, one message naming the key or the
+/// file and line.
+#[test]
+fn noise_coherence_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &str| std::fs::write(dir.path().join(name), body).unwrap();
+    write("d.csv", "freq_hz,re_1_1,im_1_1\n10,0.5,0\n20,0,2\n");
+    let base =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot.toml"))
+            .unwrap();
+    let with = |keys: &str| {
+        base.replace("data = \"robot.csv\"", "data = \"d.csv\"")
+            .replace("radius = 0.06", keys)
+    };
+    let cfg_path = dir.path().join("c.toml");
+    let parse_err = |keys: &str| {
+        Config::parse(&with(keys), &cfg_path)
+            .map(|_| ())
+            .expect_err(keys)
+            .to_string()
+    };
+    for (keys, needle) in [
+        ("coherence = \"coh.csv\"", "needs averages"),
+        ("coherence = \"coh.csv\"\naverages = 0", "averages = 0"),
+        ("coherence = \"coh.csv\"\naverages = -3", "averages = -3"),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\ncoverage = 0.0",
+            "coverage = 0",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\ncoverage = nan",
+            "coverage = NaN",
+        ),
+        ("averages = 2", "averages is only used with coherence"),
+        (
+            "radius = 0.1\ncoverage = 2.0",
+            "coverage is only used with coherence",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\nradius = 0.1",
+            "coherence or radius",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\nstd_file = \"s.csv\"",
+            "coherence or std_file",
+        ),
+        (
+            "coherence = \"coh.csv\"\naverages = 2\noutput_bound = 0.1",
+            "coherence or output_bound",
+        ),
+    ] {
+        let msg = parse_err(keys);
+        assert!(msg.contains(needle), "{keys}: {msg}");
+        assert!(!msg.contains('\n'), "{keys}: {msg}");
+    }
+    let data = rshape::data::read_frf_csv(&dir.path().join("d.csv")).unwrap();
+    let cfg = Config::parse(&with("coherence = \"coh.csv\"\naverages = 5"), &cfg_path).unwrap();
+    for (body, needle) in [
+        ("freq_hz,coh_1_1\n10,0.9\n20,1.2\n", "coh.csv:3:"),
+        ("freq_hz,coh_1_1\n10,0\n20,0.9\n", "coh.csv:2:"),
+        ("freq_hz,coh_1_1\n10,0.9\n20,-0.5\n", "coh.csv:3:"),
+        ("freq_hz,coh_1_1\n10,0.9\n20,abc\n", "coh.csv:3:"),
+        ("freq_hz,coh_1_1\n10,0.9\n21,0.9\n", "20 Hz"),
+        ("freq_hz,std_1_1\n10,0.9\n20,0.9\n", "coh_i_j"),
+        ("freq_hz,coh_2_1\n10,0.9\n20,0.9\n", "coh_1_1"),
+    ] {
+        write("coh.csv", body);
+        let msg = resolve_noise(None, Some(&cfg), &data)
+            .expect_err(body)
+            .to_string();
+        assert!(msg.contains("coh.csv"), "{body}: {msg}");
+        assert!(msg.contains(needle), "{body}: {msg}");
+        assert!(!msg.contains('\n'), "{body}: {msg}");
+    }
+}

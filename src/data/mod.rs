@@ -10,7 +10,8 @@
 //!   by [`check_channel`];
 //! * closed-loop files (Crowder & de Callafon eqs. (8)–(9)), a `Φ_cl` FRF or the spectra
 //!   `Y`, `R` ([`SPECTRA_COLUMNS`]): [`read_closed_loop_csv`], [`parse_closed_loop_csv`];
-//! * standard-deviation files, turned into noise radii: [`read_std_csv`] ([`StdData`]);
+//! * standard-deviation and coherence files, turned into noise radii: [`read_std_csv`],
+//!   [`read_coherence_csv`] ([`StdData`]) and [`h1_random_error`];
 //! * envelope CSV files (`omega_rad_s,r_min[,a1_limit]`, as `rshape envelope` writes them):
 //!   [`read_envelope_csv`], [`parse_envelope_csv`];
 //! * the CSV layer under all of them, every error naming file and line: [`TableReader`]
@@ -27,7 +28,7 @@ pub use closed_loop::{parse_closed_loop_csv, read_closed_loop_csv, SPECTRA_COLUM
 pub use envelope_csv::{parse_envelope_csv, read_envelope_csv};
 pub use frf::FrfData;
 pub use reader::{parse_frf_csv, read_frf_csv, Datum, FrfRows, MAX_CHANNEL};
-pub use std_file::{read_std_csv, StdData};
+pub use std_file::{h1_random_error, read_coherence_csv, read_std_csv, StdData};
 pub use table::{read_text, TableReader, MAX_RECORD_BYTES, MAX_RECORD_FIELDS};
 
 /// Checks that the config's `[channel]` (`(output, input)`, 1-based) names a channel of

@@ -31,7 +31,7 @@ impl Channels {
     pub fn from_siso(s: &Siso) -> Result<Self> {
         let radius = s.radius.clone().ok_or_else(|| {
             Error::Invalid(format!(
-                "{}: diagnose needs the noise radius: pass --noise-radius X, add a noise_radius column, or [noise] radius / std_file",
+                "{}: diagnose needs the noise radius: pass --noise-radius X, add a noise_radius column, or [noise] radius / std_file / coherence",
                 s.path.display()
             ))
         })?;

@@ -116,7 +116,7 @@ pub fn diagnose_channels(
     let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
-    let res = search(vec![configured, retuned_node], data, s)?;
+    let mut res = search(vec![configured, retuned_node], data, s)?;
     for p in &res.phases.0 {
         phases.add(p.phase, p.seconds, p.count);
     }
@@ -130,10 +130,19 @@ pub fn diagnose_channels(
     };
     let mut candidates = phases.time("first level", || ranked_candidates(&root, &res, data))?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
-    let mut node = res.nodes[res.chosen].clone();
-    let (holdout, dropped) = phases.time("holdout", || {
-        drop_failing_holdout(base, &mut node, &res.nodes, data)
+    // When the holdout drops part of the chosen set, the next-best sets are tried.
+    let super::holdout::Passing {
+        mut node,
+        holdout,
+        dropped,
+        replaced_by,
+    } = phases.time("holdout", || {
+        super::holdout::first_passing(&res.nodes, res.chosen, |n| {
+            drop_failing_holdout(base, n, &res.nodes, data)
+        })
     })?;
+    // Runner-ups and ties are then relative to the set kept.
+    res.chosen = replaced_by.unwrap_or(res.chosen);
     let eliminated = phases.time("backward elimination", || {
         super::backward::eliminate(base, &mut node, &res.nodes, data)
     })?;

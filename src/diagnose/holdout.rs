@@ -15,7 +15,89 @@ use super::rank::{EXTRAPOLATION_SPLIT, MIN_SPLIT_DATA};
 use super::report::Holdout;
 use super::retune::{cost, retune_within};
 use super::search::{add_effect, Node};
+use crate::error::Result;
 use crate::model::physical::PhysicalModel;
+
+/// How many next-best effect sets are tried when the holdout drops part of the chosen one.
+pub const MAX_ALTERNATIVES: usize = 3;
+
+/// The chosen set after the holdout, or a next-best set when the holdout drops part of it.
+#[derive(Debug, Clone)]
+pub struct Passing {
+    /// The node kept (its model refit without what the holdout dropped).
+    pub node: Node,
+    /// The holdout rows of the kept set.
+    pub holdout: Vec<Holdout>,
+    /// Labels the holdout dropped from the search's chosen set.
+    pub dropped: Vec<String>,
+    /// The index in the search's nodes of the set kept instead of the chosen one, when one
+    /// was (issue 20: a spurious chosen mode must not cost a whole step).
+    pub replaced_by: Option<usize>,
+}
+
+/// The next-best effect sets after `chosen`: the search's nodes with effects, by BIC, not
+/// the chosen set ([`same_set`]), one per set, at most `cap`.
+pub fn alternatives(nodes: &[Node], chosen: usize, cap: usize) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..nodes.len())
+        .filter(|i| *i != chosen && !nodes[*i].configured && !nodes[*i].effects.is_empty())
+        .filter(|i| !same_set(&nodes[*i].effects, &nodes[chosen].effects))
+        .collect();
+    order.sort_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic));
+    let mut out: Vec<usize> = Vec::new();
+    for i in order {
+        if !out
+            .iter()
+            .any(|o| same_set(&nodes[*o].effects, &nodes[i].effects))
+        {
+            out.push(i);
+        }
+    }
+    out.truncate(cap);
+    out
+}
+
+/// Runs the final holdout `check` (which drops failing effects from a node and returns its
+/// rows and the labels dropped) on the chosen node; when it drops something, tries the next
+/// [`MAX_ALTERNATIVES`] sets of [`alternatives`] in BIC order and keeps the first whose
+/// holdout drops nothing and that holds more effects than the reduced chosen set.  Without
+/// this a spurious chosen mode (one the data do not confirm on held-out lines) made
+/// `diagnose` report "no candidate passes" though a next-best set passed: a whole step lost.
+pub fn first_passing<F>(nodes: &[Node], chosen: usize, mut check: F) -> Result<Passing>
+where
+    F: FnMut(&mut Node) -> Result<(Vec<Holdout>, Vec<String>)>,
+{
+    let mut node = nodes[chosen].clone();
+    let (holdout, dropped) = check(&mut node)?;
+    if dropped.is_empty() {
+        return Ok(Passing {
+            node,
+            holdout,
+            dropped,
+            replaced_by: None,
+        });
+    }
+    for i in alternatives(nodes, chosen, MAX_ALTERNATIVES) {
+        if nodes[i].effects.len() <= node.effects.len() {
+            continue;
+        }
+        let mut alt = nodes[i].clone();
+        let (alt_holdout, alt_dropped) = check(&mut alt)?;
+        if alt_dropped.is_empty() {
+            return Ok(Passing {
+                node: alt,
+                holdout: alt_holdout,
+                dropped,
+                replaced_by: Some(i),
+            });
+        }
+    }
+    Ok(Passing {
+        node,
+        holdout,
+        dropped,
+        replaced_by: None,
+    })
+}
 
 /// The effects of a set with its `j`-th left out (the set the holdout and the backward
 /// elimination compare against).
@@ -129,4 +211,101 @@ pub fn holdouts(
             }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnose::problem::Measures;
+
+    /// A node holding one added mode at `f_hz` with BIC `bic`.
+    fn node(f_hz: f64, bic: f64) -> Node {
+        Node {
+            effects: vec![(Cand::Mode, vec![(std::f64::consts::TAU * f_hz).ln(), -7.0])],
+            model: PhysicalModel::default(),
+            measures: Measures {
+                v: bic,
+                misfit_rms: 2.0,
+                invalid_fraction: 0.5,
+            },
+            v_fit: bic,
+            n_params: 3,
+            bic,
+            steps: vec![],
+            configured: false,
+        }
+    }
+
+    fn f_of(n: &Node) -> f64 {
+        (n.effects[0].1[0].exp() / std::f64::consts::TAU).round()
+    }
+
+    /// The fake holdout: drops every effect of a node whose mode is not at a frequency in
+    /// `pass` (as `drop_failing_holdout` does), and records the nodes it saw.
+    fn check<'a>(
+        pass: &'a [f64],
+        seen: &'a mut Vec<f64>,
+    ) -> impl FnMut(&mut Node) -> Result<(Vec<Holdout>, Vec<String>)> + 'a {
+        move |n: &mut Node| {
+            let f = f_of(n);
+            seen.push(f);
+            let ok = pass.contains(&f);
+            let rows = vec![Holdout {
+                effect: "mode".into(),
+                interleaved_ok: ok,
+                extrapolation_ok: None,
+            }];
+            if ok {
+                Ok((rows, vec![]))
+            } else {
+                n.effects.clear();
+                Ok((rows, vec!["mode".into()]))
+            }
+        }
+    }
+
+    /// A chosen mode the holdout drops: the next sets are tried in BIC order (a duplicate of
+    /// the chosen set and the roots skipped) and the first that passes is kept.
+    #[test]
+    fn a_dropped_chosen_mode_gives_way_to_the_next_passing_set() {
+        let mut root = node(1.0, 50.0);
+        root.effects.clear();
+        root.configured = true;
+        let nodes = vec![
+            root,
+            node(824.0, 0.0),
+            node(1000.0, 1.0),
+            node(824.5, 1.5), // the chosen set again (within 1 % in frequency)
+            node(500.0, 2.0),
+            node(300.0, 3.0),
+        ];
+        let mut seen = Vec::new();
+        let p = first_passing(&nodes, 1, check(&[500.0, 300.0], &mut seen)).unwrap();
+        assert_eq!(p.replaced_by, Some(4));
+        assert_eq!(f_of(&p.node), 500.0);
+        assert_eq!(p.dropped, vec!["mode".to_string()]);
+        assert!(p.holdout.iter().all(|h| h.interleaved_ok));
+        assert_eq!(seen, vec![824.0, 1000.0, 500.0]);
+    }
+
+    /// At most [`MAX_ALTERNATIVES`] sets are tried; when none passes the chosen set stays,
+    /// reduced, and a chosen set that passes is kept without trying anything else.
+    #[test]
+    fn alternatives_are_capped_and_a_passing_chosen_set_is_kept() {
+        let nodes: Vec<Node> = [824.0, 1000.0, 700.0, 600.0, 500.0]
+            .iter()
+            .enumerate()
+            .map(|(k, f)| node(*f, k as f64))
+            .collect();
+        assert_eq!(alternatives(&nodes, 0, MAX_ALTERNATIVES), vec![1, 2, 3]);
+        let mut seen = Vec::new();
+        let p = first_passing(&nodes, 0, check(&[500.0], &mut seen)).unwrap();
+        assert_eq!(p.replaced_by, None);
+        assert!(p.node.effects.is_empty());
+        assert_eq!(seen, vec![824.0, 1000.0, 700.0, 600.0]);
+        let mut seen = Vec::new();
+        let p = first_passing(&nodes, 0, check(&[824.0, 500.0], &mut seen)).unwrap();
+        assert_eq!((p.replaced_by, p.dropped.len()), (None, 0));
+        assert_eq!(seen, vec![824.0]);
+    }
 }

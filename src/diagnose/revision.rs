@@ -131,6 +131,9 @@ pub fn write_revision(r: &Revise<'_>, out: &Path) -> Result<Revision> {
     if let Some(sf) = &raw.noise.std_file {
         raw.noise.std_file = Some(rel_to(&base_dir.join(sf), out_dir));
     }
+    if let Some(cf) = &raw.noise.coherence {
+        raw.noise.coherence = Some(rel_to(&base_dir.join(cf), out_dir));
+    }
     let text = toml::to_string_pretty(&raw).map_err(|e| {
         Error::Invalid(format!(
             "internal: the revised config does not serialize: {e}"

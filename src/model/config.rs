@@ -94,6 +94,10 @@ pub struct RSection {
 /// # or, per-frequency standard deviations (radius = std_factor·std):
 /// # std_file = "data_std.csv"
 /// # std_factor = 3.0
+/// # or, the coherence of an H1 estimate (radius = coverage·ε·|H|, Bendat & Piersol):
+/// # coherence = "frf_h1_coherence.csv"
+/// # averages = 5
+/// # coverage = 3.0
 /// ```
 #[derive(Debug, Clone, Default, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -117,6 +121,18 @@ pub struct NoiseSection {
     /// Factor from standard deviation to noise radius (default 3, i.e. 3σ).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub std_factor: Option<f64>,
+    /// A file of ordinary coherences γ² of an H1 estimate (`freq_hz` or `omega_rad_s`, then
+    /// `coh_i_j` columns), relative to the config; the radius of each datum is
+    /// `coverage·ε·|H|` with the random error `ε = √(1 − γ²)/(|γ|·√(2n))`
+    /// ([`crate::data::h1_random_error`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coherence: Option<PathBuf>,
+    /// The number of averages `n` of the H1 estimate (required with `coherence`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub averages: Option<i64>,
+    /// Coverage factor from the random error to the radius (default 3, i.e. 3σ).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<f64>,
 }
 
 /// The `[channel]` table: the SISO channel of MIMO data to compare with (1-based).
@@ -434,6 +450,47 @@ impl NoiseSection {
         }
         if self.std_file.is_some() && self.output_bound.is_some() {
             return Err("[noise]: give either std_file or output_bound (M), not both".into());
+        }
+        self.validate_coherence()
+    }
+
+    /// The coherence keys: `averages` an integer ≥ 1 and required, `coverage` finite and
+    /// positive, both only with `coherence`, which excludes the other sources.
+    fn validate_coherence(&self) -> std::result::Result<(), String> {
+        if self.coherence.is_none() {
+            return match (self.averages, self.coverage) {
+                (Some(_), _) => Err("[noise] averages is only used with coherence; add coherence = \"FILE.csv\" or remove it".into()),
+                (_, Some(_)) => Err("[noise] coverage is only used with coherence; add coherence = \"FILE.csv\" or remove it".into()),
+                _ => Ok(()),
+            };
+        }
+        let others = [
+            ("radius", self.radius.is_some()),
+            ("output_bound", self.output_bound.is_some()),
+            ("std_file", self.std_file.is_some()),
+        ];
+        if let Some((name, _)) = others.iter().find(|(_, given)| *given) {
+            return Err(format!(
+                "[noise]: give either coherence or {name}, not both"
+            ));
+        }
+        match self.averages {
+            None => {
+                return Err("[noise] coherence needs averages = n, the number of averages (hits) of the H1 estimate".into())
+            }
+            Some(n) if !(1..=i64::from(u32::MAX)).contains(&n) => {
+                return Err(format!(
+                    "[noise] averages = {n}: must be an integer ≥ 1 (the number of averages of the H1 estimate)"
+                ))
+            }
+            _ => {}
+        }
+        if let Some(k) = self.coverage {
+            if !(k.is_finite() && k > 0.0) {
+                return Err(format!(
+                    "[noise] coverage = {k}: must be a finite number > 0 (e.g. 3 for 3σ)"
+                ));
+            }
         }
         Ok(())
     }

@@ -2,7 +2,7 @@
 //! three sources and their precedence are in [`resolve_noise`]'s documentation.
 
 use super::Config;
-use crate::data::std_file::read_std_csv;
+use crate::data::std_file::{h1_random_error, read_coherence_csv, read_std_csv};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 
@@ -18,6 +18,8 @@ pub enum NoiseSource {
     ConfigOutputBound,
     /// `[noise] std_file` × `std_factor` in the config.
     ConfigStdFile,
+    /// `[noise] coherence` with `averages` and `coverage` in the config (H1 random error).
+    ConfigCoherence,
     /// The `noise_radius` column of the data file.
     DataColumn,
 }
@@ -129,6 +131,9 @@ pub fn noise_source(
         if cfg.noise_std.is_some() {
             return Some(NoiseSource::ConfigStdFile);
         }
+        if sec.coherence.is_some() {
+            return Some(NoiseSource::ConfigCoherence);
+        }
     }
     data_has_column.then_some(NoiseSource::DataColumn)
 }
@@ -158,17 +163,21 @@ pub fn is_noise_free(
 /// 1. a global radius `L_a`: the CLI flag `--noise-radius X`, or `[noise] radius = X`;
 /// 2. the time-domain `L∞` model of Sec. III, `[noise] output_bound = M`: every datum gets the
 ///    radius of the largest disk inside its uncertainty set `U` ([`linf_disk_radius`]);
-/// 3. per-frequency radii: `[noise] std_file` (radius `std_factor·std`, default 3σ) or a
-///    `noise_radius` column in the data file.
+/// 3. per-frequency radii: `[noise] std_file` (radius `std_factor·std`, default 3σ),
+///    `[noise] coherence` (the coherence γ² of an H1 estimate over `averages = n`
+///    averages: radius `coverage·ε·|H|`, `ε = √(1 − γ²)/(|γ|·√(2n))`, Bendat & Piersol,
+///    *Random Data*, Table 9.6; default coverage 3) or a `noise_radius` column in the data
+///    file.
 ///
-/// **Precedence**: CLI flag > config (`radius`, `output_bound` or
-/// `std_file`, which exclude each other) > data column.  When none is given there is no
+/// **Precedence**: CLI flag > config (`radius`, `output_bound`, `std_file` or
+/// `coherence`, which exclude each other) > data column.  When none is given there is no
 /// noise model (use the noise-free theorems).
 ///
 /// `data` must be the SISO data the envelope will use.  The config's `std_file` belongs to
 /// the config's own data file; for other data (`--data`), `<data stem>_std.csv` beside them
 /// is used, as `rshape compare` does.  Its column is `std_i_j` of the config's `[channel]`
-/// (default `std_1_1`).
+/// (default `std_1_1`); the same for `coherence` (`<data stem>_coherence.csv`, column
+/// `coh_i_j`).
 pub fn resolve_noise(
     cli_radius: Option<f64>,
     config: Option<&Config>,
@@ -229,6 +238,7 @@ pub fn resolve_noise_for_channel(
             }
         }
         (NoiseSource::ConfigStdFile, Some(cfg)) => std_file_noise(cfg, data, (out, inp))?,
+        (NoiseSource::ConfigCoherence, Some(cfg)) => coherence_noise(cfg, data, (out, inp))?,
         _ => {
             let col = data.noise_radius.clone().unwrap_or_default();
             if col.len() != data.len() {
@@ -259,35 +269,93 @@ fn std_file_noise(
     let Some((file, k)) = &cfg.noise_std else {
         return Err(Error::Invalid("no [noise] std_file in the config".into()));
     };
+    let file = file_for_data(cfg, data, file, "std", "std_file")?;
+    let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
+    Ok(ResolvedNoise {
+        description: format!("{k} × std_{out}_{inp} of {}", file.display()),
+        radii,
+        source: NoiseSource::ConfigStdFile,
+    })
+}
+
+/// The radii of a config's `[noise] coherence`: `coverage·ε·|H|` per datum, with the H1
+/// random error `ε` of [`h1_random_error`] (Bendat & Piersol, *Random Data*, Table 9.6).
+fn coherence_noise(
+    cfg: &Config,
+    data: &FrfData,
+    (out, inp): (usize, usize),
+) -> Result<ResolvedNoise> {
+    let sec = &cfg.raw.noise;
+    let (Some(file), Some(n)) = (&sec.coherence, sec.averages) else {
+        return Err(Error::Invalid(
+            "[noise] coherence needs averages = n".into(),
+        ));
+    };
+    let n = u32::try_from(n).unwrap_or(1);
+    let k = sec.coverage.unwrap_or(3.0);
+    let base = cfg.path.parent().unwrap_or(std::path::Path::new("."));
+    let file = file_for_data(cfg, data, &base.join(file), "coherence", "coherence")?;
+    let gamma2 = read_coherence_csv(&file)?.values_at(&file, "coh", &data.omega, out, inp)?;
+    // SISO data are the channel already; MIMO data hold it at (out, inp).
+    let at = if data.outputs() == 1 && data.inputs() == 1 {
+        (0, 0)
+    } else if (1..=data.outputs()).contains(&out) && (1..=data.inputs()).contains(&inp) {
+        (out - 1, inp - 1)
+    } else {
+        return Err(Error::Invalid(format!(
+            "{}: channel ({out}, {inp}) of [noise] coherence is not in the {}×{} data",
+            data.path.display(),
+            data.outputs(),
+            data.inputs()
+        )));
+    };
+    let radii = gamma2
+        .iter()
+        .zip(&data.response)
+        .map(|(&g2, h)| k * h1_random_error(g2, n) * h[at].norm())
+        .collect();
+    Ok(ResolvedNoise {
+        description: format!(
+            "{k} × ε·|H|, ε = √(1 − γ²)/(|γ|√(2·{n})) from coh_{out}_{inp} of {}",
+            file.display()
+        ),
+        radii,
+        source: NoiseSource::ConfigCoherence,
+    })
+}
+
+/// The file of a per-frequency noise source for `data`: the config's own `file` when the
+/// data are the config's data, else `<data stem>_<suffix>.csv` beside the data.
+fn file_for_data(
+    cfg: &Config,
+    data: &FrfData,
+    file: &std::path::Path,
+    suffix: &str,
+    key: &str,
+) -> Result<std::path::PathBuf> {
     let own = cfg.data.as_ref().is_some_and(|d| {
         d == &data.path
             || d.canonicalize()
                 .ok()
                 .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
     });
-    let file = if own {
-        file.clone()
+    Ok(if own {
+        file.to_path_buf()
     } else {
         let stem = data
             .path
             .file_stem()
             .map(|s| s.to_string_lossy().to_string())
             .unwrap_or_default();
-        let sib = data.path.with_file_name(format!("{stem}_std.csv"));
+        let sib = data.path.with_file_name(format!("{stem}_{suffix}.csv"));
         if !sib.exists() {
             return Err(Error::Invalid(format!(
-                "{}: the config's [noise] std_file belongs to its own data; put {} beside these data or pass --noise-radius",
+                "{}: the config's [noise] {key} belongs to its own data; put {} beside these data or pass --noise-radius",
                 data.path.display(),
                 sib.display()
             )));
         }
         sib
-    };
-    let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
-    Ok(ResolvedNoise {
-        description: format!("{k} × std_{out}_{inp} of {}", file.display()),
-        radii,
-        source: NoiseSource::ConfigStdFile,
     })
 }
 
@@ -342,5 +410,15 @@ mod tests {
         assert!(is_noise_free(None, Some(&zero), true));
         assert!(!is_noise_free(None, Some(&radius), false));
         assert!(!is_noise_free(None, Some(&bound), false));
+        let coherence = config("[noise]\ncoherence = \"coh.csv\"\naverages = 5");
+        assert_eq!(
+            noise_source(None, Some(&coherence), true),
+            Some(NoiseSource::ConfigCoherence)
+        );
+        assert_eq!(
+            noise_source(Some(0.1), Some(&coherence), true),
+            Some(NoiseSource::CliFlag)
+        );
+        assert!(!is_noise_free(None, Some(&coherence), false));
     }
 }
