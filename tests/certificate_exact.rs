@@ -10,8 +10,8 @@
 //!   times the bound (no false "failed" beyond that documented tolerance).
 use num_complex::Complex64;
 use proptest::prelude::*;
-use rshape::fit::certificate::{certify, CertInput};
 use rshape::fit::Zpk;
+use rshape::fit::{certify, CertInput};
 
 /// `|r(jω)|` by complex arithmetic on the roots (independent of `fit::between`).
 fn mag(r: &Zpk, w: f64) -> f64 {

@@ -4,7 +4,7 @@
 
 use rshape::consistency::{noise_free_envelope, noisy_envelope, BisectionSettings};
 use rshape::data::read_frf_csv;
-use rshape::diagnose::compare::{compare, prepare, PlantModel};
+use rshape::diagnose::{compare, prepare, PlantModel};
 use rshape::model::Config;
 use std::path::Path;
 

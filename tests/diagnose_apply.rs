@@ -4,7 +4,7 @@
 //! chosen set is friction + mode + delay.
 
 use rshape::data::read_frf_csv;
-use rshape::diagnose::compare::{compare, prepare, PlantModel};
+use rshape::diagnose::{compare, prepare, PlantModel};
 use rshape::model::Config;
 use serde_json::Value;
 use std::path::Path;

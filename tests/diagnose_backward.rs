@@ -5,11 +5,11 @@
 mod hidden;
 
 use hidden::{data, servo, SEEDS};
-use rshape::diagnose::backward::eliminate;
-use rshape::diagnose::candidates::{Cand, Sel};
-use rshape::diagnose::engine::ErrorMeasures;
-use rshape::diagnose::search::{add_effect, Node};
+use rshape::diagnose::eliminate;
+use rshape::diagnose::ErrorMeasures;
+use rshape::diagnose::{add_effect, Node};
 use rshape::diagnose::{retune_within, Channels};
+use rshape::diagnose::{Cand, Sel};
 
 fn node_with(effects: Vec<(Cand, Vec<f64>)>, ch: &Channels) -> Node {
     let (base, _) = servo();

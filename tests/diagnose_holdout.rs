@@ -4,11 +4,11 @@
 //! 810 Hz mode of an impact test passed with ΔBIC 5e6, then the holdout dropped it).
 
 use num_complex::Complex64;
-use rshape::diagnose::candidates::Cand;
-use rshape::diagnose::holdout::{model_of, same_set};
-use rshape::diagnose::problem::Measures;
-use rshape::diagnose::search::Node;
+use rshape::diagnose::Cand;
 use rshape::diagnose::Channels;
+use rshape::diagnose::ErrorMeasures as Measures;
+use rshape::diagnose::Node;
+use rshape::diagnose::{model_of, same_set};
 use rshape::model::physical::{Feedthrough, Gains, ModeSpec, PhysicalModel};
 
 const TAU: f64 = std::f64::consts::TAU;

@@ -6,7 +6,7 @@
 //! Table 9.6), and the radius is 3ε|H| (3σ, as `std_factor = 3` elsewhere).
 
 use num_complex::Complex64;
-use rshape::diagnose::retune::cost;
+use rshape::diagnose::cost;
 use rshape::diagnose::Diagnosis;
 use rshape::diagnose::{diagnose_channels, retune_within, Channels, SearchSettings};
 use rshape::model::physical::{

@@ -4,8 +4,8 @@
 //! a linear model cannot reach the noise on the motor bench.
 
 use rshape::data::read_frf_csv;
-use rshape::diagnose::agreement::data_vs_data;
-use rshape::diagnose::compare::{compare, prepare, PlantModel};
+use rshape::diagnose::data_vs_data;
+use rshape::diagnose::{compare, prepare, PlantModel};
 use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
 use rshape::model::Config;
 use std::path::Path;
@@ -201,10 +201,7 @@ fn motor_bench_experiments_disagree_beyond_their_noise() {
         let r = data_vs_data(&sa, &sb).unwrap();
         println!("{ch:?}: {r:?}");
         assert_eq!(r.n_common, 60);
-        assert_eq!(
-            r.verdict,
-            rshape::diagnose::agreement::AgreementVerdict::Disagree
-        );
+        assert_eq!(r.verdict, rshape::diagnose::AgreementVerdict::Disagree);
         assert!(r.disagree_fraction > 0.3 && r.distance_rms > 2.0, "{r:?}");
     }
 }

@@ -122,7 +122,7 @@ fn nothing_moves_on_the_right_model() {
         let d = diagnose(&base, &data(&base, &w, seed), 3).unwrap();
         assert!(d.retuned.moved.changes.is_empty(), "{:?}", d.retuned.moved);
         // Even refit (the changes of a forced retune on the true model): no parameter moves.
-        let ch = rshape::diagnose::changes::changes(
+        let ch = rshape::diagnose::changes(
             &base,
             &rshape::diagnose::retune(
                 &base,
@@ -152,7 +152,7 @@ fn sigma_matches_the_spread_over_noise_draws() {
         // Against a configuration far off, so that ζ₁ is always reported with its σ.
         let mut far = base.clone();
         far.mode[0].zeta = 0.03;
-        let c = rshape::diagnose::changes::changes(&far, &m, &ch);
+        let c = rshape::diagnose::changes(&far, &m, &ch);
         let x = c.changes.iter().find(|x| x.parameter == "mode[1].zeta");
         sg.push(x.expect("ζ₁ moved from 0.03").sigma);
     }

@@ -5,8 +5,8 @@
 //! lower the error on the independent experiment B too.
 
 use rshape::data::read_frf_csv;
-use rshape::diagnose::compare::{compare, misfit, prepare, PlantModel};
 use rshape::diagnose::{apply_candidate, diagnose};
+use rshape::diagnose::{compare, misfit, prepare, PlantModel};
 use rshape::model::Config;
 use std::path::Path;
 use std::process::Command;

@@ -7,8 +7,8 @@
 mod common;
 use common::{repo, rshape, stderr};
 use num_complex::Complex64;
-use rshape::diagnose::figures::{bode_svg, dense_grid, unwrap_deg, BodeData, ModelCurve};
-use rshape::diagnose::history_figure::revision_label;
+use rshape::diagnose::revision_label;
+use rshape::diagnose::{bode_svg, dense_grid, unwrap_deg, BodeData, ModelCurve};
 
 /// One `<text>` element: position, anchor, font size and content.
 #[derive(Debug)]

@@ -10,7 +10,7 @@
 //!   feedthrough cancels, the limit of any realization with `D ≠ 0`).
 use num_complex::Complex64;
 use rshape::consistency::{Envelope, EnvelopeMethod};
-use rshape::fit::realization::realize;
+use rshape::fit::realize;
 use rshape::fit::{fit_unit, FitSettings, Zpk};
 use rshape::system::logspace;
 

@@ -135,7 +135,7 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
         let (fit, rows) = fit_auto(env, a1, &set, 6).unwrap();
         println!(
             "{name} {objective:?}:\n{}",
-            rshape::fit::order::format_table(&rows, fit.order, set.auto_tolerance)
+            rshape::fit::format_table(&rows, fit.order, set.auto_tolerance)
         );
         for w in rows[1..].windows(2) {
             assert!(w[1].status == "ok" && w[0].status == "ok", "{:?}", w);

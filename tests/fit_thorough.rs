@@ -17,7 +17,7 @@
 mod common;
 
 use common::repo;
-use rshape::fit::order::OrderRow;
+use rshape::fit::OrderRow;
 use rshape::model::Controller;
 use rshape::{fit_auto, read_frf_csv, Config, FitResult, FitSettings};
 

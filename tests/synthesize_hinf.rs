@@ -16,8 +16,8 @@ use rand::{Rng, SeedableRng};
 use rshape::model::Factorization;
 use rshape::model::{Controller, Feedback};
 use rshape::stability::{analyze, Verdict};
-use rshape::synthesis::generalized_plant::{normalize, GeneralizedPlant};
-use rshape::synthesis::hinf_weighted::{gamma_test, weighted_plant, IterationStatus};
+use rshape::synthesis::{gamma_test, weighted_plant, IterationStatus};
+use rshape::synthesis::{normalize, GeneralizedPlant};
 use rshape::synthesis::{optimum, synthesize_weighted, WeightedSettings};
 use rshape::system::{
     eigenvalues, logspace, spectral_abscissa, NormalizedLcf, StateSpace, TransferFunction,
@@ -268,7 +268,7 @@ fn dynamic_r_optimum_matches_a_second_realization_and_the_controller_attains_it(
         }
         // The controller: proper (a finite state space), stabilizing, at its level.
         assert!(syn.k.d.iter().all(|v| v.is_finite()));
-        let cl = rshape::synthesis::glover_mcfarlane::closed_loop_matrix(&plant, &syn.k).unwrap();
+        let cl = rshape::synthesis::closed_loop_matrix(&plant, &syn.k).unwrap();
         let abscissa = spectral_abscissa(&eigenvalues(&cl, "cl").unwrap());
         assert!(
             abscissa < 0.0,

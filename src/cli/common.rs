@@ -244,6 +244,6 @@ pub fn fit_bound(
         Some(&progress),
     )?;
     view.finish();
-    let text = outcome.text + &crate::fit::run::work_line(&outcome.result, outcome.seconds);
+    let text = outcome.text + &crate::fit::work_line(&outcome.result, outcome.seconds);
     Ok((text, outcome.result.r))
 }

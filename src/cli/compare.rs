@@ -1,9 +1,9 @@
 //! `rshape compare CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--svg FILE] [--json]`.
 
 use super::common::{fmt_g, InputArgs};
-use crate::diagnose::agreement::{data_vs_data, AgreementVerdict};
-use crate::diagnose::compare::{compare, prepare, Band, CompareReport, CompareVerdict, PlantModel};
-use crate::diagnose::figures::{bode_overlay, dense_grid, BodeData, ModelCurve};
+use crate::diagnose::{bode_overlay, dense_grid, BodeData, ModelCurve};
+use crate::diagnose::{compare, prepare, Band, CompareReport, CompareVerdict, PlantModel};
+use crate::diagnose::{data_vs_data, AgreementVerdict};
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::path::PathBuf;

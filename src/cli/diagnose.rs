@@ -3,11 +3,11 @@
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
-use crate::diagnose::plant_form::physical_from_config;
-use crate::diagnose::revision::{params_text, write_revision, Apply, Revise};
+use crate::diagnose::physical_from_config;
 use crate::diagnose::{
     diagnose_channels, prepare, Channels, DiagnoseVerdict, Diagnosis, SearchSettings,
 };
+use crate::diagnose::{params_text, write_revision, Apply, Revise};
 use crate::report::fmt::{fmt_pct, sig};
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -356,7 +356,7 @@ fn print_alternatives(d: &Diagnosis) {
 }
 
 /// Where the time went (`--verbose`): the wall time of each phase of the search.
-fn print_phases(s: &crate::diagnose::engine::SearchStats) {
+fn print_phases(s: &crate::diagnose::SearchStats) {
     println!("\ntime per phase (wall clock):");
     println!("  {:<22} {:>9} {:>6} {:>7}", "phase", "s", "runs", "share");
     let total = s.seconds.max(1e-12);
@@ -382,7 +382,7 @@ fn print_phases(s: &crate::diagnose::engine::SearchStats) {
 }
 
 /// The configured parameters a refit moved, as a table (a common gain as one row).
-fn print_changes(c: &crate::diagnose::changes::Changes, what: &str) {
+fn print_changes(c: &crate::diagnose::Changes, what: &str) {
     if c.changes.is_empty() {
         return;
     }

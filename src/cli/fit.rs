@@ -5,7 +5,7 @@
 
 use super::common::InputArgs;
 use crate::data::read_envelope_csv;
-use crate::fit::run::{events_text, work_line};
+use crate::fit::{events_text, work_line};
 use crate::fit::{run_fit, FitSettings, Objective, OrderChoice};
 use anyhow::{anyhow, Result};
 use clap::{Args, ValueEnum};

@@ -4,7 +4,7 @@
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::{channel_arg, run_compare};
-use crate::diagnose::history_figure::{error_history, model_name, revision_label};
+use crate::diagnose::{error_history, model_name, revision_label};
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
@@ -47,7 +47,7 @@ pub struct Revision {
     /// `r_env_max`.
     pub r_env_max: Option<f64>,
     /// Verdict.
-    pub verdict: crate::diagnose::compare::CompareVerdict,
+    pub verdict: crate::diagnose::CompareVerdict,
 }
 
 /// Runs `rshape history`.

@@ -23,17 +23,12 @@ use super::candidates::sig;
 use super::changes::changes;
 use super::channels::Channels;
 use super::compare::Siso;
-pub use super::final_effects::final_effects;
+use super::final_effects::final_effects;
 use super::first_level::{ranked_candidates, Root};
 use super::holdout::{holdouts, model_of};
 use super::polish::settle;
-pub use super::problem::Measures as ErrorMeasures;
 use super::problem::{Measures, Problem};
-pub use super::rank::candidate_list;
-pub use super::report::{
-    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, PhaseTime,
-    Phases, Retuned, SearchStats, Tie,
-};
+use super::report::{DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats};
 use super::retune::retune_within;
 use super::search::{roots, search, Node, SearchResult, SearchSettings};
 use super::ties::{candidate_ties, set_ties};

@@ -21,39 +21,59 @@
 //! * [`engine`]: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
 //!   [`apply_candidate`]); [`report`]: what it reports; [`figures`]: Bode overlay of `compare`;
 //!   [`history_figure`]: the error after each revision (`history`).
-pub mod compare;
-pub mod figures;
+pub(crate) mod compare;
+pub(crate) mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
-pub mod agreement;
-pub mod backward;
-pub mod candidates;
-pub mod changes;
-pub mod channels;
-pub mod engine;
+pub(crate) mod agreement;
+pub(crate) mod backward;
+pub(crate) mod candidates;
+pub(crate) mod changes;
+pub(crate) mod channels;
+pub(crate) mod engine;
 mod explain;
-pub mod factor_form;
-pub mod final_effects;
+pub(crate) mod factor_form;
+pub(crate) mod final_effects;
 mod first_level;
-pub mod fit;
-pub mod history_figure;
-pub mod holdout;
-pub mod plant_form;
-pub mod polish;
-pub mod problem;
-pub mod rank;
-pub mod report;
-pub mod retune;
-pub mod revision;
-pub mod search;
+pub(crate) mod fit;
+pub(crate) mod history_figure;
+pub(crate) mod holdout;
+pub(crate) mod plant_form;
+pub(crate) mod polish;
+pub(crate) mod problem;
+pub(crate) mod rank;
+pub(crate) mod report;
+pub(crate) mod retune;
+pub(crate) mod revision;
+pub(crate) mod search;
 mod slots;
 mod starts;
-pub mod ties;
+pub(crate) mod ties;
 mod varpro;
 
+pub use agreement::{data_vs_data, AgreementVerdict, DataAgreement};
+pub use backward::eliminate;
+pub use candidates::{Cand, Sel, EFFECT_NAMES};
+pub use changes::{changes, Changes, CommonGain, ParamChange};
 pub use channels::{misfit_channels, Channels};
-pub use engine::{
-    apply_candidate, apply_chosen, diagnose, diagnose_channels, DiagnoseVerdict, Diagnosis,
+pub use compare::{misfit, Band, CompareRow, CompareVerdict};
+pub use engine::{apply_candidate, apply_chosen, diagnose, diagnose_channels};
+pub use factor_form::physical_from_factors;
+pub use figures::{
+    bode_overlay, bode_svg, dense_grid, unwrap_deg, BodeData, ModelCurve, FREQ_LABEL,
 };
+pub use final_effects::final_effects;
+pub use fit::{lm, LmResult};
+pub use history_figure::{error_history, history_svg, model_name, revision_label};
+pub use holdout::{model_of, same_set};
+pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSION_TOL};
+pub use problem::Measures as ErrorMeasures;
+pub use rank::candidate_list;
+pub use report::{
+    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, PhaseTime,
+    Phases, Retuned, SearchStats, Step, Tie,
+};
+pub use retune::cost;
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
-pub use search::SearchSettings;
+pub use revision::{params_text, write_revision, Apply, Revise, Revision};
+pub use search::{add_effect, Node, SearchSettings};

@@ -75,6 +75,7 @@ pub fn basis_row(q: &[f64], x: f64) -> Vec<f64> {
 }
 
 /// Value of `c₀ + Σ c_k q_k²/(x+q_k²)` at `x`.
+#[cfg(test)]
 pub fn basis_eval(q: &[f64], c: &[f64], x: f64) -> f64 {
     basis_row(q, x).iter().zip(c).map(|(a, b)| a * b).sum()
 }

@@ -23,35 +23,37 @@
 //! Comparisons are written `!(x > y)` on purpose throughout: a NaN must fail a check.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod basis;
-pub mod between;
-pub mod certificate;
+pub(crate) mod basis;
+pub(crate) mod between;
+pub(crate) mod certificate;
 pub(crate) mod chebseries;
 mod context;
 pub(crate) mod engine;
 mod levelsearch;
-pub mod order;
+pub(crate) mod order;
 pub(crate) mod polyfit;
 mod polylevel;
 mod polyrows;
-pub mod problem;
-pub mod provenance;
-pub mod realization;
-pub mod run;
+pub(crate) mod problem;
+pub(crate) mod provenance;
+pub(crate) mod realization;
+pub(crate) mod run;
 mod settings_check;
-pub mod spectral;
+pub(crate) mod spectral;
 
-pub use certificate::Certificate;
+pub use basis::Scaling;
+pub use certificate::{certify, CertInput, Certificate};
+pub use order::format_table;
 pub use order::{fit_auto, fit_auto_observed, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
 pub use provenance::{EventKind, Origin, PoleSet};
-pub use run::{run_fit, FitOutcome, OrderChoice};
+pub use realization::realize;
+pub use run::{events_text, run_fit, work_line, FitOutcome, OrderChoice, RunError};
 pub use settings_check::MAX_ORDER;
 pub use spectral::Zpk;
 
 use crate::consistency::Envelope;
 use crate::system::TransferFunction;
-use basis::Scaling;
 use context::{prepare, Context};
 use engine::{fit_order, Scored};
 use num_complex::Complex64;

@@ -12,13 +12,13 @@
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
-pub mod batch;
-pub mod bode;
-pub mod mu;
-pub mod r_vs_delta;
-pub mod stability;
-pub mod style;
-pub mod symbols;
+pub(crate) mod batch;
+pub(crate) mod bode;
+pub(crate) mod mu;
+pub(crate) mod r_vs_delta;
+pub(crate) mod stability;
+pub(crate) mod style;
+pub(crate) mod symbols;
 
 pub use batch::{batch_svg, BatchFigureInput};
 pub use bode::{bode_svg, BodeInput};

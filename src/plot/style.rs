@@ -152,16 +152,6 @@ impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
             }));
     }
 
-    /// Number of entries.
-    pub fn len(&self) -> usize {
-        self.entries.len()
-    }
-
-    /// True without entries.
-    pub fn is_empty(&self) -> bool {
-        self.entries.is_empty()
-    }
-
     /// Draws the legend in `area` (the strip below the plot), aligned with the plot's left
     /// edge.
     pub fn draw(self, area: &'a DrawingArea<DB, plotters::coord::Shift>) -> Result<()> {
@@ -371,19 +361,6 @@ pub fn draw_x_labels<DB: DrawingBackend>(
             .map_err(plot_err)?;
     }
     Ok(())
-}
-
-/// Extends a log range downwards so that the bottom `frac` of the plot (in log space) is
-/// free for a legend of the lower-left corner: the data never hide behind it.
-pub fn reserve_bottom(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
-    let frac = frac.clamp(0.0, 0.6);
-    let span = (hi / lo).log10();
-    (lo / 10f64.powf(span * frac / (1.0 - frac)), hi)
-}
-
-/// Fraction of a plot of `height` pixels taken by a legend of `rows` entries.
-pub fn legend_fraction(rows: usize, height: u32) -> f64 {
-    (rows as f64 * 19.0 + 24.0) / height as f64
 }
 
 /// A chart with logarithmic axes on both sides.

@@ -3,12 +3,19 @@
 //! a plant shaped by loop-shaping weights ([`weights`]), and the H∞ optimum for a
 //! frequency-dependent `r` ([`hinf_weighted`] on the [`generalized_plant`]). The result is
 //! always re-proved by the Theorem 1 test ([`crate::stability`]) before it is reported.
-pub mod generalized_plant;
-pub mod glover_mcfarlane;
-pub mod hinf_weighted;
-pub mod merit;
-pub mod weights;
+pub(crate) mod generalized_plant;
+pub(crate) mod glover_mcfarlane;
+pub(crate) mod hinf_weighted;
+pub(crate) mod merit;
+pub(crate) mod weights;
 
-pub use glover_mcfarlane::{central_controller, optimum, synthesize, GmController, GmOptimum};
-pub use hinf_weighted::{synthesize_weighted, WeightedController, WeightedSettings};
+pub use generalized_plant::{normalize, GeneralizedPlant, NormalizedPlant};
+pub use glover_mcfarlane::{
+    central_controller, closed_loop_matrix, optimum, synthesize, GmController, GmOptimum,
+};
+pub use hinf_weighted::{
+    gamma_test, synthesize_weighted, weighted_plant, GammaFailure, GammaSolution, GammaStep,
+    IterationStatus, WeightedController, WeightedSettings,
+};
+pub use merit::Merit;
 pub use weights::Weights;
