@@ -50,11 +50,11 @@ impl Sel {
 /// A candidate effect.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Cand {
-    /// Pure delay `e^{−sτ}`; θ = [τ] (s, |τ| used).
+    /// Pure delay `e^{−sτ}`; θ = \[τ\] (s, |τ| used).
     Delay(Sel),
     /// First-order lag; θ = [ln ω_c].
     Lag(Sel),
-    /// Gain; θ = [k].
+    /// Gain; θ = \[k\].
     Gain(Sel),
     /// Sign flip; no parameter.
     Sign(Sel),

@@ -116,7 +116,7 @@ pub const SAME_MODE_LN: f64 = 0.01;
 
 /// True when `a` and `b` hold the same effects in any order: each effect of `a` pairs with
 /// an equal candidate of `b`, and an added mode only with a mode at the same frequency
-/// (within [`SAME_MODE_LN`]).  Labels alone do not tell two added modes apart: a set
+/// (within `SAME_MODE_LN`).  Labels alone do not tell two added modes apart: a set
 /// `{mode 900 Hz}` must not be taken for `{mode 810 Hz}` (issue 20 item 3).
 pub fn same_set(a: &[(Cand, Vec<f64>)], b: &[(Cand, Vec<f64>)]) -> bool {
     if a.len() != b.len() {

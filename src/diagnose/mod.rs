@@ -3,24 +3,24 @@
 //! catalogue `docs/design/effects.md`.
 //!
 //! What is here, in the order of a `diagnose` run:
-//! * [`channels`]: the data channels, each with its noise radius and model entry;
-//!   [`plant_form`], [`factor_form`]: `[plant]` and factor-form configs converted to
+//! * `channels`: the data channels, each with its noise radius and model entry;
+//!   `plant_form`, `factor_form`: `[plant]` and factor-form configs converted to
 //!   `[physical]`;
-//! * [`compare`]: per-frequency misfit normalized by the noise radius, failing bands, error
-//!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); [`agreement`]: two data sets
+//! * `compare`: per-frequency misfit normalized by the noise radius, failing bands, error
+//!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); `agreement`: two data sets
 //!   against each other;
-//! * [`problem`]: the least-squares problem (base model, candidate effects, cost `V`);
-//!   [`fit`]: Levenberg–Marquardt; `slots` (private): the parameters `retune` refits;
-//! * [`retune`]: the joint refit of the configured model's own parameters;
-//! * [`candidates`]: the catalogue of effects and how each modifies the model (`explain`,
+//! * `problem`: the least-squares problem (base model, candidate effects, cost `V`);
+//!   `fit`: Levenberg–Marquardt; `slots` (private): the parameters `retune` refits;
+//! * `retune`: the joint refit of the configured model's own parameters;
+//! * `candidates`: the catalogue of effects and how each modifies the model (`explain`,
 //!   private: what each means in the data); `starts`
-//!   (private): their starting points; [`rank`]: screening and physical plausibility;
-//! * [`search`]: the beam search over effect sets with joint refits; [`polish`]: the
-//!   consistency polish; [`ties`]: sets the data cannot tell apart; [`holdout`]: the
+//!   (private): their starting points; `rank`: screening and physical plausibility;
+//! * `search`: the beam search over effect sets with joint refits; `polish`: the
+//!   consistency polish; `ties`: sets the data cannot tell apart; `holdout`: the
 //!   final set checked on held-out data;
-//! * [`engine`]: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
-//!   [`apply_candidate`]); [`report`]: what it reports; [`figures`]: Bode overlay of `compare`;
-//!   [`history_figure`]: the error after each revision (`history`).
+//! * `engine`: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
+//!   [`apply_candidate`]); `report`: what it reports; `figures`: Bode overlay of `compare`;
+//!   `history_figure`: the error after each revision (`history`).
 pub(crate) mod compare;
 pub(crate) mod figures;
 

@@ -46,7 +46,7 @@ pub struct CandidateReport {
     /// True when the numbers are after the joint refit of every parameter.
     pub joint_refit: bool,
     /// Passes: ΔBIC > 10 against the retuned model (the configured one for the retune),
-    /// no more invalid data or `misfit_rms` down to 90 % ([`super::rank::improves`]),
+    /// no more invalid data or `misfit_rms` down to 90 % (`rank::improves`),
     /// physically plausible (no flags).
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
@@ -70,7 +70,7 @@ pub struct CandidateReport {
 impl CandidateReport {
     /// Why the tool rejected this candidate (`None` when it passes): no fit, a plausibility
     /// flag, too small a ΔBIC, or more invalid data than the retune alone without a clear fall
-    /// of `misfit_rms` ([`super::rank::improves`]).
+    /// of `misfit_rms` (`rank::improves`).
     pub fn rejection(&self) -> Option<String> {
         if self.passes {
             return None;

@@ -32,7 +32,7 @@ pub struct Certificate {
     /// Where it is.
     pub worst_between_omega: f64,
     /// Proved lower bound of `|r|/min(r_min,i, r_min,i+1)` over every interval between
-    /// consecutive data (must be ≥ (1 + margin)·(1 − 1e-9)); see [`super::between`].
+    /// consecutive data (must be ≥ (1 + margin)·(1 − 1e-9)); see `fit::between`.
     pub between_lower_bound: f64,
     /// How the between-data bound was established.
     pub between_method: String,

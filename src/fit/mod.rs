@@ -5,16 +5,16 @@
 //! consistent; GitHub issue 4).
 //!
 //! Pipeline, one concept per file:
-//! * [`basis`]: prescaling, a partial-fraction basis for `|r|² = A(ω²)/B(ω²)`, the grids;
-//! * [`problem`]: the Clarabel LPs (minimax step with free poles, area step with fixed poles);
-//! * [`spectral`]: spectral factorization, roots on the axis reported as errors;
-//! * [`engine`]: one order — candidates, failures recorded and skipped;
-//! * [`between`]: the no-dip rule between data, proved by interval branch-and-bound;
-//! * [`context`]: input checks, prescaling, and the choice among certified candidates;
-//! * [`certificate`]: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
-//! * [`realization`]: a balanced cascade state-space realization of `r` for the exports;
-//! * [`order`]: the order sweep and the automatic order choice;
-//! * [`run`]: fit + certificate + exports, for the CLI;
+//! * `basis`: prescaling, a partial-fraction basis for `|r|² = A(ω²)/B(ω²)`, the grids;
+//! * `problem`: the Clarabel LPs (minimax step with free poles, area step with fixed poles);
+//! * `spectral`: spectral factorization, roots on the axis reported as errors;
+//! * `engine`: one order — candidates, failures recorded and skipped;
+//! * `between`: the no-dip rule between data, proved by interval branch-and-bound;
+//! * `context`: input checks, prescaling, and the choice among certified candidates;
+//! * `certificate`: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
+//! * `realization`: a balanced cascade state-space realization of `r` for the exports;
+//! * `order`: the order sweep and the automatic order choice;
+//! * `run`: fit + certificate + exports, for the CLI;
 //! * private: `levelsearch` (the minimax level search of one order in the partial-fraction
 //!   basis), `polyfit` with `polyrows` and `chebseries` (the second parametrization: the full
 //!   numerator and denominator of `|r̂|²` as Chebyshev series in the disk variable, with an

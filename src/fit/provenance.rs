@@ -27,7 +27,7 @@ impl fmt::Display for PoleSet {
     }
 }
 
-/// Which candidate a fit is (see [`super::engine`] for the candidates of one order).
+/// Which candidate a fit is (see `fit::engine` for the candidates of one order).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum Origin {
@@ -48,7 +48,7 @@ pub enum Origin {
     },
     /// The constant `r` at the largest lower bound (feasible at every order).
     Constant,
-    /// The global minimax over the full numerator and denominator ([`super::polyfit`]).
+    /// The global minimax over the full numerator and denominator (`fit::polyfit`).
     PolynomialMinimax {
         /// The level reached.
         t: f64,

@@ -3,12 +3,12 @@
 //!
 //! Each function takes plain data and returns the SVG document as a `String`; the caller
 //! writes it (atomically).  The figures are the analogues of the paper's:
-//! - [`r_vs_delta`]: Fig. 3 and Fig. 8 side by side in spirit: `|r(jω)|` against the
+//! - `r_vs_delta`: Fig. 3 and Fig. 8 side by side in spirit: `|r(jω)|` against the
 //!   per-datum smallest consistent `|r|` (`‖Δᵢ‖` of eq. (8), or the Theorem 4 bisection);
-//! - [`bode`]: the data (with noise-disk error bars, eq. (5)) against the nominal model,
+//! - `bode`: the data (with noise-disk error bars, eq. (5)) against the nominal model,
 //!   as in Fig. 7;
-//! - [`mu`]: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
-//! - [`batch`]: every dataset's envelope, the combined envelope and the one fitted `r`.
+//! - `mu`: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
+//! - `batch`: every dataset's envelope, the combined envelope and the one fitted `r`.
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).

@@ -153,7 +153,7 @@ impl GeneralizedPlant {
 /// A plant in the normalized form `D₁₂ = [0; I]`, `D₂₁ = I` (ZDG §17.2): `z̃ = Uᵀz`
 /// (orthogonal, so norms are kept), `u = S_u·ũ`, `ỹ = S_y·y`. A controller `K̃` of the
 /// normalized plant (`ũ = K̃·ỹ`) is `K = S_u·K̃·S_y` for the original one; `D₂₂` is kept for
-/// the loop shifting of [`super::hinf_weighted`].
+/// the loop shifting of `synthesis::hinf_weighted`.
 #[derive(Debug, Clone)]
 pub struct NormalizedPlant {
     /// The normalized plant (its `d22` is `S_y·D₂₂·S_u`).

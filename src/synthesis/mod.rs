@@ -1,7 +1,7 @@
 //! Controller synthesis for the perturbed coprime-factor model of Theorem 1: the
-//! Glover–McFarlane optimum for a constant bound `r` ([`glover_mcfarlane`]), optionally on
-//! a plant shaped by loop-shaping weights ([`weights`]), and the H∞ optimum for a
-//! frequency-dependent `r` ([`hinf_weighted`] on the [`generalized_plant`]). The result is
+//! Glover–McFarlane optimum for a constant bound `r` (`glover_mcfarlane`), optionally on
+//! a plant shaped by loop-shaping weights (`weights`), and the H∞ optimum for a
+//! frequency-dependent `r` (`hinf_weighted` on the `generalized_plant`). The result is
 //! always re-proved by the Theorem 1 test ([`crate::stability`]) before it is reported.
 pub(crate) mod generalized_plant;
 pub(crate) mod glover_mcfarlane;
