@@ -229,32 +229,29 @@ pub fn history_svg(
             )
         };
         let lim = |c: RGBColor| ShapeStyle::from(&c.mix(0.8)).stroke_width(1);
-        a.draw_series(DashedLineSeries::new(
-            vec![(xr.start, 1.0), (xr.end, 1.0)],
-            8,
-            5,
-            lim(C_RED),
-        ))
-        .map_err(plot_err)?;
-        a.draw_series(std::iter::once(Text::new(
-            "within the noise below this line (misfit_rms = 1)",
-            (xr.start + 0.02, 1.0),
-            above(),
-        )))
-        .map_err(plot_err)?;
-        b.draw_series(DashedLineSeries::new(
-            vec![(xr.start, 5.0), (xr.end, 5.0)],
-            8,
-            5,
-            lim(C_RED),
-        ))
-        .map_err(plot_err)?;
-        b.draw_series(std::iter::once(Text::new(
-            "consistent below 5 %",
-            (xr.start + 0.02, 5.0),
-            above(),
-        )))
-        .map_err(plot_err)?;
+        // A dashed reference level with its note just above it, on either panel (a macro:
+        // the two panels' chart types differ in their y coordinate).
+        macro_rules! reference {
+            ($area:expr, $y:expr, $note:expr) => {
+                $area
+                    .draw_series(DashedLineSeries::new(
+                        vec![(xr.start, $y), (xr.end, $y)],
+                        8,
+                        5,
+                        lim(C_RED),
+                    ))
+                    .map_err(plot_err)?;
+                $area
+                    .draw_series(std::iter::once(Text::new(
+                        $note,
+                        (xr.start + 0.02, $y),
+                        above(),
+                    )))
+                    .map_err(plot_err)?;
+            };
+        }
+        reference!(a, 1.0, "within the noise below this line (misfit_rms = 1)");
+        reference!(b, 5.0, "consistent below 5 %");
         let pts = |v: &[f64], scale: f64| -> Vec<(f64, f64)> {
             v.iter()
                 .enumerate()

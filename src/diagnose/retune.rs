@@ -25,7 +25,8 @@
 use super::channels::Channels;
 use super::fit::lm_box_jac;
 use super::slots::{
-    anchor_value, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl, MODE_BOX,
+    anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
+    MODE_BOX,
 };
 use super::varpro::VarPro;
 use crate::model::physical::PhysicalModel;
@@ -74,11 +75,7 @@ pub(super) fn solve_linear_res(
         if cols.is_empty() {
             continue;
         }
-        let rows: Vec<usize> = chs
-            .iter()
-            .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
-            .collect();
-        let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+        let (rows, ab) = block_matrix(&a, &chs, &cols, rows_per_ch);
         let yb = DVector::from_fn(rows.len(), |i, _| y[rows[i]]);
         for (j, xj) in cols.iter().zip(qr_solve(ab, yb).iter()) {
             x[*j] = *xj;

@@ -333,6 +333,23 @@ pub(super) fn get_lin(m: &PhysicalModel, s: Lin) -> f64 {
     }
 }
 
+/// The rows of the design matrix `a` that belong to channels `chs` (each channel owns
+/// `rows_per_ch` consecutive rows) and the sub-matrix of those rows and columns `cols`: one
+/// block of the block-diagonal least-squares problem of [`blocks`].
+pub(super) fn block_matrix(
+    a: &DMatrix<f64>,
+    chs: &[usize],
+    cols: &[usize],
+    rows_per_ch: usize,
+) -> (Vec<usize>, DMatrix<f64>) {
+    let rows: Vec<usize> = chs
+        .iter()
+        .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
+        .collect();
+    let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+    (rows, ab)
+}
+
 /// The independent blocks of the linear least squares: groups of channels that share no
 /// linear slot with the other groups (an output gain acts on the channels of its output, a
 /// feedthrough on one channel), each with the slots acting on it.  With one input every

@@ -21,7 +21,7 @@
 //! the forward-difference Jacobian of the whole residual.
 
 use super::channels::Channels;
-use super::slots::{blocks, design, gains_of, set_nl, Lin, Nl, Term};
+use super::slots::{block_matrix, blocks, design, gains_of, set_nl, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -82,11 +82,7 @@ fn factor(
         if cols.is_empty() {
             continue;
         }
-        let rows: Vec<usize> = chs
-            .iter()
-            .flat_map(|ch| ch * rows_per_ch..(ch + 1) * rows_per_ch)
-            .collect();
-        let ab = DMatrix::from_fn(rows.len(), cols.len(), |i, j| a[(rows[i], cols[j])]);
+        let (rows, ab) = block_matrix(a, &chs, &cols, rows_per_ch);
         let (q, r, scale) = factor_block(ab)?;
         out.push(Block {
             rows,
