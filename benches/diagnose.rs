@@ -10,9 +10,16 @@
 //! * `siso_step_1200`: one step on one channel of the same beam, 1200 lines, three modes in
 //!   the model and a fourth in the data.
 //!
+//! * `complete_discovery_1000x3`: the same beam (1000 lines × 3 channels, six modes in the
+//!   data), from a model with a rigid body and the mass line only, `diagnose` then
+//!   `apply_chosen` repeated (default settings: up to three effects a step) until nothing
+//!   more is chosen or six steps ran; the six modes must be found.
+//!
 //! Run: `cargo bench --bench diagnose -- --sample-count 3`.
 use num_complex::Complex64;
-use rshape::diagnose::{diagnose_channels, Channels, SearchSettings};
+use rshape::diagnose::{
+    apply_chosen, diagnose_channels, Channels, DiagnoseVerdict, SearchSettings,
+};
 use rshape::model::physical::{
     EffectKind, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
@@ -222,5 +229,56 @@ fn siso_step_1200(bencher: divan::Bencher) {
             },
         )
         .unwrap()
+    });
+}
+
+/// `diagnose` and `apply_chosen` repeated from `base`, at most `max_steps` times: the final
+/// model and the number of steps.
+fn discover(base: &PhysicalModel, data: &Channels, max_steps: usize) -> (PhysicalModel, usize) {
+    let mut model = base.clone();
+    for step in 0..max_steps {
+        let d = diagnose_channels(&model, data, &SearchSettings::default()).unwrap();
+        if d.verdict != DiagnoseVerdict::EffectsFound {
+            return (model, step);
+        }
+        model = apply_chosen(&d).unwrap();
+    }
+    (model, max_steps)
+}
+
+#[divan::bench(sample_count = 3)]
+fn complete_discovery_1000x3(bencher: divan::Bencher) {
+    let (_, data) = beam(3, 1000, &[], &[0, 1, 2, 3, 4, 5]);
+    // A rigid body and the mass line: nothing of the six modes.
+    let base = PhysicalModel {
+        rigid_body: vec![PoleAtZeroSpec {
+            friction_pole: None,
+            name: None,
+            mass: 1.0,
+            input_gain: Gains::Vector(vec![1.0, 0.7, 0.6]),
+            output_gain: Gains::Scalar(1.0),
+        }],
+        feedthrough: Some(Feedthrough::Matrix(vec![vec![0.1, 0.07, 0.06]])),
+        ..Default::default()
+    };
+    bencher.bench(|| {
+        let (model, _steps) = discover(&base, &data, 6);
+        // Every beam mode found within 0.5 %.
+        for (f, _, _) in BEAM {
+            let w = std::f64::consts::TAU * f;
+            assert!(
+                model
+                    .mode
+                    .iter()
+                    .any(|m| (m.omega_n / w - 1.0).abs() < 5e-3),
+                "{f} Hz not found: {:?}",
+                model
+                    .mode
+                    .iter()
+                    .map(|m| m.omega_n / std::f64::consts::TAU)
+                    .collect::<Vec<_>>()
+            );
+        }
+        model
     });
 }

@@ -14,7 +14,8 @@
 //! * `retune`: the joint refit of the configured model's own parameters;
 //! * `candidates`: the catalogue of effects and how each modifies the model (`explain`,
 //!   private: what each means in the data); `starts`
-//!   (private): their starting points; `rank`: screening and physical plausibility;
+//!   (private): their starting points (`lscf`, private: mode proposals from the residual by
+//!   an LSCF stabilization diagram); `rank`: screening and physical plausibility;
 //! * `search`: the beam search over effect sets with joint refits; `polish`: the
 //!   consistency polish; `ties`: sets the data cannot tell apart; `holdout`: the
 //!   final set checked on held-out data;
@@ -38,6 +39,7 @@ mod first_level;
 pub(crate) mod fit;
 pub(crate) mod history_figure;
 pub(crate) mod holdout;
+pub(crate) mod lscf;
 pub(crate) mod plant_form;
 pub(crate) mod polish;
 pub(crate) mod problem;

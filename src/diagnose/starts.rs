@@ -1,6 +1,7 @@
 //! Starting points of each candidate's new parameters: closed-form estimates (linear least
 //! squares on the residual, one residue per channel), the best points of a 1-D grid, and for
-//! an added mode the peaks of the noise-normalized misfit (docs/design/effects.md, step 3).
+//! an added mode the peaks of the noise-normalized misfit (docs/design/effects.md, step 3)
+//! and the poles of the residual an LSCF stabilization diagram proposes ([`super::lscf`]).
 
 use super::candidates::{Cand, Sel};
 use super::problem::{Mods, Problem};
@@ -31,12 +32,9 @@ impl Problem<'_> {
                 0.0
             }
         };
-        // Best few points of a 1-D grid of the new parameter.
-        let grid_best = |grid: &[f64], keep: usize| -> Vec<Vec<f64>> {
-            let mut vs: Vec<(f64, f64)> = grid
-                .iter()
-                .map(|x| (self.v(&cur.with(c, &[*x]), mask), *x))
-                .collect();
+        // Best few points of a 1-D grid of the new parameter: the grid's local minima by
+        // cost, then the rest by cost.
+        let pick = |mut vs: Vec<(f64, f64)>, keep: usize| -> Vec<Vec<f64>> {
             let mut local: Vec<(f64, f64)> = (0..vs.len())
                 .filter(|&i| {
                     (i == 0 || vs[i].0 <= vs[i - 1].0)
@@ -52,6 +50,13 @@ impl Problem<'_> {
                 .take(keep)
                 .map(|(_, x)| vec![x])
                 .collect()
+        };
+        let grid_best = |grid: &[f64], keep: usize| -> Vec<Vec<f64>> {
+            let vs = grid
+                .iter()
+                .map(|x| (self.v(&cur.with(c, &[*x]), mask), *x))
+                .collect();
+            pick(vs, keep)
         };
         let log_grid = |lo: f64, hi: f64, n: usize| -> Vec<f64> {
             (0..n)
@@ -70,12 +75,10 @@ impl Problem<'_> {
         match c {
             Cand::Sign(_) => vec![vec![]],
             Cand::Gain(sel) => vec![vec![1.0 + ls(&sel_chans(sel), &|ch, k| gm[ch][k])]],
-            Cand::Delay(_) => {
+            Cand::Delay(sel) => {
                 let step = 0.05 / wmax;
-                let grid: Vec<f64> = (0..=((6.0 * std::f64::consts::PI / 0.05) as usize))
-                    .map(|j| (j as f64 + 0.5) * step)
-                    .collect();
-                grid_best(&grid, 3)
+                let n = (6.0 * std::f64::consts::PI / 0.05) as usize + 1;
+                pick(self.delay_grid(&gm, sel, mask, step, n), 3)
             }
             Cand::Lag(_) | Cand::NmpZero(_) => grid_best(&log_grid(wmin / 3.0, wmax * 30.0, 40), 3),
             Cand::Zoh(_) => grid_best(&log_grid(0.01 / wmax, 3.0 / wmax, 40), 3),
@@ -95,8 +98,8 @@ impl Problem<'_> {
             Cand::Damping(_) => grid_best(&log_grid(1e-3, 0.7, 30), 3),
             Cand::Friction(_) => grid_best(&log_grid(wmin / 1000.0, wmax, 40), 3),
             Cand::Mode => {
-                // ω_n candidates: local maxima of the worst channel's |e|/r, plus a log grid
-                // over the band; residues by LS per channel.
+                // ω_n candidates: local maxima of the worst channel's |e|/r (five dampings
+                // each), plus the LSCF proposals; residues by LS per channel.
                 let (cw, _) = self.invalid_flags(cur);
                 let f = self.f();
                 let mut peaks: Vec<(f64, f64)> = (0..f)
@@ -106,23 +109,112 @@ impl Problem<'_> {
                     .map(|k| (cw[k], om[k]))
                     .collect();
                 peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
-                let mut ws: Vec<f64> = peaks.iter().take(4).map(|p| p.1).collect();
-                ws.extend(log_grid(wmin, wmax, 30).iter().map(|x| x.exp()));
+                let zetas = [0.005, 0.02, 0.06, 0.2, 0.5];
+                let mut points: Vec<(f64, f64)> = peaks
+                    .iter()
+                    .take(4)
+                    .flat_map(|p| zetas.map(|z| (p.1, z)))
+                    .collect();
+                // The poles of the residual stable across the orders of an LSCF diagram
+                // (`super::lscf`), at their own damping; the log grid over the band only
+                // when the diagram has none.
+                let proposals = self.mode_proposals(&gm, mask);
+                if proposals.is_empty() {
+                    points.extend(
+                        log_grid(wmin, wmax, 30)
+                            .iter()
+                            .flat_map(|x| zetas.map(|z| (x.exp(), z))),
+                    );
+                }
+                points.extend(proposals.iter().map(|p| (p.omega_n, p.zeta)));
                 let mut trials: Vec<(f64, Vec<f64>)> = Vec::new();
-                for w in ws {
-                    for z in [0.005, 0.02, 0.06, 0.2, 0.5] {
-                        let mut th = vec![w.ln(), f64::ln(z)];
-                        for ch in &chans {
-                            th.push(ls(&[*ch], &|ch, k| {
-                                path_of(ch, k) / (s(k) * s(k) + 2.0 * z * w * s(k) + w * w)
-                            }));
-                        }
-                        trials.push((self.v(&cur.with(Cand::Mode, &th), mask), th));
+                for (w, z) in points {
+                    let mut th = vec![w.ln(), f64::ln(z)];
+                    for ch in &chans {
+                        th.push(ls(&[*ch], &|ch, k| {
+                            path_of(ch, k) / (s(k) * s(k) + 2.0 * z * w * s(k) + w * w)
+                        }));
                     }
+                    trials.push((self.v(&cur.with(Cand::Mode, &th), mask), th));
                 }
                 trials.sort_by(|a, b| a.0.total_cmp(&b.0));
                 trials.into_iter().take(4).map(|t| t.1).collect()
             }
         }
+    }
+}
+
+impl Problem<'_> {
+    /// The mode proposals of an LSCF stabilization diagram ([`super::lscf`]) on the
+    /// residual `G_d − G_m` (`gm`: the current model) at the data in `mask`, noise-weighted.
+    pub(super) fn mode_proposals(
+        &self,
+        gm: &[Vec<Complex64>],
+        mask: &[usize],
+    ) -> Vec<super::lscf::Proposal> {
+        let omega: Vec<f64> = mask.iter().map(|k| self.omega()[*k]).collect();
+        let h: Vec<Vec<Complex64>> = (0..self.n_ch())
+            .map(|ch| {
+                mask.iter()
+                    .map(|k| self.data.g[ch][*k] - gm[ch][*k])
+                    .collect()
+            })
+            .collect();
+        let w: Vec<Vec<f64>> = (0..self.n_ch())
+            .map(|ch| mask.iter().map(|k| self.inv_sigma[ch][*k]).collect())
+            .collect();
+        super::lscf::propose(
+            &super::lscf::Frf {
+                omega: &omega,
+                h: &h,
+                w: &w,
+            },
+            &Default::default(),
+        )
+    }
+}
+
+impl Problem<'_> {
+    /// The cost with a delay `τ_j = (j + ½)·step` (`j < n`) on the channels of `sel`, the
+    /// model otherwise `gm`: `(V(τ_j), τ_j)`.  A delay multiplies the model by `e^{−jωτ}`,
+    /// so along the uniform grid the factor at each datum advances by one rotation
+    /// `e^{−jω·step}` (a complex product instead of an `exp` of the whole model per point;
+    /// the same costs to rounding).
+    fn delay_grid(
+        &self,
+        gm: &[Vec<Complex64>],
+        sel: Sel,
+        mask: &[usize],
+        step: f64,
+        n: usize,
+    ) -> Vec<(f64, f64)> {
+        let om = self.omega();
+        let mut fixed = 0.0;
+        // Per hit datum: the data, the model, the weight, the factor and its rotation.
+        let mut hit: Vec<(Complex64, Complex64, f64, Complex64, Complex64)> = Vec::new();
+        for ch in 0..self.n_ch() {
+            let on = sel.hits(self.data.entries[ch]);
+            for &k in mask {
+                let (g, m, w) = (self.data.g[ch][k], gm[ch][k], self.inv_sigma[ch][k]);
+                if on {
+                    let rot = Complex64::from_polar(1.0, -om[k] * step);
+                    let first = Complex64::from_polar(1.0, -om[k] * 0.5 * step);
+                    hit.push((g, m, w, first, rot));
+                } else {
+                    fixed += ((g - m) * w).norm_sqr();
+                }
+            }
+        }
+        (0..n)
+            .map(|j| {
+                let mut v = fixed;
+                for (g, m, w, f, rot) in hit.iter_mut() {
+                    v += ((*g - *m * *f) * *w).norm_sqr();
+                    *f *= *rot;
+                }
+                let v = if v.is_finite() { v } else { f64::INFINITY };
+                (v, (j as f64 + 0.5) * step)
+            })
+            .collect()
     }
 }
