@@ -11,7 +11,7 @@
 //!   the model and a fourth in the data.
 //!
 //! * `complete_discovery_1000x3`: the same beam (1000 lines × 3 channels, six modes in the
-//!   data), from a model with a rigid body and the mass line only, `diagnose` then
+//!   data, dampings ×20 so that the lines resolve every resonance), from a model with a rigid body and the mass line only, `diagnose` then
 //!   `apply_chosen` repeated (default settings: up to three effects a step) until nothing
 //!   more is chosen or six steps ran; the six modes must be found.
 //!
@@ -56,9 +56,11 @@ const BEAM: [(f64, f64, [f64; 3]); 6] = [
     (959.0, 1.2e-4, [1.0, 0.9, 0.6]),
 ];
 
-/// A beam mode (peak `|G| ≈ 10` at the driving point), `ω_n` times `shift`.
-fn beam_mode(j: usize, shift: f64, n_in: usize) -> ModeSpec {
+/// A beam mode (peak `|G| ≈ 10` at the driving point), `ω_n` times `shift`, its damping
+/// ratio times `zeta_factor`.
+fn beam_mode(j: usize, shift: f64, n_in: usize, zeta_factor: f64) -> ModeSpec {
     let (f, z, b) = BEAM[j];
+    let z = z * zeta_factor;
     let w = std::f64::consts::TAU * f * shift;
     ModeSpec {
         name: None,
@@ -82,11 +84,22 @@ fn beam(
     model_modes: &[usize],
     extra: &[usize],
 ) -> (PhysicalModel, Channels) {
+    beam_damped(n_in, lines, model_modes, extra, 1.0)
+}
+
+/// [`beam`] with every damping ratio times `zeta_factor`.
+fn beam_damped(
+    n_in: usize,
+    lines: usize,
+    model_modes: &[usize],
+    extra: &[usize],
+    zeta_factor: f64,
+) -> (PhysicalModel, Channels) {
     let d = Feedthrough::Matrix(vec![[0.1, 0.07, 0.06][..n_in].to_vec()]);
     let model = PhysicalModel {
         mode: model_modes
             .iter()
-            .map(|j| beam_mode(*j, 1.005, n_in))
+            .map(|j| beam_mode(*j, 1.005, n_in, zeta_factor))
             .collect(),
         feedthrough: Some(if n_in == 1 {
             Feedthrough::Scalar(0.1)
@@ -98,13 +111,13 @@ fn beam(
     let mut truth = PhysicalModel {
         mode: model_modes
             .iter()
-            .map(|j| beam_mode(*j, 1.0, n_in))
+            .map(|j| beam_mode(*j, 1.0, n_in, zeta_factor))
             .collect(),
         ..model.clone()
     };
     truth
         .mode
-        .extend(extra.iter().map(|j| beam_mode(*j, 1.0, n_in)));
+        .extend(extra.iter().map(|j| beam_mode(*j, 1.0, n_in, zeta_factor)));
     let omega: Vec<f64> = (0..lines)
         .map(|k| std::f64::consts::TAU * (20.0 + 980.0 * k as f64 / (lines - 1) as f64))
         .collect();
@@ -248,7 +261,10 @@ fn discover(base: &PhysicalModel, data: &Channels, max_steps: usize) -> (Physica
 
 #[divan::bench(sample_count = 3)]
 fn complete_discovery_1000x3(bencher: divan::Bencher) {
-    let (_, data) = beam(3, 1000, &[], &[0, 1, 2, 3, 4, 5]);
+    // Dampings ×20 (ζ = 2e-3 … 1.2e-2): every half-power band 2ζf spans a line (0.98 Hz),
+    // so the fits identify ζ; at the beam's own ζ (1–6e-4) a mode fitted on these lines
+    // runs to the ζ bound and is refused ("not identified"), whoever proposes it.
+    let (_, data) = beam_damped(3, 1000, &[], &[0, 1, 2, 3, 4, 5], 20.0);
     // A rigid body and the mass line: nothing of the six modes.
     let base = PhysicalModel {
         rigid_body: vec![PoleAtZeroSpec {

@@ -192,10 +192,10 @@ impl Problem<'_> {
         let mut fixed = 0.0;
         // Per hit datum: the data, the model, the weight, the factor and its rotation.
         let mut hit: Vec<(Complex64, Complex64, f64, Complex64, Complex64)> = Vec::new();
-        for ch in 0..self.n_ch() {
+        for (ch, gm_ch) in gm.iter().enumerate() {
             let on = sel.hits(self.data.entries[ch]);
             for &k in mask {
-                let (g, m, w) = (self.data.g[ch][k], gm[ch][k], self.inv_sigma[ch][k]);
+                let (g, m, w) = (self.data.g[ch][k], gm_ch[k], self.inv_sigma[ch][k]);
                 if on {
                     let rot = Complex64::from_polar(1.0, -om[k] * step);
                     let first = Complex64::from_polar(1.0, -om[k] * 0.5 * step);
