@@ -13,7 +13,7 @@ use super::envelope::{check_sizes, Envelope, EnvelopeMethod};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::{Factorization, FactorsAt};
-use crate::mu::{mu_full_scalar_from, FullPlusScalar, MuSettings, MuStatus};
+use crate::mu::{mu_full_scalar_low_rank, FullPlusScalar, LowRank, MuSettings, MuStatus};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -72,11 +72,7 @@ fn parts(at: &FactorsAt) -> std::result::Result<Parts, NoisyFailure> {
     if at.m_singular() {
         return Err(NoisyFailure::MSingular);
     }
-    let sol =
-        at.m.clone()
-            .lu()
-            .solve(&rhs)
-            .ok_or(NoisyFailure::MSingular)?;
+    let sol = at.m_solve(&rhs).ok_or(NoisyFailure::MSingular)?;
     let minv_nj = sol.columns(0, 1).into_owned();
     let minv = sol.columns(1, n).into_owned();
     let c_minv = &at.c * &minv;
@@ -208,6 +204,32 @@ fn status_rank(s: MuStatus) -> u8 {
     }
 }
 
+/// `F_L(V(1), φ⁻¹) = E + a·bᴴ` when `M̃(jω)` is diagonal (a `[physical]` model, one row per
+/// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
+/// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃` or where the parts fail.
+fn low_rank(at: &FactorsAt, phi: Complex64, la: f64) -> Option<LowRank> {
+    if !crate::system::linalg::is_diagonal(&at.m) {
+        return None;
+    }
+    let p = parts(at).ok()?;
+    let n = at.m.nrows();
+    let k = phi - p.v22;
+    let mut a = nalgebra::DVector::zeros(n + 2);
+    a[0] = p.j;
+    a.rows_mut(1, n).copy_from(&p.minv_nj.column(0));
+    a[n + 1] = Complex64::new(1.0, 0.0);
+    let mut b = nalgebra::DVector::zeros(n + 1);
+    for j in 0..n {
+        b[j] = (p.c_minv[(0, j)] / k).conj();
+    }
+    b[n] = Complex64::new(la, 0.0) / k.conj();
+    Some(LowRank {
+        entries: (0..n).map(|i| (i + 1, i, p.minv[(i, i)])).collect(),
+        a,
+        b,
+    })
+}
+
 /// The smallest `|r|` consistent with the noisy datum `φ` and noise radius `L_a` (Theorem 4).
 ///
 /// `M(|r|) = diag(|r|·I_{n+1}, 1)·M(1)`, since only the rows of `V₁₁`, `V₁₂` feeding `Δ̃` carry
@@ -249,6 +271,8 @@ pub fn r_min_noisy(
     }
     let mut scaled = m1.clone();
     let mut hint: Option<f64> = None;
+    let structure = low_rank(at, phi, la);
+    let mut lr = structure.clone();
     // μ(ρ) and d ln μ/d ln ρ.
     let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
         for i in 0..=n {
@@ -256,8 +280,17 @@ pub fn r_min_noisy(
                 scaled[(i, j)] = m1[(i, j)] * rho;
             }
         }
-        let b =
-            mu_full_scalar_from(&scaled, s, &settings.mu, hint).expect("shape of F_L matches Γ");
+        // The rows feeding Δ̃ scale with ρ: E and a₀..aₙ.
+        if let (Some(base), Some(lr)) = (&structure, &mut lr) {
+            for (e, e0) in lr.entries.iter_mut().zip(&base.entries) {
+                e.2 = e0.2 * rho;
+            }
+            for i in 0..=n {
+                lr.a[i] = base.a[i] * rho;
+            }
+        }
+        let b = mu_full_scalar_low_rank(&scaled, s, &settings.mu, hint, lr.as_ref())
+            .expect("shape of F_L matches Γ");
         out.mu_evaluations += 1;
         out.decompositions += b.evaluations;
         out.worst_mu_gap = out.worst_mu_gap.max(b.rel_gap);
