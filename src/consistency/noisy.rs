@@ -357,6 +357,9 @@ pub struct NoisyReport {
     pub data: Vec<NoisyDatum>,
 }
 
+/// Hears how many data of how many are done (from any thread; the library never prints).
+pub type DatumProgressFn<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
 /// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].
 pub fn noisy_envelope_report(
     f: &Factorization,
@@ -364,6 +367,21 @@ pub fn noisy_envelope_report(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<NoisyReport> {
+    noisy_envelope_report_observed(f, data, radius, settings, None)
+}
+
+/// As [`noisy_envelope_report`], reporting the data done to `progress`.  The data are
+/// independent, so they are processed in parallel (rayon); the first failing datum in
+/// frequency order is the error, as in a sequential loop.
+pub fn noisy_envelope_report_observed(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+    progress: Option<DatumProgressFn<'_>>,
+) -> Result<NoisyReport> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     settings
         .validate()
         .map_err(|e| Error::Invalid(e.to_string()))?;
@@ -383,8 +401,10 @@ pub fn noisy_envelope_report(
             data.len()
         )));
     }
-    let mut rows = Vec::with_capacity(data.len());
-    for ((&omega, phi), &la) in data.omega.iter().zip(&data.response).zip(radius) {
+    let total = data.len();
+    let done = AtomicUsize::new(0);
+    let one = |i: usize| -> Result<NoisyDatum> {
+        let (omega, la) = (data.omega[i], radius[i]);
         if !(la.is_finite() && la >= 0.0) {
             return Err(Error::Assumption {
                 omega,
@@ -395,12 +415,25 @@ pub fn noisy_envelope_report(
             });
         }
         let at = f.at(omega);
-        let row = r_min_noisy(&at, phi[(0, 0)], la, settings).map_err(|e| Error::Assumption {
-            omega,
-            msg: format!("{} ({})", e.message(), data.path.display()),
+        let row = r_min_noisy(&at, data.response[i][(0, 0)], la, settings).map_err(|e| {
+            Error::Assumption {
+                omega,
+                msg: format!("{} ({})", e.message(), data.path.display()),
+            }
         })?;
-        rows.push(row);
-    }
+        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+        if let Some(p) = progress {
+            p(d, total);
+        }
+        Ok(row)
+    };
+    // Small models stay sequential: a datum costs microseconds there.
+    let results: Vec<Result<NoisyDatum>> = if f.states() >= 8 {
+        (0..total).into_par_iter().map(one).collect()
+    } else {
+        (0..total).map(one).collect()
+    };
+    let rows = results.into_iter().collect::<Result<Vec<_>>>()?;
     let envelope = Envelope {
         omega: data.omega.clone(),
         r_min: rows.iter().map(|r| r.r_min).collect(),
@@ -425,7 +458,18 @@ pub fn noisy_envelope(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<Envelope> {
-    let rep = noisy_envelope_report(f, data, radius, settings)?;
+    noisy_envelope_observed(f, data, radius, settings, None)
+}
+
+/// As [`noisy_envelope`], reporting the data done to `progress`.
+pub fn noisy_envelope_observed(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+    progress: Option<DatumProgressFn<'_>>,
+) -> Result<Envelope> {
+    let rep = noisy_envelope_report_observed(f, data, radius, settings, progress)?;
     for (w, d) in rep.envelope.omega.iter().zip(&rep.data) {
         if matches!(d.mu_status, MuStatus::SvdFailed | MuStatus::NonFinite) {
             return Err(Error::Assumption {
