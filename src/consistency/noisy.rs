@@ -208,7 +208,9 @@ fn status_rank(s: MuStatus) -> u8 {
 /// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
 /// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃` or where the parts fail.
 fn low_rank(at: &FactorsAt, phi: Complex64, la: f64) -> Option<LowRank> {
-    if !crate::system::linalg::is_diagonal(&at.m) {
+    if at.m.nrows() < crate::system::linalg::DIAGONAL_FROM
+        || !crate::system::linalg::is_diagonal(&at.m)
+    {
         return None;
     }
     let p = parts(at).ok()?;
@@ -428,7 +430,7 @@ pub fn noisy_envelope_report_observed(
         Ok(row)
     };
     // Small models stay sequential: a datum costs microseconds there.
-    let results: Vec<Result<NoisyDatum>> = if f.states() >= 8 {
+    let results: Vec<Result<NoisyDatum>> = if f.states() >= crate::system::linalg::DIAGONAL_FROM {
         (0..total).into_par_iter().map(one).collect()
     } else {
         (0..total).map(one).collect()

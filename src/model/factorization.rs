@@ -229,7 +229,10 @@ impl Factorization {
 
     /// `σ_min(M̃(jω))`, the A1 limit on `|r(jω)|`.
     pub fn a1_limit(&self, omega: f64) -> f64 {
-        if self.realization.is_none() && self.m.is_diagonal() {
+        if self.realization.is_none()
+            && self.m.rows() >= crate::system::linalg::DIAGONAL_FROM
+            && self.m.is_diagonal()
+        {
             // σ_min of a diagonal matrix: the smallest modulus on the diagonal (a physical
             // model has one row per mode; no n×n matrix or SVD per frequency).
             return (0..self.m.rows())
@@ -273,7 +276,9 @@ impl FactorsAt {
     /// model: one row per mode, where an LU of 200 modes would cost O(n³) per frequency).
     /// `None` where the LU finds `M̃` singular.
     pub fn m_solve(&self, b: &DMatrix<Complex64>) -> Option<DMatrix<Complex64>> {
-        if crate::system::linalg::is_diagonal(&self.m) {
+        if self.m.nrows() >= crate::system::linalg::DIAGONAL_FROM
+            && crate::system::linalg::is_diagonal(&self.m)
+        {
             let mut x = b.clone();
             for (i, mut row) in x.row_iter_mut().enumerate() {
                 let d = self.m[(i, i)];
