@@ -33,7 +33,5 @@ fn run_200_modes(bencher: divan::Bencher) {
 #[divan::bench(sample_count = 3)]
 fn envelope_200_modes(bencher: divan::Bencher) {
     let (config, data, _dir) = inputs(200, 1000);
-    bencher.bench(|| {
-        rshape::pipeline::envelope::envelope(&config, &data, None).expect("envelope")
-    });
+    bencher.bench(|| rshape::pipeline::envelope::envelope(&config, &data, None).expect("envelope"));
 }

@@ -9,8 +9,12 @@ mod modes;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let k = args.get(1).map_or(200, |a| a.parse().expect("MODES: a number"));
-    let points = args.get(2).map_or(1000, |a| a.parse().expect("POINTS: a number"));
+    let k = args
+        .get(1)
+        .map_or(200, |a| a.parse().expect("MODES: a number"));
+    let points = args
+        .get(2)
+        .map_or(1000, |a| a.parse().expect("POINTS: a number"));
     let dir = std::path::PathBuf::from(args.get(3).map_or("/tmp/modes", |a| a.as_str()));
     let cfg = modes::write(&dir, k, points);
     println!("wrote {} ({k} modes, {points} points)", cfg.display());

@@ -14,7 +14,10 @@ use rshape::mu::{mu_full_scalar, mu_full_scalar_low_rank, FullPlusScalar, LowRan
 struct Rng(u64);
 impl Rng {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (self.0 >> 11) as f64 / (1u64 << 53) as f64
     }
 }
@@ -65,14 +68,16 @@ fn structured_noisy_envelope_matches_the_dense_route() {
             let (fast, g) = factors(&modes, w, false);
             let (dense, _) = factors(&modes, w, true);
             // A datum off the model by 1..30 % of |g|, noise radius 0.5..5 % of |g|.
-            let dev = Complex64::from_polar(g.norm() * (0.01 + 0.29 * rng.next()), 6.3 * rng.next());
+            let dev =
+                Complex64::from_polar(g.norm() * (0.01 + 0.29 * rng.next()), 6.3 * rng.next());
             let phi = g + dev;
             let la = g.norm() * (0.005 + 0.045 * rng.next());
             let a = r_min_noisy(&fast, phi, la, &settings).expect("fast route");
             let b = r_min_noisy(&dense, phi, la, &settings).expect("dense route");
             let tol = 1e-7 * a.r_min.max(b.r_min);
             assert!(
-                (a.r_min - b.r_min).abs() <= tol || (a.r_min.is_infinite() && b.r_min.is_infinite()),
+                (a.r_min - b.r_min).abs() <= tol
+                    || (a.r_min.is_infinite() && b.r_min.is_infinite()),
                 "n {n}, w {w}: structured r_min {} vs dense {}",
                 a.r_min,
                 b.r_min
@@ -84,7 +89,11 @@ fn structured_noisy_envelope_matches_the_dense_route() {
                 let m = gamma_lft(&fast, phi, Complex64::new(a.r_min, 0.0), la).unwrap();
                 let s = FullPlusScalar::gamma(n);
                 let d = mu_full_scalar(&m, s, &MuSettings::default()).unwrap();
-                assert!((d.upper - 1.0).abs() < 1e-6, "dense μ at r_min = {}", d.upper);
+                assert!(
+                    (d.upper - 1.0).abs() < 1e-6,
+                    "dense μ at r_min = {}",
+                    d.upper
+                );
             }
         }
     }

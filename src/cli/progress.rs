@@ -1,6 +1,7 @@
 //! Progress of a long fit (or run) on stderr, rendered from the library's [`FitProgress`]
-//! reports and per-datum counts of the noisy envelope: an indicatif spinner on a terminal, otherwise (a log, CI) one line every few
-//! seconds, and nothing at all for a fit that ends within those seconds.
+//! reports and per-datum counts of the noisy envelope: an indicatif spinner on a terminal,
+//! otherwise (a log, CI) one line every few seconds, and nothing at all for a job that ends
+//! within those seconds.
 
 use crate::fit::FitProgress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -51,7 +52,10 @@ impl FitProgressView {
     /// Renders the library's report of a per-datum stage (`what`: `envelope`, …): `done` of
     /// `total` data.
     pub fn data(&self, what: &str, done: usize, total: usize) {
-        self.show(format!("{}: {what}, {done} of {total} data", self.stage_label()));
+        self.show(format!(
+            "{}: {what}, {done} of {total} data",
+            self.stage_label()
+        ));
     }
 
     /// `run: fit` → `run` (the label of the whole command, for its other stages).

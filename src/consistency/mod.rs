@@ -35,7 +35,7 @@ pub use noise_free::{
 };
 pub use noisy::{
     gamma_lft, lower_lft, noisy_envelope, noisy_envelope_observed, noisy_envelope_report,
-    noisy_envelope_report_observed, r_min_noisy, v_matrix, DatumProgressFn,
-    BisectionSettings, NoisyDatum, NoisyFailure, NoisyReport,
+    noisy_envelope_report_observed, r_min_noisy, v_matrix, BisectionSettings, DatumProgressFn,
+    NoisyDatum, NoisyFailure, NoisyReport,
 };
 pub use stream::noise_free_envelope_rows;

@@ -237,7 +237,13 @@ impl Factorization {
             // model has one row per mode; no n×n matrix or SVD per frequency).
             return (0..self.m.rows())
                 .map(|i| self.m.entry(i, i).freq(omega).norm())
-                .fold(f64::INFINITY, |a, b| if b.is_nan() || a.is_nan() { f64::NAN } else { a.min(b) });
+                .fold(f64::INFINITY, |a, b| {
+                    if b.is_nan() || a.is_nan() {
+                        f64::NAN
+                    } else {
+                        a.min(b)
+                    }
+                });
         }
         sigma_min(&self.factor_values(omega).0)
     }

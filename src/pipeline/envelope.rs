@@ -59,7 +59,8 @@ pub fn envelope_observed(
             data.inputs()
         )));
     }
-    let (envelope, warnings, closed_loop) = closed_loop::envelope(config, data, radii.as_deref(), progress)?;
+    let (envelope, warnings, closed_loop) =
+        closed_loop::envelope(config, data, radii.as_deref(), progress)?;
     Ok(EnvelopeOutcome {
         envelope,
         noise_radii: radii,

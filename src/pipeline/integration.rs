@@ -6,7 +6,9 @@
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
-use crate::consistency::noisy::{gamma_lft, noisy_envelope_observed, BisectionSettings, DatumProgressFn};
+use crate::consistency::noisy::{
+    gamma_lft, noisy_envelope_observed, BisectionSettings, DatumProgressFn,
+};
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};

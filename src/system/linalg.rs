@@ -54,9 +54,11 @@ pub const DIAGONAL_FROM: usize = 8;
 /// True when `a` is square with every off-diagonal entry exactly zero.
 pub fn is_diagonal(a: &DMatrix<Complex64>) -> bool {
     a.is_square()
-        && a.column_iter()
-            .enumerate()
-            .all(|(j, col)| col.iter().enumerate().all(|(i, z)| i == j || *z == Complex64::default()))
+        && a.column_iter().enumerate().all(|(j, col)| {
+            col.iter()
+                .enumerate()
+                .all(|(i, z)| i == j || *z == Complex64::default())
+        })
 }
 
 /// Relative threshold under which the smallest singular value counts as zero.
