@@ -1,6 +1,7 @@
-//! Progress of a long fit on stderr, rendered from the library's [`FitProgress`] reports:
-//! an indicatif bar over the orders on a terminal, otherwise (a log, CI) one line every few
-//! seconds, and nothing at all for a fit that ends within those seconds.
+//! Progress of a long fit (or run) on stderr, rendered from the library's [`FitProgress`]
+//! reports and per-datum counts of the noisy envelope: an indicatif spinner on a terminal,
+//! otherwise (a log, CI) one line every few seconds, and nothing at all for a job that ends
+//! within those seconds.
 
 use crate::fit::FitProgress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -45,6 +46,24 @@ impl FitProgressView {
             "{}: order {} of 0..{}, {} LPs so far",
             self.label, p.order, p.last_order, p.lp_solves
         );
+        self.show(msg);
+    }
+
+    /// Renders the library's report of a per-datum stage (`what`: `envelope`, …): `done` of
+    /// `total` data.
+    pub fn data(&self, what: &str, done: usize, total: usize) {
+        self.show(format!(
+            "{}: {what}, {done} of {total} data",
+            self.stage_label()
+        ));
+    }
+
+    /// `run: fit` → `run` (the label of the whole command, for its other stages).
+    fn stage_label(&self) -> &str {
+        self.label.split(':').next().unwrap_or(&self.label)
+    }
+
+    fn show(&self, msg: String) {
         match &self.bar {
             Some(b) => b.set_message(msg),
             None => {

@@ -67,7 +67,15 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     let (w, wmin) = (sym.weight, sym.weight_min);
     let view = super::progress::FitProgressView::new("run: fit");
     let progress = |p| view.update(p);
-    let mut out = pipeline::run(config, data, a.input.noise_radius, a.order, Some(&progress))?;
+    let envelope_progress = |done, total| view.data("envelope", done, total);
+    let mut out = pipeline::run_observed(
+        config,
+        data,
+        a.input.noise_radius,
+        a.order,
+        Some(&progress),
+        Some(&envelope_progress),
+    )?;
     view.finish();
     out.timings.0.insert("load".into(), load_ms);
     let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;

@@ -133,11 +133,10 @@ pub fn theorem3_x(
         col /= *jk;
     }
     // [M̃⁻¹Ñ | M̃⁻¹] from one LU factorization of M̃.
-    let lu = f.m.clone().lu();
     let mut rhs = DMatrix::zeros(n, p + n);
     rhs.view_mut((0, 0), (n, p)).copy_from(&f.n);
     rhs.view_mut((0, p), (n, n)).fill_with_identity();
-    let sol = lu.solve(&rhs).ok_or(AssumptionFailure::MSingular)?;
+    let sol = f.m_solve(&rhs).ok_or(AssumptionFailure::MSingular)?;
     let minv_n = sol.columns(0, p).into_owned();
     let minv = sol.columns(p, n).into_owned();
     let p22 = &f.c * &minv_n;

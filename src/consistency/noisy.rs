@@ -13,7 +13,7 @@ use super::envelope::{check_sizes, Envelope, EnvelopeMethod};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::{Factorization, FactorsAt};
-use crate::mu::{mu_full_scalar_from, FullPlusScalar, MuSettings, MuStatus};
+use crate::mu::{mu_full_scalar_low_rank, FullPlusScalar, LowRank, MuSettings, MuStatus};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -72,11 +72,7 @@ fn parts(at: &FactorsAt) -> std::result::Result<Parts, NoisyFailure> {
     if at.m_singular() {
         return Err(NoisyFailure::MSingular);
     }
-    let sol =
-        at.m.clone()
-            .lu()
-            .solve(&rhs)
-            .ok_or(NoisyFailure::MSingular)?;
+    let sol = at.m_solve(&rhs).ok_or(NoisyFailure::MSingular)?;
     let minv_nj = sol.columns(0, 1).into_owned();
     let minv = sol.columns(1, n).into_owned();
     let c_minv = &at.c * &minv;
@@ -208,6 +204,34 @@ fn status_rank(s: MuStatus) -> u8 {
     }
 }
 
+/// `F_L(V(1), φ⁻¹) = E + a·bᴴ` when `M̃(jω)` is diagonal (a `[physical]` model, one row per
+/// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
+/// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃` or where the parts fail.
+fn low_rank(at: &FactorsAt, phi: Complex64, la: f64) -> Option<LowRank> {
+    if at.m.nrows() < crate::system::linalg::DIAGONAL_FROM
+        || !crate::system::linalg::is_diagonal(&at.m)
+    {
+        return None;
+    }
+    let p = parts(at).ok()?;
+    let n = at.m.nrows();
+    let k = phi - p.v22;
+    let mut a = nalgebra::DVector::zeros(n + 2);
+    a[0] = p.j;
+    a.rows_mut(1, n).copy_from(&p.minv_nj.column(0));
+    a[n + 1] = Complex64::new(1.0, 0.0);
+    let mut b = nalgebra::DVector::zeros(n + 1);
+    for j in 0..n {
+        b[j] = (p.c_minv[(0, j)] / k).conj();
+    }
+    b[n] = Complex64::new(la, 0.0) / k.conj();
+    Some(LowRank {
+        entries: (0..n).map(|i| (i + 1, i, p.minv[(i, i)])).collect(),
+        a,
+        b,
+    })
+}
+
 /// The smallest `|r|` consistent with the noisy datum `φ` and noise radius `L_a` (Theorem 4).
 ///
 /// `M(|r|) = diag(|r|·I_{n+1}, 1)·M(1)`, since only the rows of `V₁₁`, `V₁₂` feeding `Δ̃` carry
@@ -249,6 +273,8 @@ pub fn r_min_noisy(
     }
     let mut scaled = m1.clone();
     let mut hint: Option<f64> = None;
+    let structure = low_rank(at, phi, la);
+    let mut lr = structure.clone();
     // μ(ρ) and d ln μ/d ln ρ.
     let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
         for i in 0..=n {
@@ -256,8 +282,17 @@ pub fn r_min_noisy(
                 scaled[(i, j)] = m1[(i, j)] * rho;
             }
         }
-        let b =
-            mu_full_scalar_from(&scaled, s, &settings.mu, hint).expect("shape of F_L matches Γ");
+        // The rows feeding Δ̃ scale with ρ: E and a₀..aₙ.
+        if let (Some(base), Some(lr)) = (&structure, &mut lr) {
+            for (e, e0) in lr.entries.iter_mut().zip(&base.entries) {
+                e.2 = e0.2 * rho;
+            }
+            for i in 0..=n {
+                lr.a[i] = base.a[i] * rho;
+            }
+        }
+        let b = mu_full_scalar_low_rank(&scaled, s, &settings.mu, hint, lr.as_ref())
+            .expect("shape of F_L matches Γ");
         out.mu_evaluations += 1;
         out.decompositions += b.evaluations;
         out.worst_mu_gap = out.worst_mu_gap.max(b.rel_gap);
@@ -324,6 +359,9 @@ pub struct NoisyReport {
     pub data: Vec<NoisyDatum>,
 }
 
+/// Hears how many data of how many are done (from any thread; the library never prints).
+pub type DatumProgressFn<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
 /// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].
 pub fn noisy_envelope_report(
     f: &Factorization,
@@ -331,6 +369,21 @@ pub fn noisy_envelope_report(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<NoisyReport> {
+    noisy_envelope_report_observed(f, data, radius, settings, None)
+}
+
+/// As [`noisy_envelope_report`], reporting the data done to `progress`.  The data are
+/// independent, so they are processed in parallel (rayon); the first failing datum in
+/// frequency order is the error, as in a sequential loop.
+pub fn noisy_envelope_report_observed(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+    progress: Option<DatumProgressFn<'_>>,
+) -> Result<NoisyReport> {
+    use rayon::prelude::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     settings
         .validate()
         .map_err(|e| Error::Invalid(e.to_string()))?;
@@ -350,8 +403,10 @@ pub fn noisy_envelope_report(
             data.len()
         )));
     }
-    let mut rows = Vec::with_capacity(data.len());
-    for ((&omega, phi), &la) in data.omega.iter().zip(&data.response).zip(radius) {
+    let total = data.len();
+    let done = AtomicUsize::new(0);
+    let one = |i: usize| -> Result<NoisyDatum> {
+        let (omega, la) = (data.omega[i], radius[i]);
         if !(la.is_finite() && la >= 0.0) {
             return Err(Error::Assumption {
                 omega,
@@ -362,12 +417,25 @@ pub fn noisy_envelope_report(
             });
         }
         let at = f.at(omega);
-        let row = r_min_noisy(&at, phi[(0, 0)], la, settings).map_err(|e| Error::Assumption {
-            omega,
-            msg: format!("{} ({})", e.message(), data.path.display()),
+        let row = r_min_noisy(&at, data.response[i][(0, 0)], la, settings).map_err(|e| {
+            Error::Assumption {
+                omega,
+                msg: format!("{} ({})", e.message(), data.path.display()),
+            }
         })?;
-        rows.push(row);
-    }
+        let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+        if let Some(p) = progress {
+            p(d, total);
+        }
+        Ok(row)
+    };
+    // Small models stay sequential: a datum costs microseconds there.
+    let results: Vec<Result<NoisyDatum>> = if f.states() >= crate::system::linalg::DIAGONAL_FROM {
+        (0..total).into_par_iter().map(one).collect()
+    } else {
+        (0..total).map(one).collect()
+    };
+    let rows = results.into_iter().collect::<Result<Vec<_>>>()?;
     let envelope = Envelope {
         omega: data.omega.clone(),
         r_min: rows.iter().map(|r| r.r_min).collect(),
@@ -392,7 +460,18 @@ pub fn noisy_envelope(
     radius: &[f64],
     settings: &BisectionSettings,
 ) -> Result<Envelope> {
-    let rep = noisy_envelope_report(f, data, radius, settings)?;
+    noisy_envelope_observed(f, data, radius, settings, None)
+}
+
+/// As [`noisy_envelope`], reporting the data done to `progress`.
+pub fn noisy_envelope_observed(
+    f: &Factorization,
+    data: &FrfData,
+    radius: &[f64],
+    settings: &BisectionSettings,
+    progress: Option<DatumProgressFn<'_>>,
+) -> Result<Envelope> {
+    let rep = noisy_envelope_report_observed(f, data, radius, settings, progress)?;
     for (w, d) in rep.envelope.omega.iter().zip(&rep.data) {
         if matches!(d.mu_status, MuStatus::SvdFailed | MuStatus::NonFinite) {
             return Err(Error::Assumption {

@@ -60,7 +60,10 @@ fn recheck_stall(
             .fold(f64::INFINITY, f64::min)
     };
     let Some(p) = prev else { return of };
-    if settings.thorough || best(&of) < p.max_log - STALL_LOG10 {
+    // An order below at most STALL_LOG10 above its envelope leaves no gain to miss: every
+    // certified r has max log10 |r|/r_min ≥ 0, so no route can improve it by more (the
+    // paper example reaches 0.00000 at order 3; orders 4–8 were each refit for nothing).
+    if settings.thorough || best(&of) < p.max_log - STALL_LOG10 || p.max_log <= STALL_LOG10 {
         return of;
     }
     let thorough = FitSettings {

@@ -9,7 +9,7 @@ use super::engine::Prepared;
 use super::polyrows::{
     cut_rows, disk, fixed_rows, level_rows, max_violation, relative_cuts, Rows, B_CUT_GROUP,
 };
-use super::problem::{active_set_solve, initial_points, SolverEvent, SolverStatus};
+use super::problem::{active_set_solve, initial_points, Retry, SolverEvent, SolverStatus};
 use super::provenance::EventKind;
 use super::FitSettings;
 
@@ -169,6 +169,7 @@ impl<'a> LevelLp<'a> {
                 set.max_solver_iter,
                 set.max_solver_iter.min(RETRY_ITER),
                 refine,
+                Retry::Decides,
             );
             self.lp_solves += rounds;
             // Only a full-accuracy certificate of infeasibility decides the level; a

@@ -215,7 +215,18 @@ const MAX_RETRY_ROWS: usize = 60_000;
 /// `retry_iter` caps the interior-point iterations of the retry with every row (see
 /// below), `max_iter` those of the working-set solves; `refine` turns on Clarabel's
 /// iterative refinement in every solve (otherwise only in the second try of a solve that
-/// ended short of `Solved` or a proof of infeasibility).
+/// ended short of `Solved` or a proof of infeasibility).  `Retry::Decides` (the level
+/// searches, where the status says whether a level is feasible) retries an `AlmostSolved`
+/// solve too; `Retry::Fails` (the area polish, where an `AlmostSolved` point is a usable
+/// candidate, certified like any other) only a solve without a solution.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Retry {
+    /// The status decides a level: retry every solve short of `Solved` or infeasible.
+    Decides,
+    /// Only the point is used: retry only solves without one.
+    Fails,
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn active_set_solve(
     n: usize,
@@ -229,6 +240,7 @@ pub(crate) fn active_set_solve(
     max_iter: u32,
     retry_iter: u32,
     refine: bool,
+    retry: Retry,
 ) -> (LpOut, usize) {
     if mask.len() != rows.len() {
         // Rows of the initial points; the floor rows of B only at every fourth of them.
@@ -256,12 +268,17 @@ pub(crate) fn active_set_solve(
         };
         let iter = if all { retry_iter } else { max_iter };
         let mut out = lp.solve(iter, refine);
-        if !refine
-            && !matches!(
+        let settled = match retry {
+            Retry::Decides => matches!(
                 out.status,
                 SolverStatus::Solved | SolverStatus::PrimalInfeasible
-            )
-        {
+            ),
+            Retry::Fails => matches!(
+                out.status,
+                SolverStatus::Solved | SolverStatus::AlmostSolved | SolverStatus::PrimalInfeasible
+            ),
+        };
+        if !refine && !settled {
             // Solved again with iterative refinement before the status counts: without it a
             // level of the partial-fraction search at order 8 of the ISS example ended short
             // of `Solved` and was taken as not feasible, and the order lost 0.14 decade
@@ -400,6 +417,7 @@ pub(crate) fn max_slack(
         max_iter,
         max_iter,
         refine,
+        Retry::Decides,
     );
     if !out.status.has_solution() {
         return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
@@ -465,6 +483,7 @@ pub(crate) fn area_fixed_poles(
         max_iter,
         max_iter,
         refine,
+        Retry::Fails,
     );
     if !out.status.has_solution() {
         return (out.status, vec![], f64::INFINITY, rounds);

@@ -27,8 +27,11 @@
 //! structure [`FullPlusScalar`] with [`MuSettings`], giving [`MuBounds`] and a [`MuStatus`];
 //! [`mu_two_scalar`], the closed form for two complex scalar blocks.
 
+mod low_rank;
 mod search;
 pub(crate) mod two_scalar;
+
+pub use low_rank::LowRank;
 
 pub use two_scalar::mu_two_scalar;
 
@@ -219,7 +222,24 @@ pub fn mu_full_scalar_from(
     settings: &MuSettings,
     log_d_hint: Option<f64>,
 ) -> Result<MuBounds> {
+    mu_full_scalar_low_rank(m, s, settings, log_d_hint, None)
+}
+
+/// As [`mu_full_scalar_from`], with `M = E + a·bᴴ` described by `low_rank` ([`LowRank`]:
+/// `E` with at most one nonzero per row and column in `M₁₁`): each step of the search over
+/// `ln d` then costs O(n) instead of a dense eigenproblem, falling back to it where the
+/// structured eigenvector fails its residual test.  A description that does not match `m`
+/// (shape, or an entry off by more than rounding) is ignored.  The lower bound is always
+/// evaluated on `m` itself, so it stays a certificate whatever path found the witness.
+pub fn mu_full_scalar_low_rank(
+    m: &DMatrix<Complex64>,
+    s: FullPlusScalar,
+    settings: &MuSettings,
+    log_d_hint: Option<f64>,
+    low_rank: Option<&LowRank>,
+) -> Result<MuBounds> {
     check_structure(m, s)?;
+    let low_rank = low_rank.filter(|lr| lr.fits(s.rows, s.cols) && lr.matches(m));
     if m.iter().any(|v| !v.is_finite()) {
         return Ok(Outcome::non_finite().bounds(s));
     }
@@ -238,6 +258,7 @@ pub fn mu_full_scalar_from(
         lower: 0.0,
         witness: None,
         svd_failed: false,
+        low_rank,
     };
     // |M₂₂| with witness e_last (Δ̃ = 0).
     let mut e_last = DVector::zeros(q + 1);

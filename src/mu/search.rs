@@ -26,6 +26,8 @@ pub(super) struct Search<'a> {
     pub(super) lower: f64,
     pub(super) witness: Option<DVector<Complex64>>,
     pub(super) svd_failed: bool,
+    /// `M = E + a·bᴴ` when the caller knows it ([`super::low_rank`]): O(n) evaluations.
+    pub(super) low_rank: Option<&'a super::LowRank>,
 }
 
 impl Search<'_> {
@@ -58,7 +60,11 @@ impl Search<'_> {
 
     /// Offers the unscaled vector `x` (columns of `M`) as a lower-bound witness.
     pub(super) fn offer(&mut self, x: DVector<Complex64>) {
-        let z = self.m * &x;
+        // With a low-rank description (checked against `m` to rounding) the product is O(n).
+        let z = match self.low_rank {
+            Some(lr) => lr.times(&x),
+            None => self.m * &x,
+        };
         let lb = lower_of(&x, &z, self.q, self.k);
         if lb > self.lower {
             self.lower = lb;
@@ -78,6 +84,9 @@ impl Search<'_> {
     /// eigenvector and `y = M_d x/σ̄`.  The lower bound uses `x` through the exact formula of
     /// [`lower_of`], so an inexact `x` can only weaken it, never invalidate it.
     pub(super) fn eval(&mut self, t: f64) -> Option<Eval> {
+        if let Some(e) = self.low_rank.and_then(|lr| self.eval_low_rank(lr, t)) {
+            return Some(e);
+        }
         self.evals += 1;
         let (q, k) = (self.q, self.k);
         let md = self.scaled(t);
@@ -115,6 +124,38 @@ impl Search<'_> {
         }
         // Unscale by D_r⁻¹.
         let mut x = xs.into_owned();
+        x[q] /= t.exp();
+        self.offer(x);
+        Some(Eval { sigma, h, curv })
+    }
+
+    /// [`Search::eval`] for `M = E + a·bᴴ` in O(n) ([`super::low_rank::top_pair`]); the
+    /// curvature is the difference quotient of `h` over a step of `1e-6` in `t` (a second
+    /// structured evaluation).  `None` (nothing counted or offered) sends the caller to the
+    /// dense eigenproblem.
+    fn eval_low_rank(&mut self, lr: &super::LowRank, t: f64) -> Option<Eval> {
+        let (q, k) = (self.q, self.k);
+        let hs = |tp: &super::low_rank::TopPair| {
+            let s2 = tp.lambda;
+            if tp.x[q].norm_sqr() > 0.5 {
+                tp.x.rows(0, q).norm_squared() - tp.y.rows(0, k).norm_squared() / s2
+            } else {
+                tp.y[k].norm_sqr() / s2 - tp.x[q].norm_sqr()
+            }
+        };
+        let tp = super::low_rank::top_pair(lr, q, k, t)?;
+        let step = 1e-6 * t.abs().max(1.0);
+        let curv = super::low_rank::top_pair(lr, q, k, t + step)
+            .map_or(f64::NAN, |tp2| 2.0 * (hs(&tp2) - hs(&tp)) / step);
+        self.evals += 1;
+        let sigma = tp.lambda.sqrt();
+        let h = hs(&tp);
+        if sigma < self.upper {
+            self.upper = sigma;
+            self.t_upper = t;
+            self.share_upper = tp.y.rows(0, k).norm_squared() / tp.lambda;
+        }
+        let mut x = tp.x;
         x[q] /= t.exp();
         self.offer(x);
         Some(Eval { sigma, h, curv })

@@ -43,9 +43,10 @@ pub fn envelope(
     config: &Config,
     data: &FrfData,
     radii: Option<&[f64]>,
+    progress: Option<crate::consistency::DatumProgressFn<'_>>,
 ) -> Result<(Envelope, Vec<String>, Option<ClosedLoopReport>)> {
     let Some(cl) = &config.closed_loop else {
-        let (e, w) = integration::envelope(&config.factorization, data, radii)?;
+        let (e, w) = integration::envelope(&config.factorization, data, radii, progress)?;
         return Ok((e, w, None));
     };
     let rep = closed_loop_envelope(cl, data, radii, &VBisectionSettings::default())?;

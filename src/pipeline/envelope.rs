@@ -37,6 +37,16 @@ pub fn envelope(
     data: &FrfData,
     cli_noise: Option<f64>,
 ) -> Result<EnvelopeOutcome> {
+    envelope_observed(config, data, cli_noise, None)
+}
+
+/// As [`envelope`], reporting the data done by a noisy envelope to `progress`.
+pub fn envelope_observed(
+    config: &Config,
+    data: &FrfData,
+    cli_noise: Option<f64>,
+    progress: Option<crate::consistency::DatumProgressFn<'_>>,
+) -> Result<EnvelopeOutcome> {
     let radii = integration::noise_radii(config, data, cli_noise)?;
     if radii.is_some()
         && config.closed_loop.is_none()
@@ -49,7 +59,8 @@ pub fn envelope(
             data.inputs()
         )));
     }
-    let (envelope, warnings, closed_loop) = closed_loop::envelope(config, data, radii.as_deref())?;
+    let (envelope, warnings, closed_loop) =
+        closed_loop::envelope(config, data, radii.as_deref(), progress)?;
     Ok(EnvelopeOutcome {
         envelope,
         noise_radii: radii,

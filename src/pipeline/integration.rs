@@ -6,7 +6,9 @@
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
-use crate::consistency::noisy::{gamma_lft, noisy_envelope, BisectionSettings};
+use crate::consistency::noisy::{
+    gamma_lft, noisy_envelope_observed, BisectionSettings, DatumProgressFn,
+};
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
@@ -29,15 +31,17 @@ pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<
 /// The envelope of the data: noise-free (Theorem 2 / Theorem 3) when `radii` is `None`,
 /// noisy SISO (Theorem 4, bisection on `|r|` of the μ test) otherwise.  Returns the
 /// envelope and any warning worth showing.
+/// `progress` hears of the data done by the noisy envelope (the noise-free one is closed form).
 pub fn envelope(
     f: &Factorization,
     data: &FrfData,
     radii: Option<&[f64]>,
+    progress: Option<DatumProgressFn<'_>>,
 ) -> Result<(Envelope, Vec<String>)> {
     match radii {
         None => Ok((noise_free_envelope(f, data)?, Vec::new())),
         Some(r) => {
-            let env = noisy_envelope(f, data, r, &BisectionSettings::default())?;
+            let env = noisy_envelope_observed(f, data, r, &BisectionSettings::default(), progress)?;
             let inf = env.r_min.iter().filter(|x| x.is_infinite()).count();
             let w = if inf > 0 {
                 vec![format!("{inf} datum(s) have r_min = ∞: no r explains them with this noise level and model")]

@@ -62,6 +62,19 @@ pub fn run(
     order: crate::fit::OrderChoice,
     progress: Option<crate::fit::ProgressFn<'_>>,
 ) -> Result<RunOutcome> {
+    run_observed(config, data, noise_radius, order, progress, None)
+}
+
+/// As [`run`], with `envelope_progress` hearing of the data done by a noisy envelope
+/// (Theorem 4's μ search per datum, the long stage of a large physical model).
+pub fn run_observed(
+    config: &Config,
+    data: &FrfData,
+    noise_radius: Option<f64>,
+    order: crate::fit::OrderChoice,
+    progress: Option<crate::fit::ProgressFn<'_>>,
+    envelope_progress: Option<crate::consistency::DatumProgressFn<'_>>,
+) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
     let envelope::EnvelopeOutcome {
@@ -70,7 +83,7 @@ pub fn run(
         mut warnings,
         closed_loop,
     } = timings.time("envelope", || {
-        envelope::envelope(config, data, noise_radius)
+        envelope::envelope_observed(config, data, noise_radius, envelope_progress)
     })?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {

@@ -23,11 +23,42 @@ pub fn extreme_singular_values(a: &DMatrix<Complex64>) -> (f64, f64) {
             let smin = if smax > 0.0 { det / smax } else { 0.0 };
             (smax, smin)
         }
+        _ if a.nrows() >= DIAGONAL_FROM && is_diagonal(a) => {
+            // The singular values of a square diagonal matrix are the moduli of its entries
+            // (a physical model's M̃ is diagonal: one row per mode); no O(n³) SVD.
+            let d = a.diagonal();
+            let (mut max, mut min) = (0.0f64, f64::INFINITY);
+            for z in d.iter() {
+                let v = z.norm();
+                if v.is_nan() {
+                    return (f64::NAN, f64::NAN);
+                }
+                max = max.max(v);
+                min = min.min(v);
+            }
+            (max, min)
+        }
         _ => {
             let sv = a.clone().svd(false, false).singular_values;
             (sv.max(), sv.min())
         }
     }
+}
+
+/// Size from which the diagonal fast paths (σ of a diagonal `M̃`, its solves, Theorem 4's
+/// low-rank μ search) are taken.  Below it the dense factorizations cost microseconds, and
+/// the shipped 5-mode robot keeps its dense arithmetic: its fitted `r` (and `α*`) moves with
+/// the envelope's last bits (docs/internals-fit-speed.md).
+pub const DIAGONAL_FROM: usize = 8;
+
+/// True when `a` is square with every off-diagonal entry exactly zero.
+pub fn is_diagonal(a: &DMatrix<Complex64>) -> bool {
+    a.is_square()
+        && a.column_iter().enumerate().all(|(j, col)| {
+            col.iter()
+                .enumerate()
+                .all(|(i, z)| i == j || *z == Complex64::default())
+        })
 }
 
 /// Relative threshold under which the smallest singular value counts as zero.

@@ -10,6 +10,14 @@ pub struct TfMatrix {
     rows: usize,
     cols: usize,
     entries: Vec<TransferFunction>,
+    /// Row-major indices of the entries with a nonzero numerator.
+    nonzero: Vec<usize>,
+}
+
+fn nonzero_of(entries: &[TransferFunction]) -> Vec<usize> {
+    (0..entries.len())
+        .filter(|&i| !entries[i].num.is_zero())
+        .collect()
 }
 
 impl TfMatrix {
@@ -21,10 +29,12 @@ impl TfMatrix {
         if r == 0 || c == 0 || rows.iter().any(|row| row.len() != c) {
             return None;
         }
+        let entries: Vec<TransferFunction> = rows.into_iter().flatten().collect();
         Some(Self {
             rows: r,
             cols: c,
-            entries: rows.into_iter().flatten().collect(),
+            nonzero: nonzero_of(&entries),
+            entries,
         })
     }
 
@@ -38,6 +48,7 @@ impl TfMatrix {
         Self {
             rows: n,
             cols: n,
+            nonzero: nonzero_of(&entries),
             entries,
         }
     }
@@ -64,7 +75,17 @@ impl TfMatrix {
 
     /// Value at `s = jω`.
     pub fn freq(&self, omega: f64) -> DMatrix<Complex64> {
-        DMatrix::from_fn(self.rows, self.cols, |i, j| self.entry(i, j).freq(omega))
+        // Zero entries (most of a physical model's diagonal M̃) cost no evaluation.
+        let mut m = DMatrix::zeros(self.rows, self.cols);
+        for &k in &self.nonzero {
+            m[(k / self.cols, k % self.cols)] = self.entries[k].freq(omega);
+        }
+        m
+    }
+
+    /// True when the matrix is square and every entry off the diagonal is zero.
+    pub fn is_diagonal(&self) -> bool {
+        self.rows == self.cols && self.nonzero.iter().all(|k| k / self.cols == k % self.cols)
     }
 
     /// Value at `s = ∞` (each entry must be proper).
