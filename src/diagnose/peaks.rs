@@ -401,7 +401,8 @@ mod tests {
         assert_eq!(p.len(), 3, "{p:?}");
         assert!((omega[p[0].k] - 600.0).abs() <= 1.0);
         assert!((omega[p[1].k] - 1500.0).abs() <= 1.0);
-        assert!((omega[p[2].k] - 1000.0).abs() <= 1.0, "{p:?}");
+        // One of the ripple's maxima (the resonances' tails tilt the plateau).
+        assert!((omega[p[2].k] - 1000.0).abs() < 50.0, "{p:?}");
         assert!(p[2].lo <= 951.0 && p[2].hi >= 1049.0, "{p:?}");
         // Half-height width of a resonance: ≈ 2√3 ζ ω0 (20.8 and 26.0 rad/s).
         let width = |q: &RawPeak| q.hi - q.lo;
