@@ -351,3 +351,103 @@ fn the_shipped_config_noise_is_the_coherence_radius() {
         assert!((a - b).abs() <= 1e-12 * b, "line {k}: {a} vs {b}");
     }
 }
+
+/// Issue 20, acceptance: step 1 of the 20–1200 Hz walk raises the invalid fraction against
+/// the configured model (87.8 % → 95.7 %).  What the evidence shows:
+/// * the rise is the retune's: the configured mass line refit alone goes to 100 % invalid,
+///   and the mode lowers both measures against that retuned model;
+/// * the step-1 model class (the mass line `c` and one mode at the fitted ω_n, ζ, residue by
+///   weighted linear least squares: a closed form here, independent of the library's fit)
+///   does hold models with both measures below the configured model's (`c` ≈ −1.19), but
+///   their cost `V` is far above the least-squares one (ΔV in the thousands, where a 95 %
+///   confidence region spans a few units): no fit of the stated noise model picks them;
+///   only a loss that counts invalid data (or a heavy-tailed one) would.
+#[test]
+fn step_1_raises_the_invalid_fraction_only_against_the_configured_model() {
+    let data = pyfrf(20.0, 1200.0);
+    let s = SearchSettings {
+        max_effects: 1,
+        beam: 3,
+    };
+    let d1 = diagnose_channels(&accelerance_mass_line(), &data, &s).unwrap();
+    let m1 = &d1.final_model.mode[0];
+    let (wn, z) = (m1.omega_n, m1.zeta);
+    let (rms0, inv0) = (d1.before.misfit_rms, d1.before.invalid_fraction);
+    // The retune alone raises the invalid fraction; the mode then lowers both measures.
+    assert!(d1.retuned.invalid_fraction > inv0, "{:?}", d1.retuned);
+    assert!(d1.after.invalid_fraction < d1.retuned.invalid_fraction);
+    assert!(d1.after.misfit_rms < d1.retuned.misfit_rms);
+    let g = &data.g[0];
+    let r = &data.radius[0];
+    let psi = |w: f64| {
+        let s = Complex64::new(0.0, w);
+        s * s / (s * s + 2.0 * z * wn * s + wn * wn)
+    };
+    // (V, misfit_rms, invalid_fraction) of the class at mass line c, residue by weighted LS.
+    let at = |c: f64| {
+        let (mut a, mut b) = (0.0, 0.0);
+        for (k, w) in data.omega.iter().enumerate() {
+            let wt = 1.0 / (r[k] * r[k]);
+            a += (psi(*w).conj() * (g[k] - c)).re * wt;
+            b += psi(*w).norm_sqr() * wt;
+        }
+        let rho = a / b;
+        let (mut c2, mut bad) = (0.0, 0usize);
+        for (k, w) in data.omega.iter().enumerate() {
+            let e = (g[k] - c - rho * psi(*w)).norm() / r[k];
+            c2 += e * e;
+            bad += usize::from(e > 1.0);
+        }
+        let n = data.omega.len() as f64;
+        (2.0 * c2, (c2 / n).sqrt(), bad as f64 / n)
+    };
+    let grid: Vec<(f64, (f64, f64, f64))> = (0..=600)
+        .map(|j| {
+            let c = -1.10 - 0.30 * j as f64 / 600.0;
+            (c, at(c))
+        })
+        .collect();
+    let ls = grid
+        .iter()
+        .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+        .unwrap();
+    let both: Vec<_> = grid
+        .iter()
+        .filter(|(_, (_, rms, inv))| *rms < rms0 && *inv < inv0)
+        .collect();
+    let fewest = grid
+        .iter()
+        .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
+        .unwrap();
+    println!(
+        "configured: rms {rms0:.2}, invalid {:.1} %; retuned: rms {:.2}, invalid {:.1} %; step 1: rms {:.2}, invalid {:.1} %",
+        100.0 * inv0,
+        d1.retuned.misfit_rms,
+        100.0 * d1.retuned.invalid_fraction,
+        d1.after.misfit_rms,
+        100.0 * d1.after.invalid_fraction
+    );
+    println!(
+        "class scan: least squares at c = {:.4} (rms {:.2}, invalid {:.1} %); fewest invalid at c = {:.4} (rms {:.2}, invalid {:.1} %, ΔV = {:.0}); {} of 601 grid points lower both",
+        ls.0,
+        ls.1 .1,
+        100.0 * ls.1 .2,
+        fewest.0,
+        fewest.1 .1,
+        100.0 * fewest.1 .2,
+        fewest.1 .0 - ls.1 .0,
+        both.len()
+    );
+    // The closed-form least squares of the class reproduces the library's step 1.
+    assert!((ls.1 .1 - d1.after.misfit_rms).abs() < 0.02 * d1.after.misfit_rms);
+    assert!(
+        ls.1 .2 > inv0,
+        "the least-squares member raises the invalid fraction"
+    );
+    // Members with both measures lower exist, and every one costs far more than the
+    // least-squares member: ΔV > 1000 (a 95 % confidence region of 3 parameters: 7.8).
+    assert!(!both.is_empty());
+    for (c, (v, _, _)) in &both {
+        assert!(v - ls.1 .0 > 1000.0, "c = {c}: ΔV = {}", v - ls.1 .0);
+    }
+}
