@@ -1,5 +1,5 @@
-//! The acceptance rule of an added effect (`rank::improves`: no more invalid data, or
-//! `misfit_rms` down to 90 %), validated on broad suites (issue 20, item 8 follow-up): the
+//! The acceptance rule of an added effect (`rank::improves`: no more invalid data, or a lower
+//! `misfit_rms`; ΔBIC > 10 besides), validated on broad suites (issue 20, item 8 follow-up): the
 //! hidden-effect suite (tests/hidden) on the servo as a receptance and as an accelerance
 //! with the out-of-band modes, noise seeds 1–10 each (the null case on every seed), and the
 //! robot on its three seeds.  Every case must pass; the counts per class are printed

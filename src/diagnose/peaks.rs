@@ -220,9 +220,11 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                 ),
             )
         } else {
-            let pr = probe_mode(&probe_on, &final_measures, &p, data);
-            let verdict = pr.verdict(&p);
-            probe = Some(pr);
+            probe = probe_mode(&probe_on, &final_measures, &p, data);
+            let verdict = match &probe {
+                Some(pr) => pr.verdict(&p),
+                None => "one mode started here did not converge".into(),
+            };
             match proposed {
                 Some(c) => (
                     PeakFate::Rejected,
@@ -287,7 +289,7 @@ fn probe_mode(
     cur: &super::problem::Measures,
     p: &RawPeak,
     data: &Channels,
-) -> PeakProbe {
+) -> Option<PeakProbe> {
     let w = data.omega[p.k];
     let all: Vec<usize> = (0..data.len()).collect();
     let z0 = ((p.hi - p.lo) / (2.0 * 3f64.sqrt() * w)).clamp(2e-4, 0.3);
@@ -313,16 +315,7 @@ fn probe_mode(
             best = Some((fit, v));
         }
     }
-    let Some((fit, v)) = best else {
-        return PeakProbe {
-            frequency_hz: f64::NAN,
-            zeta: f64::NAN,
-            delta_bic: f64::NAN,
-            flags: vec!["the fit did not converge".into()],
-            improves: false,
-            would_pass: false,
-        };
-    };
+    let (fit, v) = best?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let delta_bic = 2.0 * (cur.v - v) - Cand::Mode.n_params(data.n_ch()) as f64 * ln2f;
     let (mut flags, no_fit) = plausibility(
@@ -336,14 +329,14 @@ fn probe_mode(
     );
     flags.extend(no_fit);
     let better = improves(&pb.measures(&fit), cur);
-    PeakProbe {
+    Some(PeakProbe {
         frequency_hz: fit.theta[0].exp() / TAU,
         zeta: fit.theta[1].exp(),
         would_pass: flags.is_empty() && delta_bic > MIN_DELTA_BIC && better,
         delta_bic,
         flags,
         improves: better,
-    }
+    })
 }
 
 impl PeakProbe {
@@ -363,7 +356,7 @@ impl PeakProbe {
         } else if self.delta_bic <= MIN_DELTA_BIC {
             format!("{at}: too small a gain (needs ΔBIC > {MIN_DELTA_BIC})")
         } else if !self.improves {
-            format!("{at}: more invalid data and misfit_rms not down to 90 %")
+            format!("{at}: more invalid data and misfit_rms not lower")
         } else {
             format!("{at}: it leaves the peak's window (the peak is not one resonance)")
         }

@@ -46,7 +46,7 @@ pub struct CandidateReport {
     /// True when the numbers are after the joint refit of every parameter.
     pub joint_refit: bool,
     /// Passes: ΔBIC > 10 against the retuned model (the configured one for the retune),
-    /// no more invalid data or `misfit_rms` down to 90 % (`rank::improves`),
+    /// no more invalid data or a lower `misfit_rms` (`rank::improves`),
     /// physically plausible (no flags).
     pub passes: bool,
     /// Within 6 BIC of the best candidate.
@@ -93,9 +93,8 @@ impl CandidateReport {
             )
         } else {
             format!(
-                "more invalid data than the retune alone ({:.1} % with it) and misfit_rms not down to {} % of the retune's",
-                100.0 * self.invalid_fraction_after,
-                100.0 * super::rank::CLEAR_RMS_DROP
+                "more invalid data than the retune alone ({:.1} % with it) and misfit_rms not lower",
+                100.0 * self.invalid_fraction_after
             )
         })
     }
@@ -214,7 +213,7 @@ pub struct PeakProbe {
     pub delta_bic: f64,
     /// Plausibility flags (ω_n or ζ at a bound).
     pub flags: Vec<String>,
-    /// No more invalid data, or `misfit_rms` down to 90 % (`rank::improves`).
+    /// No more invalid data, or a lower `misfit_rms` (`rank::improves`).
     pub improves: bool,
     /// ΔBIC > 10, no flag, and `improves`: it would pass the screen.
     pub would_pass: bool,
@@ -235,11 +234,14 @@ pub struct Peak {
     pub width_hz: f64,
     /// What became of it.
     pub fate: PeakFate,
-    /// The effect that explains it, or the candidate fitted there.
+    /// The effect that explains it, or the candidate fitted there (absent when none).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub effect: Option<String>,
     /// Why, in one sentence.
     pub reason: String,
-    /// For a peak left unexplained: one mode fitted there on the final model.
+    /// For a peak left unexplained: one mode fitted there on the final model (absent for
+    /// an explained peak, or when that fit did not converge).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub probe: Option<PeakProbe>,
 }
 
