@@ -159,6 +159,8 @@ pub fn diagnose_channels(
                 final_model: &node.model,
                 chosen: &chosen_labels,
                 candidates: &candidates,
+                dropped: &dropped,
+                eliminated: &eliminated,
             },
             data,
         )
@@ -286,6 +288,9 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
 fn unreached_modes(peaks: &[super::report::Peak]) -> String {
     let mut f: Vec<f64> = Vec::new();
     for p in peaks {
+        if p.fate != super::report::PeakFate::NotProposed {
+            continue;
+        }
         if let Some(pr) = &p.probe {
             let inside = (p.window_hz[0]..=p.window_hz[1]).contains(&pr.frequency_hz);
             if pr.would_pass && inside && !f.iter().any(|x| (x - pr.frequency_hz).abs() < 1e-3 * x)

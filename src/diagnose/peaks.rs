@@ -143,6 +143,10 @@ pub(super) struct Outcome<'a> {
     pub final_model: &'a PhysicalModel,
     pub chosen: &'a [String],
     pub candidates: &'a [CandidateReport],
+    /// Effects the final holdout dropped.
+    pub dropped: &'a [String],
+    /// Effects the backward elimination dropped.
+    pub eliminated: &'a [String],
 }
 
 /// The per-peak account (module docs) and the number of peaks not listed.
@@ -199,13 +203,8 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                 PeakFate::Modelled,
                 Some(format!("mode {} Hz", sig(x / TAU))),
                 format!(
-                    "at the mode {} Hz already in the model: what is left of its fit{}",
-                    sig(x / TAU),
-                    if after > 0.5 * p.height && after > MIN_HEIGHT {
-                        " (a close mode it hides would show in a narrower window)"
-                    } else {
-                        ""
-                    }
+                    "at the mode {} Hz already in the model: what is left of its fit",
+                    sig(x / TAU)
                 ),
             )
         } else if !o.chosen.is_empty() && (after <= 0.5 * p.height || after < MIN_HEIGHT) {
@@ -236,7 +235,9 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                         "a mode candidate was fitted here and {}; probe on the final model: {verdict}",
                         match c.rejection() {
                             Some(why) => format!("rejected: {why}"),
-                            None => "passed the screen but is not in the chosen set (another set has the lower BIC, or the holdout or the backward elimination dropped it)".into(),
+                            None if o.dropped.iter().any(|d| d == "mode") => "passed the screen, but a mode of the chosen set failed the holdout (fitted on 3 of every 4 lines it did not predict the fourth better) and was dropped".into(),
+                            None if o.eliminated.iter().any(|d| d == "mode") => "passed the screen, but the backward elimination dropped a mode of the chosen set (ΔBIC ≤ 10 without it)".into(),
+                            None => "passed the screen but is not in the chosen set (another set has the lower BIC)".into(),
                         }
                     ),
                 ),
