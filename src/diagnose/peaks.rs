@@ -39,6 +39,7 @@ use super::report::{CandidateReport, Peak, PeakFate, PeakProbe};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Lowest residual peak listed, in noise units (`|e|/r`).
 pub const MIN_HEIGHT: f64 = 3.0;
@@ -172,8 +173,9 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
     let probe_on = Problem::new(o.final_model, data)?;
     let final_measures = probe_on.measures(&Mods::default());
     let n_root = o.retuned.mode.len();
-    let mut out = Vec::with_capacity(raw.len());
-    for p in raw {
+    // Each peak's account (and its probe fit) is independent of the others: in parallel (the
+    // indexed collect keeps the order).
+    let out: Vec<Peak> = raw.par_iter().map(|&p| {
         let w = data.omega[p.k];
         let (after, width) = (e1[p.k], p.hi - p.lo);
         let mode_in = |modes: &[crate::model::physical::ModeSpec]| {
@@ -251,7 +253,7 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                 ),
             }
         };
-        out.push(Peak {
+        Peak {
             frequency_hz: w / TAU,
             height: p.height,
             height_after: after,
@@ -261,8 +263,8 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
             effect,
             reason,
             probe,
-        });
-    }
+        }
+    }).collect();
     Ok((out, not_listed))
 }
 
