@@ -7,15 +7,24 @@
 
 use num_complex::Complex64;
 use rshape::diagnose::cost;
-use rshape::diagnose::Diagnosis;
 use rshape::diagnose::{diagnose_channels, retune_within, Channels, SearchSettings};
+use rshape::diagnose::{Diagnosis, PeakFate};
 use rshape::model::physical::{
     Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec, Quantity,
 };
 use std::path::Path;
 
 const TAU: f64 = std::f64::consts::TAU;
-const DIR: &str = "../shared/data/pyfrf-impact";
+/// `../shared/data/pyfrf-impact`, looked up from the repository's folder upwards (a git
+/// worktree sits one level deeper than the main checkout).
+fn dir() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .skip(1)
+        .map(|a| a.join("shared/data/pyfrf-impact"))
+        .find(|p| p.is_dir())
+        .expect("../shared/data/pyfrf-impact")
+}
 
 fn columns(path: &Path) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).unwrap();
@@ -27,8 +36,8 @@ fn columns(path: &Path) -> Vec<Vec<f64>> {
 
 /// The accelerance on `[f_lo, f_hi]` Hz with its noise radius from the coherence.
 fn pyfrf(f_lo: f64, f_hi: f64) -> Channels {
-    let h = columns(&Path::new(DIR).join("frf_h1.csv"));
-    let c = columns(&Path::new(DIR).join("frf_h1_coherence.csv"));
+    let h = columns(&dir().join("frf_h1.csv"));
+    let c = columns(&dir().join("frf_h1_coherence.csv"));
     let (mut omega, mut g, mut radius) = (vec![], vec![], vec![]);
     for (row, coh) in h.iter().zip(&c) {
         assert_eq!(row[0], coh[0]);
@@ -43,7 +52,7 @@ fn pyfrf(f_lo: f64, f_hi: f64) -> Channels {
         radius.push(3.0 * eps * hv.norm());
     }
     Channels {
-        path: DIR.into(),
+        path: dir(),
         omega,
         entries: vec![(0, 0)],
         g: vec![g],
@@ -260,17 +269,19 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
     }
 }
 
-/// The whole band, 20–5000 Hz (48 s for five steps at opt-level 1): the modes found, and
-/// nothing at a band edge.  Found: 900, 3664, 4126, 810 Hz; then the best single mode
-/// runs to the 5000 Hz edge (flagged, not applied) and the upper residual lowers the error
-/// too little: 851, 2640, 3035, 4160, 4390 Hz are not found (docs/guide/discovery-walkthrough.md).
+/// The whole band, 20–5000 Hz (ten steps, about 60 s in release on a loaded 2-core machine):
+/// the modes found (900, 3664, 4126, 810, 4391, 2640, 851 Hz among them), nothing at a band
+/// edge, and every mode the issue lists (810, 851, 900, 2640, 3035, 3670, 4130/4160,
+/// 4390 Hz) either in the final model or named in the last step's per-peak account with its
+/// fate and a reason (docs/guide/discovery-walkthrough.md, section 6).
 #[test]
-#[ignore = "the whole band: about 48 s at opt-level 1"]
+#[ignore = "the whole band, ten steps: about 60 s in release"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);
-    let last = &steps.last().unwrap().final_model;
-    for f in [900.0, 3664.0, 4126.0, 810.0] {
+    let last_step = steps.last().unwrap();
+    let last = &last_step.final_model;
+    for f in [900.0, 3664.0, 4126.0, 810.0, 851.0, 2640.0, 4391.0] {
         assert!(has_mode(last, f, 3.0), "no mode at {f} Hz: {:?}", last.mode);
     }
     let w_max = TAU * 5000.0;
@@ -281,6 +292,44 @@ fn pyfrf_accelerance_whole_band() {
             d.final_model.mode
         );
         assert!(d.after.misfit_rms < d.before.misfit_rms || d.chosen.is_empty());
+    }
+    println!("per-peak account of the last step:");
+    for p in &last_step.peaks {
+        println!(
+            "  {:8.1} Hz  {:9.3} -> {:9.3}  {}: {}",
+            p.frequency_hz,
+            p.height,
+            p.height_after,
+            p.fate.as_str(),
+            p.reason
+        );
+    }
+    // Every listed mode: found (a mode of the final model within 0.3 %), or a peak of the
+    // last account within 1 % with a fate other than "explained by a mode" and a reason.
+    for f in [
+        810.0, 851.0, 900.0, 2640.0, 3035.0, 3670.0, 4130.0, 4160.0, 4390.0,
+    ] {
+        if has_mode(last, f, 3e-3 * f) {
+            continue;
+        }
+        let p = last_step
+            .peaks
+            .iter()
+            .filter(|p| (p.frequency_hz - f).abs() < 0.01 * f)
+            .min_by(|a, b| {
+                (a.frequency_hz - f)
+                    .abs()
+                    .total_cmp(&(b.frequency_hz - f).abs())
+            });
+        let p = p.unwrap_or_else(|| panic!("{f} Hz: neither found nor in the peak account"));
+        assert!(
+            !matches!(p.fate, PeakFate::Added | PeakFate::Modelled) && p.reason.len() > 20,
+            "{f} Hz: {p:?}"
+        );
+        // An unexplained peak carries the probe: one mode fitted there on the final model.
+        if matches!(p.fate, PeakFate::Rejected | PeakFate::NotProposed) {
+            assert!(p.probe.is_some(), "{f} Hz: {p:?}");
+        }
     }
 }
 
@@ -301,5 +350,105 @@ fn the_shipped_config_noise_is_the_coherence_radius() {
     for (k, (a, b)) in r.radii.iter().zip(&hand.radius[0]).enumerate() {
         assert!((data.omega[k] - hand.omega[k]).abs() < 1e-9 * hand.omega[k]);
         assert!((a - b).abs() <= 1e-12 * b, "line {k}: {a} vs {b}");
+    }
+}
+
+/// Issue 20, acceptance: step 1 of the 20–1200 Hz walk raises the invalid fraction against
+/// the configured model (87.8 % → 95.7 %).  What the evidence shows:
+/// * the rise is the retune's: the configured mass line refit alone goes to 100 % invalid,
+///   and the mode lowers both measures against that retuned model;
+/// * the step-1 model class (the mass line `c` and one mode at the fitted ω_n, ζ, residue by
+///   weighted linear least squares: a closed form here, independent of the library's fit)
+///   does hold models with both measures below the configured model's (`c` ≈ −1.19), but
+///   their cost `V` is far above the least-squares one (ΔV in the thousands, where a 95 %
+///   confidence region spans a few units): no fit of the stated noise model picks them;
+///   only a loss that counts invalid data (or a heavy-tailed one) would.
+#[test]
+fn step_1_raises_the_invalid_fraction_only_against_the_configured_model() {
+    let data = pyfrf(20.0, 1200.0);
+    let s = SearchSettings {
+        max_effects: 1,
+        beam: 3,
+    };
+    let d1 = diagnose_channels(&accelerance_mass_line(), &data, &s).unwrap();
+    let m1 = &d1.final_model.mode[0];
+    let (wn, z) = (m1.omega_n, m1.zeta);
+    let (rms0, inv0) = (d1.before.misfit_rms, d1.before.invalid_fraction);
+    // The retune alone raises the invalid fraction; the mode then lowers both measures.
+    assert!(d1.retuned.invalid_fraction > inv0, "{:?}", d1.retuned);
+    assert!(d1.after.invalid_fraction < d1.retuned.invalid_fraction);
+    assert!(d1.after.misfit_rms < d1.retuned.misfit_rms);
+    let g = &data.g[0];
+    let r = &data.radius[0];
+    let psi = |w: f64| {
+        let s = Complex64::new(0.0, w);
+        s * s / (s * s + 2.0 * z * wn * s + wn * wn)
+    };
+    // (V, misfit_rms, invalid_fraction) of the class at mass line c, residue by weighted LS.
+    let at = |c: f64| {
+        let (mut a, mut b) = (0.0, 0.0);
+        for (k, w) in data.omega.iter().enumerate() {
+            let wt = 1.0 / (r[k] * r[k]);
+            a += (psi(*w).conj() * (g[k] - c)).re * wt;
+            b += psi(*w).norm_sqr() * wt;
+        }
+        let rho = a / b;
+        let (mut c2, mut bad) = (0.0, 0usize);
+        for (k, w) in data.omega.iter().enumerate() {
+            let e = (g[k] - c - rho * psi(*w)).norm() / r[k];
+            c2 += e * e;
+            bad += usize::from(e > 1.0);
+        }
+        let n = data.omega.len() as f64;
+        (2.0 * c2, (c2 / n).sqrt(), bad as f64 / n)
+    };
+    let grid: Vec<(f64, (f64, f64, f64))> = (0..=600)
+        .map(|j| {
+            let c = -1.10 - 0.30 * j as f64 / 600.0;
+            (c, at(c))
+        })
+        .collect();
+    let ls = grid
+        .iter()
+        .min_by(|a, b| a.1 .0.total_cmp(&b.1 .0))
+        .unwrap();
+    let both: Vec<_> = grid
+        .iter()
+        .filter(|(_, (_, rms, inv))| *rms < rms0 && *inv < inv0)
+        .collect();
+    let fewest = grid
+        .iter()
+        .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
+        .unwrap();
+    println!(
+        "configured: rms {rms0:.2}, invalid {:.1} %; retuned: rms {:.2}, invalid {:.1} %; step 1: rms {:.2}, invalid {:.1} %",
+        100.0 * inv0,
+        d1.retuned.misfit_rms,
+        100.0 * d1.retuned.invalid_fraction,
+        d1.after.misfit_rms,
+        100.0 * d1.after.invalid_fraction
+    );
+    println!(
+        "class scan: least squares at c = {:.4} (rms {:.2}, invalid {:.1} %); fewest invalid at c = {:.4} (rms {:.2}, invalid {:.1} %, ΔV = {:.0}); {} of 601 grid points lower both",
+        ls.0,
+        ls.1 .1,
+        100.0 * ls.1 .2,
+        fewest.0,
+        fewest.1 .1,
+        100.0 * fewest.1 .2,
+        fewest.1 .0 - ls.1 .0,
+        both.len()
+    );
+    // The closed-form least squares of the class reproduces the library's step 1.
+    assert!((ls.1 .1 - d1.after.misfit_rms).abs() < 0.02 * d1.after.misfit_rms);
+    assert!(
+        ls.1 .2 > inv0,
+        "the least-squares member raises the invalid fraction"
+    );
+    // Members with both measures lower exist, and every one costs far more than the
+    // least-squares member: ΔV > 1000 (a 95 % confidence region of 3 parameters: 7.8).
+    assert!(!both.is_empty());
+    for (c, (v, _, _)) in &both {
+        assert!(v - ls.1 .0 > 1000.0, "c = {c}: ΔV = {}", v - ls.1 .0);
     }
 }

@@ -1,5 +1,5 @@
 //! `rshape diagnose CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--json]
-//! [--apply K|chosen [--force] --write NEW.toml]`.
+//! [--band FMIN:FMAX] [--apply K|chosen [--force] --write NEW.toml]`.
 
 use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
@@ -40,6 +40,9 @@ pub struct DiagnoseArgs {
     /// Where to write the revised config.
     #[arg(long, requires = "apply")]
     pub write: Option<PathBuf>,
+    /// Diagnose only the lines with FMIN ≤ f ≤ FMAX (Hz), e.g. `--band 20:1200`.
+    #[arg(long, value_parser = parse_band, value_name = "FMIN:FMAX", allow_hyphen_values = true)]
+    pub band: Option<(f64, f64)>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -57,6 +60,20 @@ fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
         .filter(|k| *k >= 1)
         .map(Apply::Rank)
         .ok_or_else(|| format!("`{s}`: give a candidate rank (1, 2, …) or `chosen`"))
+}
+
+fn parse_band(s: &str) -> std::result::Result<(f64, f64), String> {
+    let bad = || format!("`{s}`: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX (e.g. 20:1200)");
+    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if a.is_finite() && b.is_finite() && 0.0 <= a && a < b {
+        Ok((a, b))
+    } else {
+        Err(bad())
+    }
 }
 
 /// The data channels to diagnose: the selected one, or every channel of MIMO data.
@@ -113,7 +130,10 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             p
         }
     };
-    let data = channels(a, &inputs, noise)?;
+    let mut data = channels(a, &inputs, noise)?;
+    if let Some((lo, hi)) = a.band {
+        data = data.band(lo, hi)?;
+    }
     let settings = SearchSettings {
         max_effects: a.max_effects.max(1),
         beam: a.beam.max(1),
@@ -175,6 +195,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
     }
     print_dropped(d);
     print_alternatives(d);
+    print_peaks(d);
     println!(
         "\nsearch: {} nodes expanded, {} joint refits, {} s (beam {})",
         d.search.nodes_expanded,
@@ -352,6 +373,27 @@ fn print_alternatives(d: &Diagnosis) {
             sig(t.bic_gap),
             t.disambiguation
         );
+    }
+}
+
+/// The per-peak account: every peak of the residual and what became of it.
+fn print_peaks(d: &Diagnosis) {
+    if d.peaks.is_empty() {
+        return;
+    }
+    println!("\npeaks of the residual (|data − model|/r ≥ 3 and at least twice the dip to higher ground; height on the retuned model → the final one):");
+    for p in &d.peaks {
+        println!(
+            "  {:>9} Hz {:>9} → {:<9} {}: {}",
+            sig(p.frequency_hz),
+            sig(p.height),
+            sig(p.height_after),
+            p.fate.as_str().replace('_', " "),
+            p.reason
+        );
+    }
+    if d.peaks_not_listed > 0 {
+        println!("  ({} lower peaks not listed)", d.peaks_not_listed);
     }
 }
 

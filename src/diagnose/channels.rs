@@ -80,6 +80,45 @@ impl Channels {
         Ok(out)
     }
 
+    /// The lines with `f_lo ≤ f ≤ f_hi` (Hz; `diagnose --band`), every channel with its
+    /// radii.  Fewer than two lines left is an error naming the data's band.
+    pub fn band(&self, f_lo: f64, f_hi: f64) -> Result<Self> {
+        let tau = std::f64::consts::TAU;
+        if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
+            return Err(Error::Invalid(format!(
+                "--band {f_lo}:{f_hi}: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX"
+            )));
+        }
+        let keep: Vec<usize> = (0..self.len())
+            // Hz from rad/s carries rounding: a line at exactly FMIN or FMAX is kept.
+            .filter(|k| {
+                let f = self.omega[*k] / tau;
+                f >= f_lo * (1.0 - 1e-12) && f <= f_hi * (1.0 + 1e-12)
+            })
+            .collect();
+        if keep.len() < 2 {
+            return Err(Error::Invalid(format!(
+                "--band {f_lo}:{f_hi}: {} of the data's lines lie in it (the data span {} … {} Hz); at least 2 are needed",
+                keep.len(),
+                crate::report::fmt::sig(self.omega.first().copied().unwrap_or(0.0) / tau),
+                crate::report::fmt::sig(self.omega.last().copied().unwrap_or(0.0) / tau)
+            )));
+        }
+        fn pick<T: Copy>(v: &[Vec<T>], keep: &[usize]) -> Vec<Vec<T>> {
+            v.iter()
+                .map(|c| keep.iter().map(|k| c[*k]).collect())
+                .collect()
+        }
+        Ok(Self {
+            path: self.path.clone(),
+            omega: keep.iter().map(|k| self.omega[*k]).collect(),
+            entries: self.entries.clone(),
+            g: pick(&self.g, &keep),
+            radius: pick(&self.radius, &keep),
+            radius_source: self.radius_source.clone(),
+        })
+    }
+
     /// Number of channels.
     pub fn n_ch(&self) -> usize {
         self.entries.len()

@@ -100,6 +100,8 @@ pub fn diagnose_channels(
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
             cost_test: Some([n as f64, before.v]),
+            peaks: vec![],
+            peaks_not_listed: 0,
             search: mk_stats(0, 0, Phases::default()),
             final_model: base.clone(),
         });
@@ -150,6 +152,19 @@ pub fn diagnose_channels(
         ties
     });
     let after = node.measures;
+    let (peaks, peaks_not_listed) = phases.time("peak account", || {
+        super::peaks::account(
+            &super::peaks::Outcome {
+                retuned: &root_model,
+                final_model: &node.model,
+                chosen: &chosen_labels,
+                candidates: &candidates,
+                dropped: &dropped,
+                eliminated: &eliminated,
+            },
+            data,
+        )
+    })?;
     let verdict = if !node.effects.is_empty() {
         DiagnoseVerdict::EffectsFound
     } else if retuned.consistent() {
@@ -157,7 +172,8 @@ pub fn diagnose_channels(
     } else {
         DiagnoseVerdict::NoEffectFound
     };
-    let message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels);
+    let message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
+        + &unreached_modes(&peaks);
     Ok(Diagnosis {
         verdict,
         message,
@@ -185,6 +201,8 @@ pub fn diagnose_channels(
         ),
         retuned_in_chosen: changes(base, &node.model, data),
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
+        peaks,
+        peaks_not_listed,
         search: mk_stats(res.expanded, res.joint_refits, phases),
         final_model: node.model,
     })
@@ -262,6 +280,33 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
     runner_up.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     runner_up.truncate(4);
     runner_up
+}
+
+/// A note for the verdict when the per-peak account ([`super::peaks`]) found peaks where one
+/// mode fitted at the peak would pass the screen although no candidate of the run was
+/// fitted there: the modes the search's proposals did not reach (empty when none).
+fn unreached_modes(peaks: &[super::report::Peak]) -> String {
+    let mut f: Vec<f64> = Vec::new();
+    for p in peaks {
+        if p.fate != super::report::PeakFate::NotProposed {
+            continue;
+        }
+        if let Some(pr) = &p.probe {
+            let inside = (p.window_hz[0]..=p.window_hz[1]).contains(&pr.frequency_hz);
+            if pr.would_pass && inside && !f.iter().any(|x| (x - pr.frequency_hz).abs() < 1e-3 * x)
+            {
+                f.push(pr.frequency_hz);
+            }
+        }
+    }
+    if f.is_empty() {
+        return String::new();
+    }
+    f.sort_by(f64::total_cmp);
+    format!(
+        "; one mode fitted at a peak of the residual would pass the screen at {} Hz, where the search proposed none (see the peaks)",
+        f.iter().map(|x| sig(*x)).collect::<Vec<_>>().join(", ")
+    )
 }
 
 /// The one-paragraph summary of a verdict, from the measures of the configured, the retuned

@@ -18,7 +18,7 @@
 //!   an LSCF stabilization diagram); `rank`: screening and physical plausibility;
 //! * `search`: the beam search over effect sets with joint refits; `polish`: the
 //!   consistency polish; `ties`: sets the data cannot tell apart; `holdout`: the
-//!   final set checked on held-out data;
+//!   final set checked on held-out data; `peaks`: every peak of the residual and its fate;
 //! * `engine`: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
 //!   [`apply_candidate`]); `report`: what it reports; `figures`: Bode overlay of `compare`;
 //!   `history_figure`: the error after each revision (`history`).
@@ -40,6 +40,7 @@ pub(crate) mod fit;
 pub(crate) mod history_figure;
 pub(crate) mod holdout;
 pub(crate) mod lscf;
+pub(crate) mod peaks;
 pub(crate) mod plant_form;
 pub(crate) mod polish;
 pub(crate) mod problem;
@@ -72,8 +73,8 @@ pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSIO
 pub use problem::Measures as ErrorMeasures;
 pub use rank::candidate_list;
 pub use report::{
-    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, PhaseTime,
-    Phases, Retuned, SearchStats, Step, Tie,
+    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Peak, PeakFate,
+    PeakProbe, PhaseTime, Phases, Retuned, SearchStats, Step, Tie,
 };
 pub use retune::cost;
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};

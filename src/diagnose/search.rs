@@ -8,8 +8,8 @@
 //!   (ΔBIC > 10, plausible: no parameter at a bound, a mode inside the band) are written into
 //!   the model and **every** parameter is refit jointly (the node's own and the new
 //!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10, it
-//!   improves on the node ([`super::rank::improves`]: no more invalid data, or `misfit_rms`
-//!   down to 90 % or less), and the refit left no new mode at a band edge.
+//!   improves on the node ([`super::rank::improves`]: no more invalid data, or a lower
+//!   `misfit_rms`), and the refit left no new mode at a band edge.
 //! * **Level**: the children of all nodes, one per effect set (the best of the orders that
 //!   reach it), the `beam` lowest `BIC = 2V + n_θ·ln(2F)` kept.
 //! * **Stop** at the first level with a consistent node (fewest effects that explain the
