@@ -108,12 +108,7 @@ fn channel_factors(frf: &Frf<'_>, n_max: usize, t: f64) -> Vec<DMatrix<f64>> {
 /// below `1e-13` of the largest or the result is not finite.
 fn lstsq(mut a: DMatrix<f64>, b: DVector<f64>) -> Option<DVector<f64>> {
     let n = a.ncols();
-    let scale: Vec<f64> = (0..n)
-        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
-        .collect();
-    for (j, s) in scale.iter().enumerate() {
-        a.column_mut(j).scale_mut(1.0 / s);
-    }
+    let scale = crate::system::linalg::equilibrate_columns(&mut a);
     let qr = a.qr();
     let r = qr.r();
     let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);

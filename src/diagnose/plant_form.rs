@@ -153,12 +153,7 @@ pub fn physical_from_tf(g: &TransferFunction) -> Result<PhysicalModel, String> {
         y[2 * r] = gv.re * wt;
         y[2 * r + 1] = gv.im * wt;
     }
-    let col: Vec<f64> = (0..n)
-        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
-        .collect();
-    for (j, c) in col.iter().enumerate() {
-        a.column_mut(j).scale_mut(1.0 / c);
-    }
+    let col = crate::system::linalg::equilibrate_columns(&mut a);
     let x = a
         .svd(true, true)
         .solve(&y, 1e-13)

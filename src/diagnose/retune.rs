@@ -95,12 +95,7 @@ pub(super) fn solve_linear_res(
 /// blow up.
 fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
     let n = a.ncols();
-    let scale: Vec<f64> = (0..n)
-        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
-        .collect();
-    for (j, s) in scale.iter().enumerate() {
-        a.column_mut(j).scale_mut(1.0 / s);
-    }
+    let scale = crate::system::linalg::equilibrate_columns(&mut a);
     let qr = a.qr();
     let r = qr.r();
     // Qᵀy by the Householder reflections (no explicit Q).

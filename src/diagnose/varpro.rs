@@ -55,12 +55,7 @@ fn factor_block(mut a: DMatrix<f64>) -> Option<(DMatrix<f64>, DMatrix<f64>, Vec<
     if a.nrows() < n {
         return None;
     }
-    let scale: Vec<f64> = (0..n)
-        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
-        .collect();
-    for (j, s) in scale.iter().enumerate() {
-        a.column_mut(j).scale_mut(1.0 / s);
-    }
+    let scale = crate::system::linalg::equilibrate_columns(&mut a);
     let qr = a.qr();
     let r = qr.r();
     let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
