@@ -173,7 +173,7 @@ pub struct FinalEffect {
     pub sigma: BTreeMap<String, f64>,
 }
 
-/// What became of a peak of the residual ([`super::peaks`]).
+/// What became of a peak of the residual (module `peaks`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PeakFate {
@@ -202,7 +202,7 @@ impl PeakFate {
     }
 }
 
-/// One mode fitted at a peak on top of the final model ([`super::peaks`]).
+/// One mode fitted at a peak on top of the final model (module `peaks`).
 #[derive(Debug, Clone, Serialize)]
 pub struct PeakProbe {
     /// Where the mode went, Hz.
@@ -219,7 +219,7 @@ pub struct PeakProbe {
     pub would_pass: bool,
 }
 
-/// A peak of the residual `|data − model|/r` and its fate ([`super::peaks`]).
+/// A peak of the residual `|data − model|/r` and its fate (module `peaks`).
 #[derive(Debug, Clone, Serialize)]
 pub struct Peak {
     /// Frequency of the peak, Hz.
@@ -397,7 +397,7 @@ pub struct Diagnosis {
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
     /// Every peak of the residual that stands out of the noise, with its fate (at most
-    /// [`super::peaks::MAX_PEAKS`], the highest).
+    /// `peaks::MAX_PEAKS`, the highest).
     pub peaks: Vec<Peak>,
     /// Peaks found but not listed.
     pub peaks_not_listed: usize,
