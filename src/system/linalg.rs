@@ -103,6 +103,20 @@ pub fn spectral_norm(a: &DMatrix<Complex64>) -> f64 {
     a.clone().svd(false, false).singular_values.max()
 }
 
+/// Scales every column of `a` to unit 2-norm in place and returns the scales `s_j` (so the
+/// scaled matrix is `A S⁻¹`, and `x = S⁻¹ x̃` undoes it): the column equilibration before a
+/// least-squares QR, which keeps parameters of very different units from hiding a small
+/// pivot.  A zero column keeps a tiny positive scale instead of dividing by zero.
+pub(crate) fn equilibrate_columns(a: &mut DMatrix<f64>) -> Vec<f64> {
+    let scale: Vec<f64> = (0..a.ncols())
+        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
+        .collect();
+    for (j, s) in scale.iter().enumerate() {
+        a.column_mut(j).scale_mut(1.0 / s);
+    }
+    scale
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -129,18 +143,4 @@ mod tests {
             }
         }
     }
-}
-
-/// Scales every column of `a` to unit 2-norm in place and returns the scales `s_j` (so the
-/// scaled matrix is `A S⁻¹`, and `x = S⁻¹ x̃` undoes it): the column equilibration before a
-/// least-squares QR, which keeps parameters of very different units from hiding a small
-/// pivot.  A zero column keeps a tiny positive scale instead of dividing by zero.
-pub(crate) fn equilibrate_columns(a: &mut DMatrix<f64>) -> Vec<f64> {
-    let scale: Vec<f64> = (0..a.ncols())
-        .map(|j| a.column(j).norm().max(f64::MIN_POSITIVE))
-        .collect();
-    for (j, s) in scale.iter().enumerate() {
-        a.column_mut(j).scale_mut(1.0 / s);
-    }
-    scale
 }
