@@ -259,6 +259,24 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
         .runner_up
         .iter()
         .any(|r| r.effects == ["mode"] && r.bic_gap < 0.0));
+    // The per-peak account calls a peak explained only where the final model brought it
+    // down to half or into the noise (a broad window around an added mode once said
+    // "explained" of a residual that grew, 26.7 -> 28.8 at 831 Hz).
+    let mut added_not_down = 0;
+    for d in &steps {
+        for p in &d.peaks {
+            let down = p.height_after <= 0.5 * p.height || p.height_after < 3.0;
+            assert!(
+                down || !p.reason.starts_with("explained") && !p.reason.starts_with("lowered"),
+                "{p:?}"
+            );
+            if matches!(p.fate, PeakFate::Added) && !down {
+                assert!(p.reason.contains("not that mode's alone"), "{p:?}");
+                added_not_down += 1;
+            }
+        }
+    }
+    eprintln!("peaks in the window of an added mode but not brought down: {added_not_down}");
     // The 1/s term on an accelerance is flagged as implausible, never applied.
     for d in &steps {
         for c in d.candidates.iter().filter(|c| c.effect == "integrator") {

@@ -240,7 +240,7 @@ fn print_candidates(d: &Diagnosis) {
     if d.candidates.is_empty() {
         return;
     }
-    println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, no more invalid data):");
+    println!("\ncandidates on the configured model (ranked by ΔBIC = 2ΔV − n·ln 2F; each with every parameter refit jointly when marked *; pass = ΔBIC > 10 against the retune, plausible, and no more invalid data or a lower misfit_rms):");
     for c in &d.candidates {
         if let Some(why) = &c.no_fit {
             println!("{:>2}. {:<18} no fit: {why}", c.rank, c.effect);

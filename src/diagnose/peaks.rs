@@ -21,7 +21,8 @@
 //! and of the final model (a peak the refit created), merged, and the [`MAX_PEAKS`] highest
 //! listed.
 //!
-//! **Fate**, in this order: *added* (a mode this run added lies in the window), *modelled*
+//! **Fate**, in this order: *added* (a mode this run added lies in the window; the reason
+//! says whether it brought the residual down to half or into the noise), *modelled*
 //! (a mode already in the model lies there: the rest of its fit), *lowered* (the chosen set
 //! brought the residual down to half or below [`MIN_HEIGHT`]), *rejected* (a mode candidate
 //! of this run was fitted in the window and rejected, with the candidate's reason), or
@@ -191,14 +192,27 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
             c.cand == Some(Cand::Mode) && c.params.get("omega_n").is_some_and(|x| p.contains(*x))
         });
         let mut probe = None;
+        // A peak is explained when the final model brings it down to half or into the noise;
+        // a mode added inside a broad window need not do that (a residual that stays or
+        // grows there is not that mode's alone), and the account must not say it does.
+        let brought_down = after <= 0.5 * p.height || after < MIN_HEIGHT;
         let (fate, effect, reason) = if let Some(x) = added {
             (
                 PeakFate::Added,
                 Some(format!("mode {} Hz", sig(x / TAU))),
-                format!(
-                    "explained by the mode this run added at {} Hz",
-                    sig(x / TAU)
-                ),
+                if brought_down {
+                    format!(
+                        "explained by the mode this run added at {} Hz",
+                        sig(x / TAU)
+                    )
+                } else {
+                    format!(
+                        "the mode this run added at {} Hz lies in this peak's window, but the residual here stays at {} (was {}): not that mode's alone, more is missing here",
+                        sig(x / TAU),
+                        sig(after),
+                        sig(p.height)
+                    )
+                },
             )
         } else if let Some(x) = modelled {
             (
@@ -209,7 +223,7 @@ pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                     sig(x / TAU)
                 ),
             )
-        } else if !o.chosen.is_empty() && (after <= 0.5 * p.height || after < MIN_HEIGHT) {
+        } else if !o.chosen.is_empty() && brought_down {
             (
                 PeakFate::Lowered,
                 Some(o.chosen.join(" + ")),
