@@ -39,7 +39,6 @@ use super::rank::{improves, plausibility, MIN_DELTA_BIC};
 use super::report::{CandidateReport, Peak, PeakFate, PeakProbe};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
-use num_complex::Complex64;
 use rayon::prelude::*;
 
 /// Lowest residual peak listed, in noise units (`|e|/r`).
@@ -314,18 +313,7 @@ fn probe_mode(
     let resp = pb.response(&empty);
     let mut best: Option<(Mods, f64)> = None;
     for z in [z0, 3.0 * z0, z0 / 3.0] {
-        let mut th = vec![w.ln(), f64::ln(z)];
-        for (ch, resp) in resp.iter().enumerate() {
-            let (mut a, mut b) = (0.0, 0.0);
-            for (k, &wk) in data.omega.iter().enumerate() {
-                let s = Complex64::new(0.0, wk);
-                let psi = pb.parts(&empty, ch, Some(k), wk).1 / (s * s + 2.0 * z * w * s + w * w);
-                let wt = (1.0 / data.radius[ch][k]).powi(2);
-                a += (psi.conj() * (data.g[ch][k] - resp[k])).re * wt;
-                b += psi.norm_sqr() * wt;
-            }
-            th.push(if b > 0.0 && a.is_finite() { a / b } else { 0.0 });
-        }
+        let th = pb.mode_theta(&empty, &resp, w, z, &all);
         let m = empty.with(Cand::Mode, &th);
         let (fit, v, _) = pb.refit(&m, &all);
         if v.is_finite() && best.as_ref().is_none_or(|b| v < b.1) {

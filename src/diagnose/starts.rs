@@ -14,23 +14,8 @@ impl Problem<'_> {
         let (wmin, wmax) = (self.omega_min(), self.omega_max());
         let om = self.omega();
         let n_ch = self.n_ch();
-        let w2 = |ch: usize, k: usize| self.inv_sigma[ch][k].powi(2);
-        // Linear LS of e = G_d − G_m on a basis ψ over the channels in `chs`:
-        // ρ = Re Σ ψ* e w / Σ|ψ|² w.
         let ls = |chs: &[usize], psi: &dyn Fn(usize, usize) -> Complex64| -> f64 {
-            let (mut a, mut b) = (0.0, 0.0);
-            for &ch in chs {
-                for &k in mask {
-                    let p = psi(ch, k);
-                    a += (p.conj() * (self.data.g[ch][k] - gm[ch][k])).re * w2(ch, k);
-                    b += p.norm_sqr() * w2(ch, k);
-                }
-            }
-            if b > 0.0 && a.is_finite() {
-                a / b
-            } else {
-                0.0
-            }
+            self.ls_coefficient(&gm, chs, mask, psi)
         };
         // Best few points of a 1-D grid of the new parameter: the grid's local minima by
         // cost, then the rest by cost.
@@ -66,7 +51,6 @@ impl Problem<'_> {
         // The path of the current model at each datum (for additive bases).
         let path_of = |ch: usize, k: usize| self.parts(cur, ch, Some(k), om[k]).1;
         let s = |k: usize| Complex64::new(0.0, om[k]);
-        let chans: Vec<usize> = (0..n_ch).collect();
         let sel_chans = |sel: Sel| -> Vec<usize> {
             (0..n_ch)
                 .filter(|ch| sel.hits(self.data.entries[*ch]))
@@ -129,12 +113,7 @@ impl Problem<'_> {
                 points.extend(proposals.iter().map(|p| (p.omega_n, p.zeta)));
                 let mut trials: Vec<(f64, Vec<f64>)> = Vec::new();
                 for (w, z) in points {
-                    let mut th = vec![w.ln(), f64::ln(z)];
-                    for ch in &chans {
-                        th.push(ls(&[*ch], &|ch, k| {
-                            path_of(ch, k) / (s(k) * s(k) + 2.0 * z * w * s(k) + w * w)
-                        }));
-                    }
+                    let th = self.mode_theta(cur, &gm, w, z, mask);
                     trials.push((self.v(&cur.with(Cand::Mode, &th), mask), th));
                 }
                 trials.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -145,6 +124,54 @@ impl Problem<'_> {
 }
 
 impl Problem<'_> {
+    /// Linear least squares of the residual `e = G_d − G_m` (`gm`: the model's response) on
+    /// a basis `ψ` over the channels `chs` and the data in `mask`, noise-weighted:
+    /// `ρ = Re Σ ψ* e w / Σ |ψ|² w` (0 when the basis vanishes or the sum is not finite).
+    pub(super) fn ls_coefficient(
+        &self,
+        gm: &[Vec<Complex64>],
+        chs: &[usize],
+        mask: &[usize],
+        psi: &dyn Fn(usize, usize) -> Complex64,
+    ) -> f64 {
+        let (mut a, mut b) = (0.0, 0.0);
+        for &ch in chs {
+            for &k in mask {
+                let w2 = self.inv_sigma[ch][k].powi(2);
+                let p = psi(ch, k);
+                a += (p.conj() * (self.data.g[ch][k] - gm[ch][k])).re * w2;
+                b += p.norm_sqr() * w2;
+            }
+        }
+        if b > 0.0 && a.is_finite() {
+            a / b
+        } else {
+            0.0
+        }
+    }
+
+    /// The parameters `[ln ω_n, ln ζ, ρ_1 … ρ_C]` of an added mode at `(w, z)` on the model
+    /// `cur` (response `gm`): each channel's residue by [`Problem::ls_coefficient`] on the
+    /// basis `path/(s² + 2ζω_n s + ω_n²)`.
+    pub(super) fn mode_theta(
+        &self,
+        cur: &Mods,
+        gm: &[Vec<Complex64>],
+        w: f64,
+        z: f64,
+        mask: &[usize],
+    ) -> Vec<f64> {
+        let om = self.omega();
+        let mut th = vec![w.ln(), f64::ln(z)];
+        for ch in 0..self.n_ch() {
+            th.push(self.ls_coefficient(gm, &[ch], mask, &|ch, k| {
+                let s = Complex64::new(0.0, om[k]);
+                self.parts(cur, ch, Some(k), om[k]).1 / (s * s + 2.0 * z * w * s + w * w)
+            }));
+        }
+        th
+    }
+
     /// The mode proposals of an LSCF stabilization diagram ([`super::lscf`]) on the
     /// residual `G_d − G_m` (`gm`: the current model) at the data in `mask`, noise-weighted.
     pub(super) fn mode_proposals(
