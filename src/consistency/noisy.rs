@@ -208,9 +208,7 @@ fn status_rank(s: MuStatus) -> u8 {
 /// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
 /// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃` or where the parts fail.
 fn low_rank(at: &FactorsAt, phi: Complex64, la: f64) -> Option<LowRank> {
-    if at.m.nrows() < crate::system::linalg::DIAGONAL_FROM
-        || !crate::system::linalg::is_diagonal(&at.m)
-    {
+    if !crate::system::linalg::diagonal_fast_path(&at.m) {
         return None;
     }
     let p = parts(at).ok()?;

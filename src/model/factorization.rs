@@ -235,15 +235,10 @@ impl Factorization {
         {
             // σ_min of a diagonal matrix: the smallest modulus on the diagonal (a physical
             // model has one row per mode; no n×n matrix or SVD per frequency).
-            return (0..self.m.rows())
-                .map(|i| self.m.entry(i, i).freq(omega).norm())
-                .fold(f64::INFINITY, |a, b| {
-                    if b.is_nan() || a.is_nan() {
-                        f64::NAN
-                    } else {
-                        a.min(b)
-                    }
-                });
+            return crate::system::linalg::extreme_moduli(
+                (0..self.m.rows()).map(|i| self.m.entry(i, i).freq(omega)),
+            )
+            .1;
         }
         sigma_min(&self.factor_values(omega).0)
     }
@@ -282,9 +277,7 @@ impl FactorsAt {
     /// model: one row per mode, where an LU of 200 modes would cost O(n³) per frequency).
     /// `None` where the LU finds `M̃` singular.
     pub fn m_solve(&self, b: &DMatrix<Complex64>) -> Option<DMatrix<Complex64>> {
-        if self.m.nrows() >= crate::system::linalg::DIAGONAL_FROM
-            && crate::system::linalg::is_diagonal(&self.m)
-        {
+        if crate::system::linalg::diagonal_fast_path(&self.m) {
             let mut x = b.clone();
             for (i, mut row) in x.row_iter_mut().enumerate() {
                 let d = self.m[(i, i)];

@@ -23,20 +23,10 @@ pub fn extreme_singular_values(a: &DMatrix<Complex64>) -> (f64, f64) {
             let smin = if smax > 0.0 { det / smax } else { 0.0 };
             (smax, smin)
         }
-        _ if a.nrows() >= DIAGONAL_FROM && is_diagonal(a) => {
+        _ if diagonal_fast_path(a) => {
             // The singular values of a square diagonal matrix are the moduli of its entries
             // (a physical model's M̃ is diagonal: one row per mode); no O(n³) SVD.
-            let d = a.diagonal();
-            let (mut max, mut min) = (0.0f64, f64::INFINITY);
-            for z in d.iter() {
-                let v = z.norm();
-                if v.is_nan() {
-                    return (f64::NAN, f64::NAN);
-                }
-                max = max.max(v);
-                min = min.min(v);
-            }
-            (max, min)
+            extreme_moduli(a.diagonal().iter().copied())
         }
         _ => {
             let sv = a.clone().svd(false, false).singular_values;
@@ -50,6 +40,27 @@ pub fn extreme_singular_values(a: &DMatrix<Complex64>) -> (f64, f64) {
 /// the shipped 5-mode robot keeps its dense arithmetic: its fitted `r` (and `α*`) moves with
 /// the envelope's last bits (docs/internals-fit-speed.md).
 pub const DIAGONAL_FROM: usize = 8;
+
+/// True when the diagonal fast paths apply to `a`: at least [`DIAGONAL_FROM`] rows, and
+/// diagonal ([`is_diagonal`]).
+pub fn diagonal_fast_path(a: &DMatrix<Complex64>) -> bool {
+    a.nrows() >= DIAGONAL_FROM && is_diagonal(a)
+}
+
+/// `(max, min)` of the moduli of `values` (the singular values of a diagonal matrix); both
+/// NaN when one modulus is.
+pub fn extreme_moduli(values: impl IntoIterator<Item = Complex64>) -> (f64, f64) {
+    let (mut max, mut min) = (0.0f64, f64::INFINITY);
+    for z in values {
+        let v = z.norm();
+        if v.is_nan() {
+            return (f64::NAN, f64::NAN);
+        }
+        max = max.max(v);
+        min = min.min(v);
+    }
+    (max, min)
+}
 
 /// True when `a` is square with every off-diagonal entry exactly zero.
 pub fn is_diagonal(a: &DMatrix<Complex64>) -> bool {
