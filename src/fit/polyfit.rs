@@ -181,8 +181,19 @@ fn factor_lowest(
                 z.gain = target / z.mag(x0.sqrt());
                 if z.gain > 0.0 && z.gain.is_finite() {
                     let c = prep.score(z, Origin::PolynomialMinimax { t: lev.exp() });
+                    // The level is proved as `A/B` reaches it (`LevelLp::level`); the factors
+                    // must reach it too, or the candidate is not the level's.
+                    let reach = (1.0 + set.bisection_tol).powi(2) * (1.0 + 1e-6);
                     if c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6 {
-                        return Some(c);
+                        if c.t <= lev.exp() * reach {
+                            return Some(c);
+                        }
+                        last_err = Some(format!(
+                            "level {:.4e}: the spectral factors reach only {:.4e}",
+                            lev.exp(),
+                            c.t
+                        ));
+                        continue;
                     }
                     last_err = Some(format!(
                         "level {:.4e}: bounds missed on the grid (coverage {:.3e})",

@@ -7,7 +7,8 @@ use super::basis::PointKind;
 use super::chebseries::cheb;
 use super::engine::Prepared;
 use super::polyrows::{
-    cut_rows, disk, fixed_rows, level_rows, max_violation, relative_cuts, Rows, B_CUT_GROUP,
+    cut_rows, disk, fixed_rows, level_rows, max_violation, reached_level, relative_cuts,
+    relative_level_rows, Rows, B_CUT_GROUP,
 };
 use super::problem::{active_set_solve, initial_points, Retry, SolverEvent, SolverStatus};
 use super::provenance::EventKind;
@@ -93,11 +94,7 @@ impl<'a> LevelLp<'a> {
             data,
             init: initial_points(&prep.grid, 40),
             mask: Vec::new(),
-            cuts: Rows {
-                rows: Vec::new(),
-                group: Vec::new(),
-                point: Vec::new(),
-            },
+            cuts: Rows::empty(),
             lp_solves: 0,
             b_cut_used: false,
         }
@@ -152,8 +149,20 @@ impl<'a> LevelLp<'a> {
         eq[n + 1..].copy_from_slice(&cheb(n, 0.0));
         let eqs = vec![(eq, 1.0)];
         let cost = vec![0.0; nv];
+        // Relative level rows of this level (they hold at `t` only).
+        let mut level_cuts = Rows::empty();
+        // A level is proved when the solution reaches it within the search's resolution.
+        let reach_tol = (1.0 + set.bisection_tol).powi(2);
         for _ in 0..CUT_ROUNDS {
-            let r = level_rows(n, &self.prep.grid, self.x0, t, &self.base, &self.cuts);
+            let r = level_rows(
+                n,
+                &self.prep.grid,
+                self.x0,
+                t,
+                &self.base,
+                &self.cuts,
+                &level_cuts,
+            );
             if self.mask.len() != r.rows.len() {
                 self.mask.clear();
             }
@@ -210,8 +219,24 @@ impl<'a> LevelLp<'a> {
                 &mut self.cuts,
             );
             self.b_cut_used |= self.cuts.group.contains(&B_CUT_GROUP);
-            if !cut && !relative_cuts(n, &out.x, &self.prep.grid, self.x0, &mut self.cuts) {
+            if cut || relative_cuts(n, &out.x, &self.prep.grid, self.x0, &mut self.cuts) {
+                continue;
+            }
+            // The level rows are met only to the LP's absolute tolerance: the solution must
+            // reach the level as `A/B`, else the level is solved again with the missed rows
+            // scaled by the solution's magnitude (a level the solution does not reach proves
+            // nothing, and its candidate silently lost the order: ISS orders 6–7).
+            if reached_level(n, &out.x, &self.prep.grid, self.x0) <= t * reach_tol {
                 return Level::Feasible(out.x);
+            }
+            if !relative_level_rows(n, &out.x, &self.prep.grid, self.x0, t, &mut level_cuts) {
+                self.doubt(
+                    events,
+                    t,
+                    out.status,
+                    "the solution misses the level at the data even with its rows scaled relatively; level treated as not feasible".into(),
+                );
+                return Level::Doubt;
             }
         }
         self.doubt(

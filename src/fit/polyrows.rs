@@ -24,6 +24,17 @@ pub(super) struct Rows {
     pub(super) point: Vec<usize>,
 }
 
+impl Rows {
+    /// No rows.
+    pub(super) fn empty() -> Self {
+        Self {
+            rows: Vec::new(),
+            group: Vec::new(),
+            point: Vec::new(),
+        }
+    }
+}
+
 fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
     let m = row.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     if m > 0.0 && m.is_finite() {
@@ -49,6 +60,7 @@ const A_FLOOR_CUT_GROUP: u32 = 5;
 const NO_DIP_CUT_GROUP: u32 = 6;
 const LOWER_RELATIVE_GROUP: u32 = 7;
 const A1_RELATIVE_GROUP: u32 = 8;
+const LEVEL_RELATIVE_GROUP: u32 = 9;
 
 /// Floors on `Σ b_k T_k(u)` at a positivity cut (the normalization is 1 at `x = x₀`), in
 /// the order tried.  1e-7 keeps the LP from hiding the sign again (about 1e-8 of tolerance
@@ -96,6 +108,7 @@ pub(super) fn level_rows(
     t: f64,
     base: &Rows,
     cuts: &Rows,
+    level_cuts: &Rows,
 ) -> Rows {
     let mut r = Rows {
         rows: base.rows.clone(),
@@ -113,9 +126,11 @@ pub(super) fn level_rows(
             );
         }
     }
-    r.rows.extend(cuts.rows.iter().cloned());
-    r.group.extend(&cuts.group);
-    r.point.extend(&cuts.point);
+    for c in [cuts, level_cuts] {
+        r.rows.extend(c.rows.iter().cloned());
+        r.group.extend(&c.group);
+        r.point.extend(&c.point);
+    }
     // Sort by (group, point) so that neighbours along a group are adjacent for the
     // working-set rule.
     let mut idx: Vec<usize> = (0..r.rows.len()).collect();
@@ -262,6 +277,67 @@ pub(super) fn relative_cuts(
         }
     }
     cuts.rows.len() > before
+}
+
+/// The level `t` as the solution `(a, b)` reaches it: `max A/(upper·B)` over the data
+/// (`+∞` where `B ≤ 0` at a datum).  The level rows are met to the LP's absolute tolerance on
+/// rows normalized by their largest coefficient, so where `B` is tiny (at a lightly damped
+/// resonance of `|r|`) `A/B` can exceed `t·upper` many times over: on the ISS example
+/// (orders 6–7) a level "proved" at 8.06e3 and 7.26e3 was reached only at 1.60e4 and 3.57e4.
+pub(super) fn reached_level(n: usize, x: &[f64], grid: &[GridPoint], x0: f64) -> f64 {
+    let k = n + 1;
+    let (a, b) = (&x[..k], &x[k..2 * k]);
+    let mut t = 0.0f64;
+    for g in grid {
+        if let Some(up) = g.upper.filter(|_| g.kind == PointKind::Datum) {
+            let u = disk(g.x, x0);
+            let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
+            if !(bv > 0.0) {
+                return f64::INFINITY;
+            }
+            t = t.max(av / (up * bv));
+        }
+    }
+    if t.is_nan() {
+        f64::INFINITY
+    } else {
+        t
+    }
+}
+
+/// Relative level rows for a solution that misses the level `t` at some datum (see
+/// [`reached_level`]): every level row within [`NEAR`] of its bound, divided by the
+/// solution's magnitude there (`|A| + t·upper·|B|`) instead of by its largest coefficient, as
+/// [`relative_cuts`] does for the lower bounds and A1.  They hold at this level only, so they
+/// go to `out`, which the caller drops with the level.  Returns whether any row was added.
+pub(super) fn relative_level_rows(
+    n: usize,
+    x: &[f64],
+    grid: &[GridPoint],
+    x0: f64,
+    t: f64,
+    out: &mut Rows,
+) -> bool {
+    let k = n + 1;
+    let (a, b) = (&x[..k], &x[k..2 * k]);
+    let done: std::collections::HashSet<usize> = out.point.iter().copied().collect();
+    let before = out.rows.len();
+    for (i, g) in grid.iter().enumerate() {
+        let Some(up) = g.upper.filter(|_| g.kind == PointKind::Datum) else {
+            continue;
+        };
+        let u = disk(g.x, x0);
+        let (av, bv) = (chebseries::eval(a, u), chebseries::eval(b, u));
+        let (slack, mag) = (t * up * bv - av, av.abs() + t * up * bv.abs());
+        if !(slack < NEAR * mag && mag > 0.0) || done.contains(&i) {
+            continue;
+        }
+        let row: Vec<f64> = ab_row(n, u, -1.0, t * up).iter().map(|v| v / mag).collect();
+        out.rows.push((row, 0.0));
+        out.group.push(LEVEL_RELATIVE_GROUP);
+        out.point.push(i);
+    }
+    out.rows.len() > before
 }
 
 /// Largest violation `rhs − row·x` over normalized rows.
