@@ -348,3 +348,56 @@ pub(super) fn max_violation(rows: &[(Vec<f64>, f64)], x: &[f64]) -> f64 {
         .fold(f64::NEG_INFINITY, f64::max)
         / scale
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A datum where `B` is tiny: the level row, normalized by its largest coefficient, is
+    /// met to the LP's absolute tolerance while `A/B` is twice the level.  `reached_level`
+    /// sees the miss, and the relative row makes it a violation of order one.
+    #[test]
+    fn a_level_met_absolutely_but_not_relatively_is_seen_and_rescaled() {
+        let (x0, t, up) = (1.0, 1.0, 1.0);
+        // Datum at x = 3: u = (3 − 1)/(3 + 1) = 0.5.
+        let datum = GridPoint {
+            w: 3f64.sqrt(),
+            x: 3.0,
+            lower: 1e-12,
+            upper: Some(up),
+            a1: None,
+            kind: PointKind::Datum,
+            datum: Some(0),
+        };
+        let grid = [datum];
+        // B(u) = 1 − (2 − 2e-9)·u is 1e-9 at u = 0.5; A = 2e-9 (constant).
+        let x = [2e-9, 0.0, 1.0, -(2.0 - 2e-9)];
+        let (av, bv) = (2e-9, 1.0 - (2.0 - 2e-9) * 0.5);
+        let level = level_rows(
+            1,
+            &grid,
+            x0,
+            t,
+            &Rows::empty(),
+            &Rows::empty(),
+            &Rows::empty(),
+        );
+        assert!(max_violation(&level.rows, &x) <= 1e-9);
+        let reached = reached_level(1, &x, &grid, x0);
+        assert!(
+            (reached - av / (up * bv)).abs() <= 1e-6 * reached,
+            "{reached}"
+        );
+        assert!(reached > 1.9 * t);
+        let mut rel = Rows::empty();
+        assert!(relative_level_rows(1, &x, &grid, x0, t, &mut rel));
+        assert_eq!((rel.rows.len(), rel.point[0]), (1, 0));
+        // Violation (A − t·U·B)/(|A| + t·U·|B|) = 1e-9/3e-9.
+        let v = max_violation(&rel.rows, &x) * (1.0 + 2.0);
+        assert!((v - 1.0 / 3.0).abs() < 1e-6, "{v}");
+        // A second call adds nothing at a point already rescaled.
+        assert!(!relative_level_rows(1, &x, &grid, x0, t, &mut rel));
+        // B ≤ 0 at a datum: no level is reached.
+        assert!(reached_level(1, &[1.0, 0.0, 1.0, -2.5], &grid, x0).is_infinite());
+    }
+}
