@@ -34,6 +34,10 @@ enum Level {
     /// Not decided (a solve short of `Solved`, cuts that did not converge); an event says
     /// which.
     Doubt,
+    /// Infeasible only with a cut `B ≥ b_cut` in the LP (stricter than `B > 0`): not
+    /// decided either, but a proof for the LP as it stands, which refinement cannot change;
+    /// another cut floor or centre decides the level.
+    CutBound,
 }
 
 /// The feasibility LP of one level at one disk-map centre, with the cuts found so far
@@ -116,7 +120,7 @@ impl<'a> LevelLp<'a> {
     fn try_level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Option<Vec<f64>> {
         match self.level(t, events) {
             Level::Feasible(x) => Some(x),
-            Level::Infeasible | Level::Doubt => None,
+            Level::Infeasible | Level::Doubt | Level::CutBound => None,
         }
     }
 
@@ -126,7 +130,8 @@ impl<'a> LevelLp<'a> {
     /// leaves a doubt, again with it: the refinement decides the doubtful levels (envelope 13
     /// of the reference sweep at order 3: 0.011 decade above the reference without it) and
     /// costs 2–3× per solve, on every level when always on (2000 data, orders 0–8: 3.3 s CPU
-    /// always on, 1.3 s on a doubt only).
+    /// always on, 1.3 s on a doubt only).  A level infeasible only with the cuts on `B`
+    /// ([`Level::CutBound`]) is not solved again: refinement does not remove a cut.
     fn level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
         if self.set.thorough {
             return self.level_with(t, events, true);
@@ -189,7 +194,7 @@ impl<'a> LevelLp<'a> {
                 // (another centre or cut floor) must decide it.
                 if self.cuts.group.contains(&B_CUT_GROUP) {
                     self.doubt(events, t, out.status, "infeasible with the positivity cuts on B; level treated as not feasible (the other candidates stand)".into());
-                    return Level::Doubt;
+                    return Level::CutBound;
                 }
                 return Level::Infeasible;
             }
@@ -311,7 +316,7 @@ impl<'a> LevelLp<'a> {
             match self.level(at.exp(), events) {
                 Level::Feasible(x) => return Some((lo, at, vec![(at, x)])),
                 Level::Infeasible => lo = at,
-                Level::Doubt => return None,
+                Level::Doubt | Level::CutBound => return None,
             }
         }
         None
