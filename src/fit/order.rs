@@ -48,7 +48,7 @@ const STALL_LOG10: f64 = 0.0017;
 /// short of `Solved` is solved again with refinement before its status counts, a level is
 /// feasible only when its solution reaches it at the data, and the polynomial candidate's
 /// factors must reach its level).  A stall without a doubt is the envelope's own floor (the
-/// 2000-point jagged envelope stalls at 0.300 decade from order 4 on: neighbouring data differ
+/// 2000-point jagged envelope stalls at 0.300 decade from order 3 on: neighbouring data differ
 /// by up to a factor 2, and every order must cover both).  Such an order is refit with
 /// [`FitSettings::thorough`] and the better of the two kept (the LPs of both are counted).
 fn recheck_stall(
@@ -65,15 +65,15 @@ fn recheck_stall(
             .fold(f64::INFINITY, f64::min)
     };
     let Some(p) = prev else { return of };
-    // An order below at most STALL_LOG10 above its envelope leaves no gain to miss: every
-    // certified r has max log10 |r|/r_min ≥ 0, so no route can improve it by more (the
-    // paper example reaches 0.00000 at order 3; orders 4–8 were each refit for nothing).
     let undecided = of.events.iter().any(|e| {
         matches!(
             e.kind,
             EventKind::LevelNotFeasible | EventKind::DoubtBudgetSpent | EventKind::NoFeasibleLevel
         )
     });
+    // An order below at most STALL_LOG10 above its envelope leaves no gain to miss: every
+    // certified r has max log10 |r|/r_min ≥ 0, so no route can improve it by more (the
+    // paper example reaches 0.00000 at order 3; orders 4–8 were each refit for nothing).
     if settings.thorough
         || !undecided
         || best(&of) < p.max_log - STALL_LOG10
