@@ -41,6 +41,22 @@ pub fn fit_auto(
 /// bisection tolerances.
 const STALL_LOG10: f64 = 0.0017;
 
+/// Whether an order whose fast fit reached `best` (max `log10 |r|/r_min`), over an order below
+/// that reached `prev_max`, must be refit by the thorough route: only a stall (no gain of
+/// [`STALL_LOG10`]) with a level left undecided qualifies, and never an order below already
+/// within [`STALL_LOG10`] of its envelope (every certified `r` has max ≥ 0, so no route can
+/// gain more there; the paper example reaches 0.00000 at order 3 and orders 4–8 were each
+/// refit for nothing).
+fn stall_needs_recheck(events: &[super::SolverEvent], best: f64, prev_max: f64) -> bool {
+    let undecided = events.iter().any(|e| {
+        matches!(
+            e.kind,
+            EventKind::LevelNotFeasible | EventKind::DoubtBudgetSpent | EventKind::NoFeasibleLevel
+        )
+    });
+    undecided && best >= prev_max - STALL_LOG10 && prev_max > STALL_LOG10
+}
+
 /// One more order can never do worse than the order below it (its set of candidates
 /// contains the lower order's), so an order that does not improve is suspect — but only
 /// when its fast fit left a level undecided ([`EventKind::LevelNotFeasible`], a spent doubt
@@ -65,20 +81,7 @@ fn recheck_stall(
             .fold(f64::INFINITY, f64::min)
     };
     let Some(p) = prev else { return of };
-    let undecided = of.events.iter().any(|e| {
-        matches!(
-            e.kind,
-            EventKind::LevelNotFeasible | EventKind::DoubtBudgetSpent | EventKind::NoFeasibleLevel
-        )
-    });
-    // An order below at most STALL_LOG10 above its envelope leaves no gain to miss: every
-    // certified r has max log10 |r|/r_min ≥ 0, so no route can improve it by more (the
-    // paper example reaches 0.00000 at order 3; orders 4–8 were each refit for nothing).
-    if settings.thorough
-        || !undecided
-        || best(&of) < p.max_log - STALL_LOG10
-        || p.max_log <= STALL_LOG10
-    {
+    if settings.thorough || !stall_needs_recheck(&of.events, best(&of), p.max_log) {
         return of;
     }
     let thorough = FitSettings {
@@ -200,4 +203,47 @@ pub fn format_table(rows: &[OrderRow], chosen: usize, tol: f64) -> String {
         "chosen: the smallest order whose mean and max are within {tol} (log10) of the best\n"
     ));
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::{SolverEvent, SolverStatus};
+
+    fn event(kind: EventKind) -> SolverEvent {
+        SolverEvent {
+            order: 5,
+            stage: "minimax".into(),
+            status: SolverStatus::PrimalInfeasible,
+            kind,
+            action: String::new(),
+        }
+    }
+
+    /// The thorough refit runs exactly for a stall with a level left undecided, above the
+    /// envelope's floor: a gain, a stall without a doubt, a reduced-accuracy solution (proved
+    /// afterwards) or an order below already at its envelope never triggers it.
+    #[test]
+    fn recheck_only_a_stall_with_an_undecided_level() {
+        let doubt = [
+            EventKind::LevelNotFeasible,
+            EventKind::DoubtBudgetSpent,
+            EventKind::NoFeasibleLevel,
+        ];
+        for kind in doubt {
+            let ev = [event(EventKind::ReducedAccuracyUsed), event(kind)];
+            assert!(stall_needs_recheck(&ev, 0.3, 0.3), "{kind:?} stall");
+            assert!(stall_needs_recheck(&ev, 0.31, 0.3), "{kind:?} worse");
+            assert!(stall_needs_recheck(&ev, 0.3 - 0.9 * STALL_LOG10, 0.3));
+            assert!(!stall_needs_recheck(&ev, 0.3 - 1.1 * STALL_LOG10, 0.3));
+            assert!(!stall_needs_recheck(&ev, 0.0, 0.5 * STALL_LOG10));
+        }
+        let proved = [
+            event(EventKind::ReducedAccuracyUsed),
+            event(EventKind::CandidateDiscarded),
+            event(EventKind::RefittedChained),
+        ];
+        assert!(!stall_needs_recheck(&proved, 0.3, 0.3));
+        assert!(!stall_needs_recheck(&[], 0.3, 0.3));
+    }
 }
