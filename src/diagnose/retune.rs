@@ -158,30 +158,6 @@ pub fn retune_within(
     mask: Option<&[usize]>,
     rough: bool,
 ) -> NominalRefit {
-    retune_from(m, None, anchor, data, mask, rough)
-}
-
-/// [`retune_within`] on all data, the Levenberg–Marquardt started from the better (lower
-/// cost, residues solved) of the rough start of `m` and `warm`: the same terms as `m` at
-/// other values (an effect written into the retuned root instead of the configured model).
-/// The boxes stay those of `m` and `anchor`; a `warm` of another structure is ignored.
-pub(super) fn retune_warm(
-    m: &PhysicalModel,
-    warm: &PhysicalModel,
-    anchor: &PhysicalModel,
-    data: &Channels,
-) -> NominalRefit {
-    retune_from(m, Some(warm), anchor, data, None, true)
-}
-
-fn retune_from(
-    m: &PhysicalModel,
-    warm: Option<&PhysicalModel>,
-    anchor: &PhysicalModel,
-    data: &Channels,
-    mask: Option<&[usize]>,
-    rough: bool,
-) -> NominalRefit {
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
     let (lin, mut nl) = slots(m, data);
@@ -235,35 +211,11 @@ fn retune_from(
             v_start = solve_linear(&mut start, &lin, data, mask);
         }
     }
-    // A warm start of the same structure replaces the rough one when it fits better: the
-    // rough grid places each mode with the others and the new effect at their start values,
-    // which, far from the data, can leave the iteration in a poor basin (the configured
-    // root's children on the six-mode beam ended above the retuned root's cost).
-    // The boxes of the parameters `anchor` does not hold (the new effect's) are around their
-    // values in the model the iteration starts from.
-    let mut box_model = m;
-    if let Some(w) = warm {
-        let (lin_w, nl_w) = slots(w, data);
-        if lin_w == lin && nl.iter().all(|s| nl_w.contains(s)) {
-            let mut ws = w.clone();
-            let v_w = solve_linear(&mut ws, &lin, data, mask);
-            if v_w < v_start {
-                start = ws;
-                box_model = w;
-            }
-        }
-    }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
     for s in &nl {
         // Bounds around the configured value, so a rough start may not wander further.
-        let (a, b, t) = bounds(
-            box_model,
-            *s,
-            anchor_value(anchor, box_model, *s),
-            w_min,
-            w_max,
-        );
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
         lo.push(a);
         hi.push(b);
         typ.push(t);

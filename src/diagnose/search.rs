@@ -33,7 +33,7 @@ use super::rank::{
     candidate_list, improves, modes_at_band_edge, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC,
 };
 use super::report::{Phases, Step};
-use super::retune::{retune, retune_warm, retune_within, ADDED_NOTE};
+use super::retune::{retune, retune_within, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -165,8 +165,6 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
     let mut level: Vec<usize> = (0..roots.len()).collect();
     // The configured model: the anchor of every refit's boxes.
     let anchor = roots[0].model.clone();
-    // The retuned root (a warm start of the configured model's children).
-    let retuned_root = roots.get(1).unwrap_or(&roots[0]).model.clone();
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let (mut expanded, mut joint_refits) = (0, 0);
@@ -176,26 +174,16 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
             break;
         }
         let mut children: Vec<Node> = Vec::new();
-        // Every node of the level screened first: the configured root's children start
-        // from the retuned root's screen of the same effect when that fits better.
-        let mut screens: Vec<Vec<Screened>> = Vec::new();
         for &ni in &level {
-            let node = &nodes[ni];
+            let node = nodes[ni].clone();
             let p = Problem::new(&node.model, data)?;
             let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
             let cands: Vec<Cand> = candidate_list(&node.model, data)
                 .into_iter()
                 .filter(|c| *c == Cand::Mode || !used.contains(c))
                 .collect();
-            screens.push(phases.time("screen", || p.screen(&cands, node.measures)));
+            let screened = phases.time("screen", || p.screen(&cands, node.measures));
             expanded += 1;
-        }
-        let retuned_screen = level
-            .iter()
-            .position(|i| *i == 1 && depth == 1)
-            .map(|j| screens[j].clone());
-        for (&ni, screened) in level.iter().zip(screens) {
-            let node = nodes[ni].clone();
             // The `beam + 1` best promising candidates are written into the model and every
             // parameter refit jointly: independent refits, run in parallel (rayon's indexed
             // collect keeps their order, so the result does not depend on the scheduling).
@@ -217,20 +205,7 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                 .map(|(sc, go)| {
                     go.then(|| {
                         let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                        // The configured model's children: from the rough start or, when it
-                        // fits better, from the effect written into the retuned root.
-                        let warm = retuned_screen
-                            .iter()
-                            .flatten()
-                            .find(|w| node.configured && w.cand == sc.cand && w.no_fit.is_none());
-                        let r = if let Some(w) = warm {
-                            let warm = add_effect(&retuned_root, &w.cand, &w.mods.theta, data);
-                            retune_warm(&added, &warm, &anchor, data)
-                        } else if node.configured {
-                            retune_within(&added, &anchor, data, None, true)
-                        } else {
-                            retune_within(&added, &anchor, data, None, false)
-                        };
+                        let r = retune_within(&added, &anchor, data, None, node.configured);
                         let v_fit = r.v_after;
                         let n_params = r.n_params;
                         settle(r.model, &anchor, data).map(|(model, m)| (model, m, v_fit, n_params))

@@ -18,13 +18,13 @@ pub(super) enum Term {
     Mode(usize),
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub(super) enum Lin {
     Out(Term, usize),
     Feed(usize, usize),
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub(super) enum Nl {
     ModeW(usize),
     ModeZ(usize),
