@@ -13,6 +13,7 @@ use super::retune::retune_within;
 use super::search::Node;
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
+use rayon::prelude::*;
 
 /// Drops the effects of `node` the data do not need (see the module docs), refitting the
 /// rest; `nodes` are the search's nodes (reused models of the smaller sets).  Returns the
@@ -26,11 +27,18 @@ pub fn eliminate(
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut dropped = Vec::new();
     while !node.effects.is_empty() {
+        // The refits without each effect are independent: in parallel (rayon's indexed
+        // collect keeps their order, so the weakest is picked as in a serial loop).
+        let refits: Vec<_> = (0..node.effects.len())
+            .into_par_iter()
+            .map(|j| {
+                let others = without(&node.effects, j);
+                let wo = model_of(base, &others, nodes, data);
+                retune_within(&wo, base, data, None, false)
+            })
+            .collect();
         let mut worst: Option<(usize, f64, PhysicalModel, f64)> = None;
-        for j in 0..node.effects.len() {
-            let others = without(&node.effects, j);
-            let wo = model_of(base, &others, nodes, data);
-            let r = retune_within(&wo, base, data, None, false);
+        for (j, r) in refits.into_iter().enumerate() {
             let n_e = node.effects[j].0.n_params(data.n_ch());
             let d_bic = 2.0 * (r.v_after - node.v_fit) - n_e as f64 * ln2f;
             if d_bic <= MIN_DELTA_BIC && worst.as_ref().is_none_or(|w| d_bic < w.1) {

@@ -17,6 +17,7 @@ use super::retune::{cost, retune_within};
 use super::search::{add_effect, Node};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
+use rayon::prelude::*;
 
 /// How many next-best effect sets are tried when the holdout drops part of the chosen one.
 pub const MAX_ALTERNATIVES: usize = 3;
@@ -194,9 +195,14 @@ pub fn holdouts(
         )
     };
     let full = node.model.clone();
-    let full_ho = part(&full, &fit, &ho);
-    let full_hi = extrap.then(|| part(&full, &low, &high));
+    let (full_ho, full_hi) = rayon::join(
+        || part(&full, &fit, &ho),
+        || extrap.then(|| part(&full, &low, &high)),
+    );
+    // Each effect's refits are independent of the others': in parallel (indexed collect,
+    // the same rows in the same order).
     (0..node.effects.len())
+        .into_par_iter()
         .map(|j| {
             let others = without(&node.effects, j);
             let c = node.effects[j].0;
