@@ -94,8 +94,12 @@ pub fn v_matrix(
     r: Complex64,
     la: f64,
 ) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
-    let p = parts(at)?;
-    let n = at.m.nrows();
+    Ok(v_of_parts(&parts(at)?, r, la))
+}
+
+/// [`v_matrix`] from its `r`-free [`Parts`].
+fn v_of_parts(p: &Parts, r: Complex64, la: f64) -> DMatrix<Complex64> {
+    let n = p.minv.nrows();
     let mut v = DMatrix::zeros(n + 3, n + 2);
     v.view_mut((1, 0), (n, n)).copy_from(&(&p.minv * r));
     v[(0, n + 1)] = r * p.j;
@@ -104,7 +108,7 @@ pub fn v_matrix(
     v.view_mut((n + 2, 0), (1, n)).copy_from(&p.c_minv);
     v[(n + 2, n)] = Complex64::new(la, 0.0);
     v[(n + 2, n + 1)] = p.v22;
-    Ok(v)
+    v
 }
 
 /// `F_L(V, φ⁻¹) = V₁₁ + V₁₂(φ − V₂₂)⁻¹V₂₁` (eq. (15) and Lemma 1), `(n+2)×(n+1)`, for a
@@ -206,12 +210,11 @@ fn status_rank(s: MuStatus) -> u8 {
 
 /// `F_L(V(1), φ⁻¹) = E + a·bᴴ` when `M̃(jω)` is diagonal (a `[physical]` model, one row per
 /// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
-/// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃` or where the parts fail.
-fn low_rank(at: &FactorsAt, phi: Complex64, la: f64) -> Option<LowRank> {
+/// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃`.
+fn low_rank(at: &FactorsAt, p: &Parts, phi: Complex64, la: f64) -> Option<LowRank> {
     if !crate::system::linalg::diagonal_fast_path(&at.m) {
         return None;
     }
-    let p = parts(at).ok()?;
     let n = at.m.nrows();
     let k = phi - p.v22;
     let mut a = nalgebra::DVector::zeros(n + 2);
@@ -250,7 +253,9 @@ pub fn r_min_noisy(
     la: f64,
     settings: &BisectionSettings,
 ) -> std::result::Result<NoisyDatum, NoisyFailure> {
-    let m1 = gamma_lft(at, phi, Complex64::new(1.0, 0.0), la)?;
+    // The parts serve both M(1) and its low-rank description: one solve with M̃ per datum.
+    let p = parts(at)?;
+    let m1 = lower_lft(&v_of_parts(&p, Complex64::new(1.0, 0.0), la), phi)?;
     let n = at.m.nrows();
     let a1 = at.a1_limit();
     let s = FullPlusScalar::gamma(n);
@@ -271,7 +276,7 @@ pub fn r_min_noisy(
     }
     let mut scaled = m1.clone();
     let mut hint: Option<f64> = None;
-    let structure = low_rank(at, phi, la);
+    let structure = low_rank(at, &p, phi, la);
     let mut lr = structure.clone();
     // μ(ρ) and d ln μ/d ln ρ.
     let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
