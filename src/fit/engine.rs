@@ -273,7 +273,7 @@ impl<'a> OrderSearch<'a> {
             .fold(f64::INFINITY, f64::min);
         let t_cap = if t_best.is_finite() {
             match set.objective {
-                Objective::Minimax => t_best * (1.0 + set.bisection_tol).powi(2),
+                Objective::Minimax => t_best * set.level_resolution(),
                 Objective::Area => t_best * set.area_slack * set.area_slack,
             }
         } else {

@@ -146,6 +146,15 @@ impl Default for FitSettings {
     }
 }
 
+impl FitSettings {
+    /// The factor `(1 + bisection_tol)²` on a level `t` (of `|r|²/r_min²`) within which the
+    /// searches do not tell levels apart: a level counts as reached by a solution within it,
+    /// and the best level known, times it, caps the next candidates' search.
+    pub fn level_resolution(&self) -> f64 {
+        (1.0 + self.bisection_tol).powi(2)
+    }
+}
+
 /// A certified fit.
 #[derive(Debug, Clone, Serialize)]
 pub struct FitResult {

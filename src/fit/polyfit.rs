@@ -183,7 +183,7 @@ fn factor_lowest(
                     let c = prep.score(z, Origin::PolynomialMinimax { t: lev.exp() });
                     // The level is proved as `A/B` reaches it (`LevelLp::level`); the factors
                     // must reach it too, or the candidate is not the level's.
-                    let reach = (1.0 + set.bisection_tol).powi(2) * (1.0 + 1e-6);
+                    let reach = set.level_resolution() * (1.0 + 1e-6);
                     if c.coverage >= 1.0 - 1e-6 && c.a1_ratio >= 1.0 - 1e-6 {
                         if c.t <= lev.exp() * reach {
                             return Some(c);

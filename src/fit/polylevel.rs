@@ -98,7 +98,7 @@ impl<'a> LevelLp<'a> {
             data,
             init: initial_points(&prep.grid, 40),
             mask: Vec::new(),
-            cuts: Rows::empty(),
+            cuts: Rows::default(),
             lp_solves: 0,
             b_cut_used: false,
         }
@@ -155,9 +155,9 @@ impl<'a> LevelLp<'a> {
         let eqs = vec![(eq, 1.0)];
         let cost = vec![0.0; nv];
         // Relative level rows of this level (they hold at `t` only).
-        let mut level_cuts = Rows::empty();
+        let mut level_cuts = Rows::default();
         // A level is proved when the solution reaches it within the search's resolution.
-        let reach_tol = (1.0 + set.bisection_tol).powi(2);
+        let reach_tol = set.level_resolution();
         for _ in 0..CUT_ROUNDS {
             let r = level_rows(
                 n,

@@ -18,21 +18,20 @@ pub(super) fn disk(x: f64, x0: f64) -> f64 {
 
 /// Rows `row·v ≥ rhs` (variables `[a; b]`), their groups and grid points; the level rows
 /// (`A ≤ t·upper·B`) are appended by [`level_rows`], the positivity cuts by [`cut_rows`].
+#[derive(Default)]
 pub(super) struct Rows {
     pub(super) rows: Vec<(Vec<f64>, f64)>,
     pub(super) group: Vec<u32>,
     pub(super) point: Vec<usize>,
 }
 
-impl Rows {
-    /// No rows.
-    pub(super) fn empty() -> Self {
-        Self {
-            rows: Vec::new(),
-            group: Vec::new(),
-            point: Vec::new(),
-        }
-    }
+/// Appends the row `ca·A(u) + cb·B(u) ≥ 0` divided by the solution's magnitude `mag` there
+/// (a relative row: [`relative_cuts`], [`relative_level_rows`]).
+fn push_relative(r: &mut Rows, n: usize, u: f64, (ca, cb): (f64, f64), mag: f64, g: u32, p: usize) {
+    let row: Vec<f64> = ab_row(n, u, ca, cb).iter().map(|v| v / mag).collect();
+    r.rows.push((row, 0.0));
+    r.group.push(g);
+    r.point.push(p);
 }
 
 fn push(r: &mut Rows, mut row: Vec<f64>, rhs: f64, g: u32, p: usize) {
@@ -270,10 +269,7 @@ pub(super) fn relative_cuts(
             if !(slack > -NEAR * mag && mag > 0.0) || done.contains(&(group, i)) {
                 continue;
             }
-            let row: Vec<f64> = ab_row(n, u, ca, cb).iter().map(|v| v / mag).collect();
-            cuts.rows.push((row, 0.0));
-            cuts.group.push(group);
-            cuts.point.push(i);
+            push_relative(cuts, n, u, (ca, cb), mag, group, i);
         }
     }
     cuts.rows.len() > before
@@ -332,10 +328,7 @@ pub(super) fn relative_level_rows(
         if !(slack < NEAR * mag && mag > 0.0) || done.contains(&i) {
             continue;
         }
-        let row: Vec<f64> = ab_row(n, u, -1.0, t * up).iter().map(|v| v / mag).collect();
-        out.rows.push((row, 0.0));
-        out.group.push(LEVEL_RELATIVE_GROUP);
-        out.point.push(i);
+        push_relative(out, n, u, (-1.0, t * up), mag, LEVEL_RELATIVE_GROUP, i);
     }
     out.rows.len() > before
 }
@@ -378,9 +371,9 @@ mod tests {
             &grid,
             x0,
             t,
-            &Rows::empty(),
-            &Rows::empty(),
-            &Rows::empty(),
+            &Rows::default(),
+            &Rows::default(),
+            &Rows::default(),
         );
         assert!(max_violation(&level.rows, &x) <= 1e-9);
         let reached = reached_level(1, &x, &grid, x0);
@@ -389,7 +382,7 @@ mod tests {
             "{reached}"
         );
         assert!(reached > 1.9 * t);
-        let mut rel = Rows::empty();
+        let mut rel = Rows::default();
         assert!(relative_level_rows(1, &x, &grid, x0, t, &mut rel));
         assert_eq!((rel.rows.len(), rel.point[0]), (1, 0));
         // Violation (A − t·U·B)/(|A| + t·U·|B|) = 1e-9/3e-9.
