@@ -121,9 +121,7 @@ impl Problem<'_> {
             }
         }
     }
-}
 
-impl Problem<'_> {
     /// Linear least squares of the residual `e = G_d − G_m` (`gm`: the model's response) on
     /// a basis `ψ` over the channels `chs` and the data in `mask`, noise-weighted:
     /// `ρ = Re Σ ψ* e w / Σ |ψ|² w` (0 when the basis vanishes or the sum is not finite).
@@ -199,9 +197,7 @@ impl Problem<'_> {
             &Default::default(),
         )
     }
-}
 
-impl Problem<'_> {
     /// The cost with a delay `τ_j = (j + ½)·step` (`j < n`) on the channels of `sel`, the
     /// model otherwise `gm`: `(V(τ_j), τ_j)`.  A delay multiplies the model by `e^{−jωτ}`,
     /// so along the uniform grid the factor at each datum advances by one rotation
