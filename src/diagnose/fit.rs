@@ -14,6 +14,45 @@ pub struct LmResult {
     pub jtj: DMatrix<f64>,
 }
 
+/// When a fit stops.
+#[derive(Debug, Clone, Copy)]
+pub struct LmSettings {
+    /// Most iterations (accepted steps).
+    pub max_iter: usize,
+    /// Absolute tolerance on the cost: the fit stops once an accepted, nearly undamped step
+    /// (damping `λ ≤ 1e-4`) lowered `V` by less than `v_tol` and the geometric series of
+    /// the steps to come (their decrease falling by the ratio of the last two,
+    /// `d q/(1 − q)`) is below `v_tol` too.  `0` stops only on a step that gains nothing
+    /// (relative `1e-12`).
+    pub v_tol: f64,
+}
+
+impl LmSettings {
+    /// `max_iter` iterations, no absolute tolerance.
+    pub fn exact(max_iter: usize) -> Self {
+        Self {
+            max_iter,
+            v_tol: 0.0,
+        }
+    }
+
+    /// For a cost that is a `−ln L` (`V = Σ|e|²/σ²`): stop when what is left to gain is
+    /// below [`V_TOL`] — a hundredth of a unit of `V`, a thousandth of the smallest BIC
+    /// difference `diagnose` acts on (6).
+    pub fn likelihood(max_iter: usize) -> Self {
+        Self {
+            max_iter,
+            v_tol: V_TOL,
+        }
+    }
+}
+
+/// The absolute cost tolerance of [`LmSettings::likelihood`].
+pub const V_TOL: f64 = 1e-2;
+
+/// Damping below which a step counts as Gauss–Newton's own (the tolerance applies).
+const LAMBDA_GN: f64 = 1e-4;
+
 /// Minimizes `Σ r(θ)²`.  `typ[i]` is a typical magnitude of `θ_i` (for the finite-difference
 /// step).  Deterministic.
 pub fn lm<F>(f: F, theta0: &[f64], typ: &[f64], max_iter: usize) -> LmResult
@@ -27,7 +66,7 @@ where
         typ,
         &vec![f64::NEG_INFINITY; n],
         &vec![f64::INFINITY; n],
-        max_iter,
+        &LmSettings::exact(max_iter),
     )
 }
 
@@ -44,12 +83,12 @@ pub fn lm_box<F>(
     typ: &[f64],
     lo: &[f64],
     hi: &[f64],
-    max_iter: usize,
+    settings: &LmSettings,
 ) -> LmResult
 where
     F: Fn(&[f64], &mut Vec<f64>),
 {
-    lm_box_jac(f, &|_, _, _| false, theta0, typ, lo, hi, max_iter)
+    lm_box_jac(f, &|_, _, _| false, theta0, typ, lo, hi, settings)
 }
 
 /// A Jacobian supplied by the caller: `jac(θ, r(θ), J)` fills `J` (`∂r/∂θ`, rows of `r`,
@@ -67,7 +106,7 @@ pub fn lm_box_jac<F>(
     typ: &[f64],
     lo: &[f64],
     hi: &[f64],
-    max_iter: usize,
+    settings: &LmSettings,
 ) -> LmResult
 where
     F: Fn(&[f64], &mut Vec<f64>),
@@ -115,9 +154,13 @@ where
     let mut trial = Vec::new();
     let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
     let mut prev_step: Option<Vec<f64>> = None;
-    for _ in 0..max_iter {
-        let jtj = jac.transpose() * &jac;
-        let g = jac.transpose() * DVector::from_column_slice(&r);
+    // The decrease of the last accepted step.
+    let mut prev_drop: Option<f64> = None;
+    for _ in 0..settings.max_iter {
+        // One transposed copy for both products (the blocked product beats dot products).
+        let jt = jac.transpose();
+        let jtj = &jt * &jac;
+        let g = &jt * DVector::from_column_slice(&r);
         let dmax = (0..n).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
         // Active bounds: a parameter on a bound that the descent direction pushes outward is
         // held there (its row and column leave the step), so the projection of the step
@@ -154,6 +197,7 @@ where
             f(&cand, &mut trial);
             let vt = ss(&trial);
             if vt < v {
+                let v_old = v;
                 let mut rel = (v - vt) / v.max(1e-300);
                 let taken: Vec<f64> = (0..n).map(|i| cand[i] - theta[i]).collect();
                 theta = cand;
@@ -187,6 +231,22 @@ where
                 if rel < 1e-12 {
                     improved = false;
                 }
+                // What is left to gain, when the decreases keep falling by their last ratio.
+                let drop = v_old - v;
+                if let Some(p) = prev_drop {
+                    let q = drop / p;
+                    // Only near Gauss–Newton's own step: a heavily damped step gains
+                    // little because it is short, not because little is left.
+                    let undamped = lambda <= LAMBDA_GN;
+                    if undamped
+                        && drop < settings.v_tol
+                        && q < 1.0
+                        && drop * q / (1.0 - q) < settings.v_tol
+                    {
+                        improved = false;
+                    }
+                }
+                prev_drop = Some(drop);
                 break;
             }
             lambda *= 4.0;
@@ -246,7 +306,7 @@ mod tests {
             r.clear();
             r.push(t[0] - 3.0);
         };
-        let res = lm_box(f, &[0.5], &[1.0], &[0.0], &[2.0], 100);
+        let res = lm_box(f, &[0.5], &[1.0], &[0.0], &[2.0], &LmSettings::exact(100));
         assert_eq!(res.theta[0], 2.0);
         assert!((res.v - 1.0).abs() < 1e-12);
     }

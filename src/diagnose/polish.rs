@@ -21,7 +21,7 @@
 
 use super::channels::Channels;
 use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
-use super::fit::lm_box;
+use super::fit::{lm_box, LmSettings};
 use super::problem::{Measures, Problem};
 use super::slots::{
     anchor_value, bounds, design, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl,
@@ -132,7 +132,7 @@ pub fn polish(m: &PhysicalModel, anchor: &PhysicalModel, data: &Channels) -> Opt
                 mu * (q - HINGE).max(0.0)
             }));
         };
-        let res = lm_box(f, &theta, &typ, &lo, &hi, ITER);
+        let res = lm_box(f, &theta, &typ, &lo, &hi, &LmSettings::likelihood(ITER));
         let (v, out) = score(&par.residual(m, &res.theta, data, &all));
         if v > budget {
             break;

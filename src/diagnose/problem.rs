@@ -6,7 +6,7 @@
 use super::candidates::Cand;
 use super::channels::Channels;
 use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
-use super::fit::lm_box;
+use super::fit::{lm_box, LmSettings};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectPath, PhysicalModel};
 use nalgebra::DMatrix;
@@ -311,7 +311,7 @@ impl<'a> Problem<'a> {
             &typ,
             &lo,
             &hi,
-            80,
+            &LmSettings::likelihood(80),
         );
         (
             Mods {

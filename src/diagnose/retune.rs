@@ -23,7 +23,7 @@
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use super::channels::Channels;
-use super::fit::lm_box_jac;
+use super::fit::{lm_box_jac, LmSettings};
 use super::slots::{
     anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
     MODE_BOX,
@@ -255,7 +255,7 @@ pub fn retune_within(
             &typ,
             &lo,
             &hi,
-            200,
+            &LmSettings::likelihood(200),
         );
         model_at(&res.theta)
     };

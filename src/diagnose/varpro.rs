@@ -100,79 +100,111 @@ impl VarPro<'_> {
         mm
     }
 
-    /// `∂A/∂θ_k` as `(column, derivative)` pairs (the columns it changes), analytic where
-    /// the module documentation says so, else a forward difference of the design matrix.
+    /// Accumulates `A_k = ∂A/∂θ_k` against the solution and the residual: adds
+    /// `sign·A_k x` into `u` (one column of `U`, every row) and `sign·A_kᵀ r` into `t` (one
+    /// column of `T`, a row per linear slot).  Analytic where the module documentation says
+    /// so, else a forward difference of the design matrix.
+    #[allow(clippy::too_many_arguments)]
     fn d_design(
         &self,
         mm: &PhysicalModel,
         a: &DMatrix<f64>,
         th: &[f64],
         k: usize,
-    ) -> Vec<(usize, DVector<f64>)> {
+        x: &DVector<f64>,
+        res: &DVector<f64>,
+        sign: f64,
+        u: &mut [f64],
+        t: &mut [f64],
+    ) {
         let rows_per_ch = 2 * self.mask.len();
-        let s_at =
-            |row: usize| Complex64::new(0.0, self.data.omega[self.mask[(row % rows_per_ch) / 2]]);
-        // Columns of term `t`, with a complex factor per row (`None`: the row is untouched).
-        let scaled = |t: Term, f: &dyn Fn(usize) -> Option<Complex64>| {
-            self.lin
+        // Columns of term `tm` on the channels `chs`, with a complex factor per frequency.
+        let mut scaled = |tm: Term, chs: &dyn Fn(usize) -> bool, f: &dyn Fn(usize) -> Complex64| {
+            for (j, _) in self
+                .lin
                 .iter()
                 .enumerate()
-                .filter(|(_, l)| matches!(l, Lin::Out(u, _) if *u == t))
-                .map(|(j, _)| {
-                    let mut d = DVector::<f64>::zeros(a.nrows());
-                    for row in (0..a.nrows()).step_by(2) {
-                        if let Some(fac) = f(row) {
-                            let c = Complex64::new(a[(row, j)], a[(row + 1, j)]) * fac;
-                            d[row] = c.re;
-                            d[row + 1] = c.im;
-                        }
+                .filter(|(_, l)| matches!(l, Lin::Out(v, _) if *v == tm))
+            {
+                let (col, xj) = (a.column(j), sign * x[j]);
+                let mut dot = 0.0;
+                for ch in (0..self.data.n_ch()).filter(|c| chs(*c)) {
+                    let base = ch * rows_per_ch;
+                    for (q, kq) in (0..self.mask.len()).map(|q| (q, self.mask[q])) {
+                        let row = base + 2 * q;
+                        let c = Complex64::new(col[row], col[row + 1]) * f(kq);
+                        u[row] += xj * c.re;
+                        u[row + 1] += xj * c.im;
+                        dot += c.re * res[row] + c.im * res[row + 1];
                     }
-                    (j, d)
-                })
-                .collect::<Vec<_>>()
+                }
+                t[j] += sign * dot;
+            }
         };
         match self.nl[k] {
             Nl::ModeW(i) | Nl::ModeZ(i) => {
                 let (w, z) = (mm.mode[i].omega_n, mm.mode[i].zeta);
                 let by_w = matches!(self.nl[k], Nl::ModeW(_));
-                scaled(Term::Mode(i), &|row| {
-                    let s = s_at(row);
-                    let den = s * s + 2.0 * z * w * s + w * w;
-                    let num = if by_w {
-                        2.0 * z * w * s + 2.0 * w * w
-                    } else {
-                        2.0 * z * w * s
-                    };
-                    Some(-num / den)
-                })
+                // The factor depends on the frequency only: computed once per line.
+                let fac: Vec<Complex64> = self
+                    .data
+                    .omega
+                    .iter()
+                    .map(|om| {
+                        let s = Complex64::new(0.0, *om);
+                        let den = s * s + 2.0 * z * w * s + w * w;
+                        let num = if by_w {
+                            2.0 * z * w * s + 2.0 * w * w
+                        } else {
+                            2.0 * z * w * s
+                        };
+                        -num / den
+                    })
+                    .collect();
+                scaled(Term::Mode(i), &|_| true, &|kq| fac[kq]);
             }
-            Nl::In(t, i) => {
-                let b = gains_of(mm, t).1.to_vec(mm.n_inputs())[i];
+            Nl::In(tm, i) => {
+                let b = gains_of(mm, tm).1.to_vec(mm.n_inputs())[i];
                 if b != 0.0 && b.is_finite() {
                     let inv = Complex64::new(1.0 / b, 0.0);
-                    return scaled(t, &|row| {
-                        (self.data.entries[row / rows_per_ch].1 == i).then_some(inv)
-                    });
+                    let entries = &self.data.entries;
+                    scaled(tm, &|ch| entries[ch].1 == i, &|_| inv);
+                } else {
+                    self.forward_difference(a, th, k, x, res, sign, u, t);
                 }
-                self.forward_difference(a, th, k)
             }
-            Nl::RigidPole(_) | Nl::Delay(_) | Nl::LogEffect(_) => self.forward_difference(a, th, k),
+            Nl::RigidPole(_) | Nl::Delay(_) | Nl::LogEffect(_) => {
+                self.forward_difference(a, th, k, x, res, sign, u, t)
+            }
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn forward_difference(
         &self,
         a: &DMatrix<f64>,
         th: &[f64],
         k: usize,
-    ) -> Vec<(usize, DVector<f64>)> {
+        x: &DVector<f64>,
+        res: &DVector<f64>,
+        sign: f64,
+        u: &mut [f64],
+        t: &mut [f64],
+    ) {
         let h = 1e-7 * th[k].abs().max(self.typ[k]).max(1e-300);
-        let mut t = th.to_vec();
-        t[k] += h;
-        let (ah, _) = design(&self.model(&t), self.lin, self.data, self.mask);
-        (0..a.ncols())
-            .map(|j| (j, (ah.column(j) - a.column(j)) / h))
-            .collect()
+        let mut tt = th.to_vec();
+        tt[k] += h;
+        let (ah, _) = design(&self.model(&tt), self.lin, self.data, self.mask);
+        for j in 0..a.ncols() {
+            let (c1, c0) = (ah.column(j), a.column(j));
+            let (xj, mut dot) = (sign * x[j], 0.0);
+            for row in 0..a.nrows() {
+                let d = (c1[row] - c0[row]) / h;
+                u[row] += xj * d;
+                dot += d * res[row];
+            }
+            t[j] += sign * dot;
+        }
     }
 
     /// Fills `jac` with `∂r/∂θ` at `θ` (the residual `r = y − A x`, rows as
@@ -197,49 +229,57 @@ impl VarPro<'_> {
                 x[*j] = z[i] / b.scale[i];
             }
         }
-        if x.iter().any(|v| !v.is_finite()) || jac.nrows() != a.nrows() {
+        let m = a.nrows();
+        if x.iter().any(|v| !v.is_finite()) || jac.nrows() != m {
             return false;
         }
         let res = &y - &a * &x;
-        // U = [A_k x]_k (every row), T = [A_kᵀ r]_k: one column per parameter, so the
-        // projections below are two matrix products per block.
+        // `∂r/∂θ = −(U + Q (Z − QᵀU))`, `U = [A_k x]_k`, `Z = R⁻ᵀ S T`, `T = [A_kᵀ r]_k`:
+        // `U` and `T` are accumulated negated, so the sign needs no pass of its own.
         let kk = self.nl.len();
-        let mut u_all = DMatrix::<f64>::zeros(a.nrows(), kk);
+        let mut u = DMatrix::<f64>::zeros(m, kk);
         let mut t_all = DMatrix::<f64>::zeros(n, kk);
         for k in 0..kk {
-            for (j, d) in &self.d_design(&mm, &a, th, k) {
-                u_all.column_mut(k).axpy(x[*j], d, 1.0);
-                t_all[(*j, k)] = d.dot(&res);
-            }
+            self.d_design(
+                &mm,
+                &a,
+                th,
+                k,
+                &x,
+                &res,
+                -1.0,
+                u.column_mut(k).as_mut_slice(),
+                t_all.column_mut(k).as_mut_slice(),
+            );
         }
-        let m = a.nrows();
-        if let [b] = fact.as_slice() {
-            if b.rows.len() == m && b.rows.iter().enumerate().all(|(i, r)| i == *r) {
-                // One block over every row (one output, or SISO): no gather, no scatter.
-                let w = DMatrix::from_fn(n, kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
-                let Some(z) = b.r.tr_solve_upper_triangular(&w) else {
-                    return false;
-                };
-                let c = z - b.q.tr_mul(&u_all);
-                jac.copy_from(&u_all);
-                jac.gemm(1.0, &b.q, &c, 1.0);
-                jac.neg_mut();
-                return jac.iter().all(|v| v.is_finite());
-            }
-        }
-        jac.fill(0.0);
-        for b in &fact {
-            let ub = DMatrix::from_fn(b.rows.len(), kk, |i, k| u_all[(b.rows[i], k)]);
-            let w = DMatrix::from_fn(b.cols.len(), kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
-            // −(P⊥ U + Q R⁻ᵀ S T) = −(U + Q (Z − Qᵀ U)), Z = R⁻ᵀ S T.
+        let single = matches!(fact.as_slice(), [b] if b.rows.len() == m
+            && b.rows.iter().enumerate().all(|(i, r)| i == *r));
+        if single {
+            // One block over every row (one output, or SISO): no gather, no scatter.
+            let b = &fact[0];
+            let w = DMatrix::from_fn(n, kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
             let Some(z) = b.r.tr_solve_upper_triangular(&w) else {
                 return false;
             };
-            let c = z - b.q.tr_mul(&ub);
+            // `Qᵀ U` through an explicit transpose (Q is thin): the blocked product, not
+            // one dot product per entry.
+            let c = z - b.q.transpose() * &u;
+            std::mem::swap(jac, &mut u);
+            jac.gemm(1.0, &b.q, &c, 1.0);
+            return jac.iter().all(|v| v.is_finite());
+        }
+        jac.fill(0.0);
+        for b in &fact {
+            let ub = DMatrix::from_fn(b.rows.len(), kk, |i, k| u[(b.rows[i], k)]);
+            let w = DMatrix::from_fn(b.cols.len(), kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
+            let Some(z) = b.r.tr_solve_upper_triangular(&w) else {
+                return false;
+            };
+            let c = z - b.q.transpose() * &ub;
             let col = ub + &b.q * c;
             for k in 0..kk {
                 for (i, row) in b.rows.iter().enumerate() {
-                    jac[(*row, k)] = -col[(i, k)];
+                    jac[(*row, k)] = col[(i, k)];
                 }
             }
         }
