@@ -196,8 +196,12 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
     print_dropped(d);
     print_alternatives(d);
     print_peaks(d);
+    let given_up = match d.search.refits_given_up {
+        0 => String::new(),
+        k => format!(" ({k} given up, far above their reference)"),
+    };
     println!(
-        "\nsearch: {} nodes expanded, {} joint refits, {} s (beam {})",
+        "\nsearch: {} nodes expanded, {} joint refits{given_up}, {} s (beam {})",
         d.search.nodes_expanded,
         d.search.joint_refits,
         sig(d.search.seconds),

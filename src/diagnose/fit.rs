@@ -12,6 +12,9 @@ pub struct LmResult {
     pub v: f64,
     /// `JᵀJ` at the optimum (for the covariance `(2JᵀJ)⁻¹` when `v` is a `−ln L`).
     pub jtj: DMatrix<f64>,
+    /// The fit gave up ([`LmSettings::give_up`]): `theta` is where it stopped, not an
+    /// optimum.
+    pub abandoned: bool,
 }
 
 /// When a fit stops.
@@ -22,9 +25,12 @@ pub struct LmSettings {
     /// Absolute tolerance on the cost: the fit stops once an accepted, nearly undamped step
     /// (damping `λ ≤ 1e-4`) lowered `V` by less than `v_tol` and the geometric series of
     /// the steps to come (their decrease falling by the ratio of the last two,
-    /// `d q/(1 − q)`) is below `v_tol` too.  `0` stops only on a step that gains nothing
-    /// (relative `1e-12`).
+    /// `d q/(1 − q)`, an estimate: half of `v_tol` leaves room for its error) is below
+    /// `v_tol / 2`.  `0` stops only on a step that gains nothing (relative `1e-12`).
     pub v_tol: f64,
+    /// `(k, v)`: give up when the cost is still above `v` after `k` iterations (a fit whose
+    /// result only counts below `v`, and that is not getting there).
+    pub give_up: Option<(usize, f64)>,
 }
 
 impl LmSettings {
@@ -33,6 +39,7 @@ impl LmSettings {
         Self {
             max_iter,
             v_tol: 0.0,
+            give_up: None,
         }
     }
 
@@ -43,6 +50,7 @@ impl LmSettings {
         Self {
             max_iter,
             v_tol: V_TOL,
+            give_up: None,
         }
     }
 }
@@ -147,6 +155,7 @@ where
             theta,
             v,
             jtj: DMatrix::zeros(n, n),
+            abandoned: false,
         };
     }
     jacobian(&theta, &r, &mut jac, &mut rp);
@@ -156,7 +165,12 @@ where
     let mut prev_step: Option<Vec<f64>> = None;
     // The decrease of the last accepted step.
     let mut prev_drop: Option<f64> = None;
-    for _ in 0..settings.max_iter {
+    let mut abandoned = false;
+    for iter in 0..settings.max_iter {
+        if settings.give_up.is_some_and(|(k, above)| iter == k && v > above) {
+            abandoned = true;
+            break;
+        }
         // One transposed copy for both products (the blocked product beats dot products).
         let jt = jac.transpose();
         let jtj = &jt * &jac;
@@ -198,6 +212,7 @@ where
             let vt = ss(&trial);
             if vt < v {
                 let v_old = v;
+                let mut extrapolated = false;
                 let mut rel = (v - vt) / v.max(1e-300);
                 let taken: Vec<f64> = (0..n).map(|i| cand[i] - theta[i]).collect();
                 theta = cand;
@@ -221,6 +236,7 @@ where
                         let ve = ss(&trial);
                         if ve < v {
                             rel += (v - ve) / v.max(1e-300);
+                            extrapolated = true;
                             theta = ext;
                             std::mem::swap(&mut r, &mut trial);
                             v = ve;
@@ -232,8 +248,9 @@ where
                     improved = false;
                 }
                 // What is left to gain, when the decreases keep falling by their last ratio.
+                // An extrapolated jump is no term of the series: the ratio starts afresh.
                 let drop = v_old - v;
-                if let Some(p) = prev_drop {
+                if let Some(p) = prev_drop.filter(|_| !extrapolated) {
                     let q = drop / p;
                     // Only near Gauss–Newton's own step: a heavily damped step gains
                     // little because it is short, not because little is left.
@@ -241,12 +258,12 @@ where
                     if undamped
                         && drop < settings.v_tol
                         && q < 1.0
-                        && drop * q / (1.0 - q) < settings.v_tol
+                        && drop * q / (1.0 - q) < 0.5 * settings.v_tol
                     {
                         improved = false;
                     }
                 }
-                prev_drop = Some(drop);
+                prev_drop = (!extrapolated).then_some(drop);
                 break;
             }
             lambda *= 4.0;
@@ -257,7 +274,12 @@ where
         jacobian(&theta, &r, &mut jac, &mut rp);
     }
     let jtj = jac.transpose() * &jac;
-    LmResult { theta, v, jtj }
+    LmResult {
+        theta,
+        v,
+        jtj,
+        abandoned,
+    }
 }
 
 #[cfg(test)]
@@ -297,6 +319,56 @@ mod tests {
         assert!(res.theta[0].abs() < 1e-5, "t = {}", res.theta[0]);
         assert!((res.v - a * a).abs() < 1e-11, "V = {}", res.v);
         assert!(evals.get() < 120, "{} evaluations", evals.get());
+    }
+
+    /// The likelihood tolerance stops a linearly converging fit (the function above with
+    /// `ρ = 2AB = 0.24`, too fast for the extrapolation) once what is left (the exact
+    /// minimum is `V = A²`) is below `V_TOL`, in fewer evaluations than the exact stop.
+    #[test]
+    fn the_likelihood_tolerance_stops_within_it_of_the_minimum() {
+        let (a, b) = (1.5, 0.08);
+        let run = |settings: LmSettings| {
+            let evals = std::cell::Cell::new(0);
+            let f = |t: &[f64], r: &mut Vec<f64>| {
+                evals.set(evals.get() + 1);
+                r.clear();
+                r.extend([t[0], a - b * t[0] * t[0]]);
+            };
+            let res = lm_box(f, &[1.0], &[1.0], &[-10.0], &[10.0], &settings);
+            (res, evals.get())
+        };
+        let (exact, n_exact) = run(LmSettings::exact(400));
+        let (tol, n_tol) = run(LmSettings::likelihood(400));
+        assert!(!tol.abandoned && !exact.abandoned);
+        assert!(tol.v - a * a < V_TOL, "V = {} (minimum {})", tol.v, a * a);
+        assert!(tol.v - a * a > 1e-9, "it should stop before the exact minimum");
+        assert!(n_tol < n_exact, "{n_tol} evaluations, exact {n_exact}");
+    }
+
+    /// A fit told to give up above a cost it cannot reach stops after the given number of
+    /// iterations and says so; one whose threshold it beats runs to the minimum.
+    #[test]
+    fn a_fit_gives_up_only_above_its_threshold() {
+        let iters = std::cell::Cell::new(0);
+        let f = |t: &[f64], r: &mut Vec<f64>| {
+            iters.set(iters.get() + 1);
+            r.clear();
+            // Rosenbrock: a curved valley, many iterations from (−1.2, 1).
+            r.extend([10.0 * (t[1] - t[0] * t[0]), 1.0 - t[0]]);
+        };
+        let settings = |above: f64| LmSettings {
+            give_up: Some((3, above)),
+            ..LmSettings::exact(500)
+        };
+        let (lo, hi) = ([-5.0, -5.0], [5.0, 5.0]);
+        let gave = lm_box(f, &[-1.2, 1.0], &[1.0, 1.0], &lo, &hi, &settings(-1.0));
+        assert!(gave.abandoned);
+        assert!(gave.v > 1e-3, "V = {}", gave.v);
+        let n_gave = iters.replace(0);
+        let full = lm_box(f, &[-1.2, 1.0], &[1.0, 1.0], &lo, &hi, &settings(1e6));
+        assert!(!full.abandoned);
+        assert!(full.v < 1e-20, "V = {}", full.v);
+        assert!(n_gave < iters.get(), "{n_gave} vs {}", iters.get());
     }
 
     #[test]

@@ -267,6 +267,9 @@ pub struct SearchStats {
     pub nodes_expanded: usize,
     /// Joint refits of every parameter.
     pub joint_refits: usize,
+    /// Joint refits given up: still far above their reference cost after 40 iterations
+    /// ([`super::search::GIVE_UP_FACTOR`]).
+    pub refits_given_up: usize,
     /// Wall time, s.
     pub seconds: f64,
     /// Wall time of each phase, in the order they ran (`--verbose` prints the table).

@@ -33,6 +33,9 @@ use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
+/// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
+pub(crate) const GIVE_UP_AFTER: usize = 40;
+
 /// Names of modes and terms `diagnose` adds start with this.
 pub const ADDED_NOTE: &str = "added by rshape diagnose";
 
@@ -158,8 +161,25 @@ pub fn retune_within(
     mask: Option<&[usize]>,
     rough: bool,
 ) -> NominalRefit {
+    retune_or_give_up(m, anchor, data, mask, rough, None).0
+}
+
+/// [`retune_within`] on every datum that gives up when its cost is still above `give_up`
+/// after [`GIVE_UP_AFTER`] iterations: the refit and whether it gave up (then the model is
+/// where the fit stopped).  For a refit whose result counts only below a known cost (a
+/// child of the search against its reference).
+pub(crate) fn retune_or_give_up(
+    m: &PhysicalModel,
+    anchor: &PhysicalModel,
+    data: &Channels,
+    mask: Option<&[usize]>,
+    rough: bool,
+    give_up: Option<f64>,
+) -> (NominalRefit, bool) {
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
+    let prof_t = std::time::Instant::now();
+    let prof_f = std::cell::Cell::new(0usize);
     let (lin, mut nl) = slots(m, data);
     // On part of the band (a holdout fit), a mode resonating outside that part is not
     // identified there: its ω_n and ζ keep their values.
@@ -228,6 +248,7 @@ pub fn retune_within(
         let v = solve_linear(&mut mm, &lin, data, mask);
         (mm, v)
     };
+    let mut abandoned = false;
     let best = if nl.is_empty() {
         (start.clone(), v_start)
     } else {
@@ -237,6 +258,7 @@ pub fn retune_within(
             for (s, x) in nl.iter().zip(th) {
                 set_nl(&mut mm, *s, *x);
             }
+            prof_f.set(prof_f.get() + 1);
             out.clear();
             out.extend(solve_linear_res(&mut mm, &lin, data, mask).iter());
         };
@@ -255,12 +277,19 @@ pub fn retune_within(
             &typ,
             &lo,
             &hi,
-            &LmSettings::likelihood(200),
+            &LmSettings {
+                give_up: give_up.map(|v| (GIVE_UP_AFTER, v)),
+                ..LmSettings::likelihood(200)
+            },
         );
+        abandoned = res.abandoned;
         model_at(&res.theta)
     };
     let n_params = lin.len() + nl.len();
-    if best.1.is_finite() && best.1 < v_before {
+    if std::env::var("RSHAPE_PROF").is_ok() {
+        eprintln!("retune rough={rough} mask={} lin={} nl={} f={} v {:.1}->{:.1} {:.3}s", mask.len(), lin.len(), nl.len(), prof_f.get(), v_before, best.1, prof_t.elapsed().as_secs_f64());
+    }
+    let refit = if best.1.is_finite() && best.1 < v_before {
         NominalRefit {
             model: best.0,
             n_params,
@@ -274,7 +303,8 @@ pub fn retune_within(
             v_before,
             v_after: v_before,
         }
-    }
+    };
+    (refit, abandoned)
 }
 
 /// SISO form of [`retune`] (good start): refits every parameter of `m` on `(omega, g)` with
