@@ -242,14 +242,35 @@ impl Cand {
     ) {
         let mut nat = Vec::with_capacity(th.len());
         self.natural(th, &mut nat);
-        self.modify_natural(&nat, base, omega, ch, entry, core, path);
+        let rho = self.base_residue(base, entry);
+        self.modify_natural(&nat, rho, base, omega, ch, entry, core, path);
     }
 
-    /// [`Cand::modify`] with the parameters of [`Cand::natural`].
+    /// The residue at model entry `entry` of the configured term a candidate changes (the
+    /// mode of `ModeShift` and `Damping`, the rigid body of `Friction`); 0 for the others.
+    pub fn base_residue(&self, base: &PhysicalModel, entry: (usize, usize)) -> f64 {
+        let (p, m) = (base.n_outputs(), base.n_inputs());
+        match self {
+            Cand::ModeShift(i) | Cand::Damping(i) => {
+                let md = &base.mode[*i];
+                residue(&md.output_gain, &md.input_gain, md.mass, p, m, entry)
+            }
+            Cand::Friction(i) => {
+                let r = &base.rigid_body[*i];
+                residue(&r.output_gain, &r.input_gain, r.mass, p, m, entry)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// [`Cand::modify`] with the parameters of [`Cand::natural`] and the configured term's
+    /// residue `rho` ([`Cand::base_residue`]: a residual computes it once per channel, not
+    /// once per datum).
     #[allow(clippy::too_many_arguments)]
     pub fn modify_natural(
         &self,
         nat: &[f64],
+        rho: f64,
         base: &PhysicalModel,
         omega: f64,
         ch: usize,
@@ -260,9 +281,6 @@ impl Cand {
         let s = Complex64::new(0.0, omega);
         let one = Complex64::new(1.0, 0.0);
         let mode_term = |w: f64, z: f64, rho: f64| rho / (s * s + 2.0 * z * w * s + w * w);
-        // The model's size only where a residue is needed (counting it walks every term, and
-        // this runs per datum of every residual).
-        let size = || (base.n_outputs(), base.n_inputs());
         match self {
             Cand::Delay(sel) if sel.hits(entry) => *path *= (-s * nat[0]).exp(),
             Cand::Lag(sel) if sel.hits(entry) => *path /= one + s / nat[0],
@@ -281,8 +299,6 @@ impl Cand {
             Cand::Mode => *core += mode_term(nat[0], nat[1], nat[2 + ch]),
             Cand::ModeShift(i) | Cand::Damping(i) => {
                 let md = &base.mode[*i];
-                let (p, m) = size();
-                let rho = residue(&md.output_gain, &md.input_gain, md.mass, p, m, entry);
                 let (w, z) = match self {
                     Cand::ModeShift(_) => (nat[0], md.zeta),
                     _ => (md.omega_n, nat[0]),
@@ -292,8 +308,6 @@ impl Cand {
             Cand::Integrator(order) => *core += nat[ch] / s.powi(*order as i32),
             Cand::Friction(i) => {
                 let r = &base.rigid_body[*i];
-                let (p, m) = size();
-                let rho = residue(&r.output_gain, &r.input_gain, r.mass, p, m, entry);
                 let p0 = r.friction_pole.unwrap_or(0.0);
                 *core += rho / (s * (s + nat[0])) - rho / (s * (s + p0));
             }

@@ -167,7 +167,10 @@ where
     let mut prev_drop: Option<f64> = None;
     let mut abandoned = false;
     for iter in 0..settings.max_iter {
-        if settings.give_up.is_some_and(|(k, above)| iter == k && v > above) {
+        if settings
+            .give_up
+            .is_some_and(|(k, above)| iter == k && v > above)
+        {
             abandoned = true;
             break;
         }
@@ -341,7 +344,10 @@ mod tests {
         let (tol, n_tol) = run(LmSettings::likelihood(400));
         assert!(!tol.abandoned && !exact.abandoned);
         assert!(tol.v - a * a < V_TOL, "V = {} (minimum {})", tol.v, a * a);
-        assert!(tol.v - a * a > 1e-9, "it should stop before the exact minimum");
+        assert!(
+            tol.v - a * a > 1e-9,
+            "it should stop before the exact minimum"
+        );
         assert!(n_tol < n_exact, "{n_tol} evaluations, exact {n_exact}");
     }
 

@@ -6,7 +6,7 @@
 use super::candidates::Cand;
 use super::channels::Channels;
 use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
-use super::fit::{lm_box, LmSettings};
+use super::fit::{lm_box_jac, LmSettings};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectPath, PhysicalModel};
 use nalgebra::DMatrix;
@@ -20,6 +20,10 @@ pub struct Problem<'a> {
     pub(super) inv_sigma: Vec<Vec<f64>>,
     pub(super) core0: Vec<Vec<Complex64>>,
     pub(super) path0: Vec<Vec<Complex64>>,
+    /// Residue of each configured mode at each channel, `[ch][mode]`.
+    mode_rho: Vec<Vec<f64>>,
+    /// Residue of each rigid body at each channel, `[ch][body]`.
+    rigid_rho: Vec<Vec<f64>>,
 }
 
 /// A model: the base plus effects with their internal parameters (concatenated).
@@ -106,9 +110,29 @@ impl<'a> Problem<'a> {
             core0.push(cores.iter().map(|c| c[*e]).collect());
             path0.push(data.omega.iter().map(|w| path_at(base, *w, *e)).collect());
         }
+        let mode_rho = data
+            .entries
+            .iter()
+            .map(|e| {
+                (0..base.mode.len())
+                    .map(|i| Cand::ModeShift(i).base_residue(base, *e))
+                    .collect()
+            })
+            .collect();
+        let rigid_rho = data
+            .entries
+            .iter()
+            .map(|e| {
+                (0..base.rigid_body.len())
+                    .map(|i| Cand::Friction(i).base_residue(base, *e))
+                    .collect()
+            })
+            .collect();
         Ok(Self {
             base,
             data,
+            mode_rho,
+            rigid_rho,
             inv_sigma: data
                 .radius
                 .iter()
@@ -192,8 +216,14 @@ impl<'a> Problem<'a> {
         let n_ch = self.n_ch();
         for c in &mods.cands {
             let n = c.n_params(n_ch);
+            let rho = match c {
+                Cand::ModeShift(i) | Cand::Damping(i) => self.mode_rho[ch][*i],
+                Cand::Friction(i) => self.rigid_rho[ch][*i],
+                _ => 0.0,
+            };
             c.modify_natural(
                 &nat[off..off + n],
+                rho,
                 self.base,
                 omega,
                 ch,
@@ -285,6 +315,44 @@ impl<'a> Problem<'a> {
         (lo, hi)
     }
 
+    /// The Jacobian of [`Problem::residual`] for a lone added mode, `θ = (ln ω_n, ln ζ,
+    /// ρ_1 … ρ_C)`: with `e = (G_d − (G₀ + ρ_c/d(s))·P)/σ`, `d = s² + 2ζω_n s + ω_n²`,
+    /// `∂e/∂ln ω_n = ρ_c P (2ζω_n s + 2ω_n²)/(d² σ)`, `∂e/∂ln ζ = ρ_c P 2ζω_n s/(d² σ)`
+    /// (zero where ζ is clamped to its bounds) and `∂e/∂ρ_c = −P/(d σ)` on channel `c`'s
+    /// rows.  `false` when `jac` is not the residual's shape.
+    fn lone_mode_jacobian(&self, th: &[f64], mask: &[usize], jac: &mut DMatrix<f64>) -> bool {
+        let n_ch = self.n_ch();
+        if th.len() != 2 + n_ch || jac.nrows() != 2 * mask.len() * n_ch || jac.ncols() != th.len() {
+            return false;
+        }
+        let mut nat = Vec::with_capacity(th.len());
+        Cand::Mode.natural(th, &mut nat);
+        let (w, z) = (nat[0], nat[1]);
+        let z_free = z == th[1].exp();
+        jac.fill(0.0);
+        for ch in 0..n_ch {
+            let rho = nat[2 + ch];
+            for (q, &k) in mask.iter().enumerate() {
+                let row = 2 * (ch * mask.len() + q);
+                let s = Complex64::new(0.0, self.data.omega[k]);
+                let d = s * s + 2.0 * z * w * s + w * w;
+                let p = self.path0[ch][k] * self.inv_sigma[ch][k];
+                let by_rho = -p / d;
+                let by_w = -by_rho * rho * (2.0 * z * w * s + 2.0 * w * w) / d;
+                let by_z = if z_free {
+                    -by_rho * rho * (2.0 * z * w * s) / d
+                } else {
+                    Complex64::new(0.0, 0.0)
+                };
+                for (col, v) in [(0, by_w), (1, by_z), (2 + ch, by_rho)] {
+                    jac[(row, col)] = v.re;
+                    jac[(row + 1, col)] = v.im;
+                }
+            }
+        }
+        jac.iter().all(|v| v.is_finite())
+    }
+
     /// Joint bounded LM fit of `mods` (all its parameters free) on the data in `mask`.
     pub(super) fn refit(&self, mods: &Mods, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
         if mods.theta.is_empty() {
@@ -299,13 +367,19 @@ impl<'a> Problem<'a> {
         }
         let (lo, hi) = self.bounds(mods);
         let cands = mods.cands.clone();
-        let res = lm_box(
+        // An added mode fitted alone (the screen's most frequent fit, from several starts)
+        // has an analytic Jacobian; every other fit, forward differences.
+        let lone_mode = mods.cands == [Cand::Mode];
+        let res = lm_box_jac(
             |th: &[f64], out: &mut Vec<f64>| {
                 let m = Mods {
                     cands: cands.clone(),
                     theta: th.to_vec(),
                 };
                 self.residual(&m, mask, out)
+            },
+            &|th: &[f64], _: &[f64], jac: &mut DMatrix<f64>| {
+                lone_mode && self.lone_mode_jacobian(th, mask, jac)
             },
             &mods.theta,
             &typ,
@@ -341,5 +415,83 @@ pub fn measures_of(c: &[Vec<f64>]) -> Measures {
         v: 2.0 * c2,
         misfit_rms: (c2 / n).sqrt(),
         invalid_fraction: bad as f64 / n,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::physical::{EffectKind, EffectSpec, Gains, ModeSpec};
+
+    /// The analytic Jacobian of a lone added mode against fourth-order central differences
+    /// of the residual itself (one output, three inputs, a delay on the path so `P ≠ 1`).
+    #[test]
+    fn the_lone_mode_jacobian_matches_central_differences() {
+        let mut delay = EffectSpec::new(EffectKind::Delay);
+        delay.tau_s = Some(2e-4);
+        let base = PhysicalModel {
+            mode: vec![ModeSpec {
+                name: None,
+                omega_n: 900.0,
+                zeta: 0.01,
+                mass: 1.0,
+                input_gain: Gains::Vector(vec![1.0, -0.4, 0.7]),
+                output_gain: Gains::Scalar(3e4),
+            }],
+            effect: vec![delay],
+            ..Default::default()
+        };
+        let omega = crate::system::logspace(100.0, 3000.0, 80);
+        let entries = vec![(0, 0), (0, 1), (0, 2)];
+        let g: Vec<Vec<Complex64>> = entries
+            .iter()
+            .map(|e| omega.iter().map(|w| base.eval(*w)[*e] * 1.1).collect())
+            .collect();
+        let radius = g
+            .iter()
+            .map(|c| c.iter().map(|x| 0.02 * x.norm() + 1e-3).collect())
+            .collect();
+        let data = Channels {
+            path: "test".into(),
+            omega,
+            entries,
+            g,
+            radius,
+            radius_source: vec![String::new(); 3],
+        };
+        let p = Problem::new(&base, &data).expect("problem");
+        let mask: Vec<usize> = (0..data.len()).step_by(2).collect();
+        let th = vec![450f64.ln(), 0.03f64.ln(), 2e3, -7e2, 1.1e3];
+        let resid = |t: &[f64]| {
+            let mut out = Vec::new();
+            let m = Mods {
+                cands: vec![Cand::Mode],
+                theta: t.to_vec(),
+            };
+            p.residual(&m, &mask, &mut out);
+            out
+        };
+        let rows = resid(&th).len();
+        let mut jac = DMatrix::zeros(rows, th.len());
+        assert!(p.lone_mode_jacobian(&th, &mask, &mut jac));
+        for k in 0..th.len() {
+            let h = 1e-4 * th[k].abs().max(1.0);
+            let at = |d: f64| {
+                let mut t = th.clone();
+                t[k] += d;
+                resid(&t)
+            };
+            let (p2, p1, m1, m2) = (at(2.0 * h), at(h), at(-h), at(-2.0 * h));
+            let scale = (0..rows).map(|i| jac[(i, k)].abs()).fold(0.0, f64::max);
+            assert!(scale > 0.0, "column {k} is zero");
+            for i in 0..rows {
+                let fd = (-p2[i] + 8.0 * p1[i] - 8.0 * m1[i] + m2[i]) / (12.0 * h);
+                assert!(
+                    (fd - jac[(i, k)]).abs() <= 1e-6 * scale,
+                    "θ_{k}, row {i}: analytic {} vs {fd}",
+                    jac[(i, k)]
+                );
+            }
+        }
     }
 }

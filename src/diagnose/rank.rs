@@ -261,10 +261,15 @@ impl Problem<'_> {
     /// Fits candidate `c` alone on top of the problem's model (multi-start).
     pub(super) fn fit_candidate(&self, c: Cand, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
         let cur = Mods::default();
+        // The starts are independent fits: in parallel, the best chosen in their order (the
+        // first of equal costs), as a sequential loop would.
+        let fits: Vec<(Mods, f64, DMatrix<f64>)> = self
+            .starts(&cur, c, mask)
+            .par_iter()
+            .map(|st| self.refit(&cur.with(c, st), mask))
+            .collect();
         let mut best: Option<(Mods, f64, DMatrix<f64>)> = None;
-        for st in self.starts(&cur, c, mask) {
-            let m = cur.with(c, &st);
-            let fit = self.refit(&m, mask);
+        for fit in fits {
             if best.as_ref().is_none_or(|b| fit.1 < b.1) {
                 best = Some(fit);
             }

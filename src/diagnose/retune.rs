@@ -287,7 +287,16 @@ pub(crate) fn retune_or_give_up(
     };
     let n_params = lin.len() + nl.len();
     if std::env::var("RSHAPE_PROF").is_ok() {
-        eprintln!("retune rough={rough} mask={} lin={} nl={} f={} v {:.1}->{:.1} {:.3}s", mask.len(), lin.len(), nl.len(), prof_f.get(), v_before, best.1, prof_t.elapsed().as_secs_f64());
+        eprintln!(
+            "retune rough={rough} mask={} lin={} nl={} f={} v {:.1}->{:.1} {:.3}s",
+            mask.len(),
+            lin.len(),
+            nl.len(),
+            prof_f.get(),
+            v_before,
+            best.1,
+            prof_t.elapsed().as_secs_f64()
+        );
     }
     let refit = if best.1.is_finite() && best.1 < v_before {
         NominalRefit {

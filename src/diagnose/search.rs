@@ -222,8 +222,14 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
                     go.then(|| {
                         let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
                         let give_up = Some(GIVE_UP_FACTOR * ref_v);
-                        let (r, gave_up) =
-                            retune_or_give_up(&added, &anchor, data, None, node.configured, give_up);
+                        let (r, gave_up) = retune_or_give_up(
+                            &added,
+                            &anchor,
+                            data,
+                            None,
+                            node.configured,
+                            give_up,
+                        );
                         if gave_up {
                             return Ok(None);
                         }
