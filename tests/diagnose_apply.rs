@@ -1,7 +1,7 @@
 //! Issue 20, defect 2: `--apply K` refuses a candidate the tool rejected (one-line reason,
 //! exit 2, nothing written) unless `--force`; `--apply chosen` writes the chosen set,
 //! jointly refit, in one revision.  On the motor bench (configs/twomass_rigid.toml), whose
-//! chosen set is friction + mode + delay.
+//! chosen set is mode + friction + delay.
 
 use rshape::data::read_frf_csv;
 use rshape::diagnose::{compare, prepare, PlantModel};

@@ -46,6 +46,21 @@ use rayon::prelude::*;
 /// 3675 other children) no refit that far above after 40 iterations ended below it.
 pub const GIVE_UP_FACTOR: f64 = 3.0;
 
+/// BICs closer than this are the same fit: each least-squares cost is within
+/// [`V_TOL`](super::fit::V_TOL) of its minimum, a BIC (`2V + …`) within twice that.
+const SAME_FIT_BIC: f64 = 4.0 * super::fit::V_TOL;
+
+/// `a`'s steps explain more than `b`'s: the first step where their ΔBICs differ is larger
+/// in `a`.
+fn steps_explain_more(a: &Node, b: &Node) -> bool {
+    a.steps
+        .iter()
+        .zip(&b.steps)
+        .map(|(x, y)| x.delta_bic.total_cmp(&y.delta_bic))
+        .find(|o| o.is_ne())
+        .is_some_and(|o| o.is_gt())
+}
+
 /// Search settings.
 #[derive(Debug, Clone, Copy)]
 pub struct SearchSettings {
@@ -319,8 +334,13 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
         children.sort_by(|a, b| a.bic.total_cmp(&b.bic));
         let mut kept: Vec<Node> = Vec::new();
         for c in children {
-            if !kept.iter().any(|k| same_set(&k.effects, &c.effects)) {
-                kept.push(c);
+            match kept.iter_mut().find(|k| same_set(&k.effects, &c.effects)) {
+                // Two orders that reach the same fit (BICs equal within what the fits'
+                // tolerance leaves, 2·V_TOL each): the path whose earlier steps explained
+                // more is the one reported.
+                Some(k) if c.bic - k.bic < SAME_FIT_BIC && steps_explain_more(&c, k) => *k = c,
+                Some(_) => {}
+                None => kept.push(c),
             }
         }
         let mut children = kept;
