@@ -32,6 +32,7 @@ use super::varpro::VarPro;
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
 pub(crate) const GIVE_UP_AFTER: usize = 40;
@@ -178,8 +179,6 @@ pub(crate) fn retune_or_give_up(
 ) -> (NominalRefit, bool) {
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
-    let prof_t = std::time::Instant::now();
-    let prof_f = std::cell::Cell::new(0usize);
     let (lin, mut nl) = slots(m, data);
     // On part of the band (a holdout fit), a mode resonating outside that part is not
     // identified there: its ω_n and ζ keep their values.
@@ -204,24 +203,30 @@ pub(crate) fn retune_or_give_up(
         for i in 0..m.mode.len() {
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
-            let grid = (0..33).flat_map(|j| {
-                let w = w0 * MODE_BOX.powf(-1.0 + j as f64 / 16.0);
-                [z0, 0.003, 0.01, 0.03, 0.1].map(|z| (w, z))
-            });
+            let grid: Vec<(f64, f64)> = (0..33)
+                .flat_map(|j| {
+                    let w = w0 * MODE_BOX.powf(-1.0 + j as f64 / 16.0);
+                    [z0, 0.003, 0.01, 0.03, 0.1].map(|z| (w, z))
+                })
+                .collect();
             // The other columns factored once, each grid point's cost from the mode's own
             // columns projected off them ([`super::varpro::ModeGrid`]); the full least
-            // squares at every point where they are rank-deficient.
+            // squares at every point where they are rank-deficient.  The points are
+            // independent: costed in parallel, the best taken in grid order as before.
             let fast = super::varpro::ModeGrid::new(&start, i, &lin, data, mask);
-            for (w, z) in grid {
-                let v = match &fast {
-                    Some(g) => g.cost(&start, w, z),
+            let costs: Vec<f64> = grid
+                .par_iter()
+                .map(|&(w, z)| match &fast {
+                    Some(g) => g.cost(w, z),
                     None => {
                         let mut t = start.clone();
                         t.mode[i].omega_n = w;
                         t.mode[i].zeta = z;
                         solve_linear(&mut t, &lin, data, mask)
                     }
-                };
+                })
+                .collect();
+            for (&(w, z), &v) in grid.iter().zip(&costs) {
                 if v < best.0 {
                     best = (v, w, z);
                 }
@@ -258,7 +263,6 @@ pub(crate) fn retune_or_give_up(
             for (s, x) in nl.iter().zip(th) {
                 set_nl(&mut mm, *s, *x);
             }
-            prof_f.set(prof_f.get() + 1);
             out.clear();
             out.extend(solve_linear_res(&mut mm, &lin, data, mask).iter());
         };
@@ -286,18 +290,6 @@ pub(crate) fn retune_or_give_up(
         model_at(&res.theta)
     };
     let n_params = lin.len() + nl.len();
-    if std::env::var("RSHAPE_PROF").is_ok() {
-        eprintln!(
-            "retune rough={rough} mask={} lin={} nl={} f={} v {:.1}->{:.1} {:.3}s",
-            mask.len(),
-            lin.len(),
-            nl.len(),
-            prof_f.get(),
-            v_before,
-            best.1,
-            prof_t.elapsed().as_secs_f64()
-        );
-    }
     let refit = if best.1.is_finite() && best.1 < v_before {
         NominalRefit {
             model: best.0,

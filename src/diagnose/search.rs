@@ -61,6 +61,53 @@ fn steps_explain_more(a: &Node, b: &Node) -> bool {
         .is_some_and(|o| o.is_gt())
 }
 
+/// A child's joint refit: the model, its measures, its least-squares cost and number of
+/// parameters.
+type Refit = (PhysicalModel, Measures, f64, usize);
+
+/// One node's screen: every candidate fitted alone (best first), which of them get a joint
+/// refit (the `beam + 1` best promising ones), and the cost the children are measured
+/// against.
+struct Expansion {
+    screened: Vec<Screened>,
+    refit: Vec<bool>,
+    ref_v: f64,
+}
+
+/// Screens node `ni` of `nodes` (see [`Expansion`]).
+fn expand(nodes: &[Node], ni: usize, data: &Channels, s: &SearchSettings) -> Result<Expansion> {
+    let node = &nodes[ni];
+    let p = Problem::new(&node.model, data)?;
+    let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
+    let cands: Vec<Cand> = candidate_list(&node.model, data)
+        .into_iter()
+        .filter(|c| *c == Cand::Mode || !used.contains(c))
+        .collect();
+    let screened = p.screen(&cands, node.measures);
+    let mut tried = 0;
+    let refit = screened
+        .iter()
+        .map(|sc| {
+            let promising =
+                sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
+            let go = promising && tried <= s.beam;
+            tried += usize::from(go);
+            go
+        })
+        .collect();
+    // Against the best of the node and (for the configured model) its retune.
+    let ref_v = if node.configured {
+        nodes[1].v_fit.min(node.v_fit)
+    } else {
+        node.v_fit
+    };
+    Ok(Expansion {
+        screened,
+        refit,
+        ref_v,
+    })
+}
+
 /// Search settings.
 #[derive(Debug, Clone, Copy)]
 pub struct SearchSettings {
@@ -199,67 +246,56 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
             break;
         }
         let mut children: Vec<Node> = Vec::new();
-        for &ni in &level {
+        // Every node of the level is screened, then the children of all of them are refit in
+        // one batch: independent computations in parallel (rayon's indexed collects keep
+        // their order, so the result does not depend on the scheduling).
+        let t_screen = std::time::Instant::now();
+        let expansions = level
+            .par_iter()
+            .map(|&ni| expand(&nodes, ni, data, s))
+            .collect::<Result<Vec<_>>>()?;
+        phases.add("screen", t_screen.elapsed().as_secs_f64(), level.len());
+        expanded += level.len();
+        let jobs: Vec<(usize, usize)> = expansions
+            .iter()
+            .enumerate()
+            .flat_map(|(li, e)| {
+                e.refit
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, go)| **go)
+                    .map(move |(j, _)| (li, j))
+            })
+            .collect();
+        let t_refit = std::time::Instant::now();
+        let done: Vec<Result<Option<Refit>>> = jobs
+            .par_iter()
+            .map(|&(li, j)| {
+                let node = &nodes[level[li]];
+                let sc = &expansions[li].screened[j];
+                let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
+                let give_up = Some(GIVE_UP_FACTOR * expansions[li].ref_v);
+                let (r, gave_up) =
+                    retune_or_give_up(&added, &anchor, data, None, node.configured, give_up);
+                if gave_up {
+                    return Ok(None);
+                }
+                let (v_fit, n_params) = (r.v_after, r.n_params);
+                settle(r.model, &anchor, data).map(|(model, m)| Some((model, m, v_fit, n_params)))
+            })
+            .collect();
+        phases.add("joint refits", t_refit.elapsed().as_secs_f64(), jobs.len());
+        let mut per_node: Vec<Vec<Option<Result<Option<Refit>>>>> = expansions
+            .iter()
+            .map(|e| e.screened.iter().map(|_| None).collect())
+            .collect();
+        for (&(li, j), r) in jobs.iter().zip(done) {
+            per_node[li][j] = Some(r);
+        }
+        for ((&ni, e), refits) in level.iter().zip(&expansions).zip(per_node) {
             let node = nodes[ni].clone();
-            let p = Problem::new(&node.model, data)?;
-            let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
-            let cands: Vec<Cand> = candidate_list(&node.model, data)
-                .into_iter()
-                .filter(|c| *c == Cand::Mode || !used.contains(c))
-                .collect();
-            let screened = phases.time("screen", || p.screen(&cands, node.measures));
-            expanded += 1;
-            // The `beam + 1` best promising candidates are written into the model and every
-            // parameter refit jointly: independent refits, run in parallel (rayon's indexed
-            // collect keeps their order, so the result does not depend on the scheduling).
-            let mut tried = 0;
-            let refit: Vec<bool> = screened
-                .iter()
-                .map(|sc| {
-                    let promising =
-                        sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
-                    let go = promising && tried <= s.beam;
-                    tried += usize::from(go);
-                    go
-                })
-                .collect();
-            // Against the best of the node and (for the configured model) its retune.
-            let ref_v = if node.configured {
-                nodes[1].v_fit.min(node.v_fit)
-            } else {
-                node.v_fit
-            };
-            let t_refit = std::time::Instant::now();
-            let refits: Vec<Option<Result<_>>> = screened
-                .par_iter()
-                .zip(&refit)
-                .map(|(sc, go)| {
-                    go.then(|| {
-                        let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                        let give_up = Some(GIVE_UP_FACTOR * ref_v);
-                        let (r, gave_up) = retune_or_give_up(
-                            &added,
-                            &anchor,
-                            data,
-                            None,
-                            node.configured,
-                            give_up,
-                        );
-                        if gave_up {
-                            return Ok(None);
-                        }
-                        let v_fit = r.v_after;
-                        let n_params = r.n_params;
-                        settle(r.model, &anchor, data)
-                            .map(|(model, m)| Some((model, m, v_fit, n_params)))
-                    })
-                })
-                .collect();
-            phases.add(
-                "joint refits",
-                t_refit.elapsed().as_secs_f64(),
-                refit.iter().filter(|g| **g).count(),
-            );
+            let screened = &e.screened;
+            let ref_v = e.ref_v;
             for (sc, refit) in screened.iter().zip(refits) {
                 let mut child_node = None;
                 if let Some(refit) = refit {

@@ -293,10 +293,13 @@ impl VarPro<'_> {
 /// `V(ω_n, ζ) = ‖r_o − Q_b Q_bᵀ r_o‖²`, `r_o = P⊥_o y`, `b = P⊥_o a = Q_b R_b`: the cost of
 /// the full least squares, in `O(m n)` per point instead of `O(m n²)`.
 pub(super) struct ModeGrid<'a> {
-    mode: usize,
-    own: Vec<Lin>,
     data: &'a Channels,
     mask: &'a [usize],
+    /// The mode's columns with its denominator left out: `a_{row,j} = coef_{row,j}/d(s_k)`
+    /// (`path · gain/m · weight`, zero where the column does not act), one complex number per
+    /// row pair, column-major.
+    coef: Vec<Complex64>,
+    n_own: usize,
     q: DMatrix<f64>,
     r_o: DVector<f64>,
 }
@@ -325,22 +328,51 @@ impl<'a> ModeGrid<'a> {
             let r_o = &y - &q * q.tr_mul(&y);
             (q, r_o)
         };
+        // The mode's own columns times its denominator: what does not move on the grid.
+        let (own_a, _) = design(m, &own, data, mask);
+        let (w, z) = (m.mode[mode].omega_n, m.mode[mode].zeta);
+        let rows_per_ch = 2 * mask.len();
+        let mut coef = Vec::with_capacity(own_a.len() / 2);
+        for j in 0..own.len() {
+            for row in (0..own_a.nrows()).step_by(2) {
+                let s = Complex64::new(0.0, data.omega[mask[(row % rows_per_ch) / 2]]);
+                let d = s * s + 2.0 * z * w * s + w * w;
+                coef.push(Complex64::new(own_a[(row, j)], own_a[(row + 1, j)]) * d);
+            }
+        }
+        if coef.iter().any(|c| !c.is_finite()) {
+            return None;
+        }
         Some(Self {
-            mode,
-            own,
             data,
             mask,
+            coef,
+            n_own: own.len(),
             q,
             r_o,
         })
     }
 
     /// The least-squares cost with the mode at `(ω_n, ζ)`.
-    pub fn cost(&self, m: &PhysicalModel, w: f64, z: f64) -> f64 {
-        let mut t = m.clone();
-        t.mode[self.mode].omega_n = w;
-        t.mode[self.mode].zeta = z;
-        let (a, _) = design(&t, &self.own, self.data, self.mask);
+    pub fn cost(&self, w: f64, z: f64) -> f64 {
+        let inv_d: Vec<Complex64> = self
+            .mask
+            .iter()
+            .map(|k| {
+                let s = Complex64::new(0.0, self.data.omega[*k]);
+                (s * s + 2.0 * z * w * s + w * w).inv()
+            })
+            .collect();
+        let rows = self.r_o.len();
+        let pairs = rows / 2;
+        let a = DMatrix::from_fn(rows, self.n_own, |row, j| {
+            let v = self.coef[j * pairs + row / 2] * inv_d[(row / 2) % inv_d.len()];
+            if row % 2 == 0 {
+                v.re
+            } else {
+                v.im
+            }
+        });
         let b = if self.q.ncols() == 0 {
             a
         } else {
@@ -516,7 +548,7 @@ mod tests {
                     t.mode[i].omega_n = w;
                     t.mode[i].zeta = z;
                     let full = solve_linear_res(&mut t, &lin, &data, &mask).norm_squared();
-                    let fast = g.cost(&start, w, z);
+                    let fast = g.cost(w, z);
                     assert!(
                         (fast - full).abs() <= 1e-9 * full,
                         "mode {i} at ({w}, {z}): {fast} vs {full}"
