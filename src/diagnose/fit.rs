@@ -22,8 +22,9 @@ pub struct LmResult {
 pub struct LmSettings {
     /// Most iterations (accepted steps).
     pub max_iter: usize,
-    /// Absolute tolerance on the cost: the fit stops once an accepted, nearly undamped step
-    /// (damping `λ ≤ 1e-4`) lowered `V` by less than `v_tol` and the geometric series of
+    /// Absolute tolerance on the cost: the fit stops once an accepted step, nearly undamped
+    /// (damping `λ ≤ 1e-4`) or gaining at most half of the step before, lowered `V` by
+    /// less than `v_tol` and the geometric series of
     /// the steps to come (their decrease falling by the ratio of the last two,
     /// `d q/(1 − q)`, an estimate: half of `v_tol` leaves room for its error) is below
     /// `v_tol / 2`.  `0` stops only on a step that gains nothing (relative `1e-12`).
@@ -255,9 +256,11 @@ where
                 let drop = v_old - v;
                 if let Some(p) = prev_drop.filter(|_| !extrapolated) {
                     let q = drop / p;
-                    // Only near Gauss–Newton's own step: a heavily damped step gains
-                    // little because it is short, not because little is left.
-                    let undamped = lambda <= LAMBDA_GN;
+                    // Near Gauss–Newton's own step, or where the gains fall at least
+                    // twofold per step (a minimum at a kink, `|τ|` at 0, approached by
+                    // ever shorter damped steps): a damped step with a slowly falling gain
+                    // gains little because it is short, not because little is left.
+                    let undamped = lambda <= LAMBDA_GN || q <= 0.5;
                     if undamped
                         && drop < settings.v_tol
                         && q < 1.0
@@ -348,6 +351,28 @@ mod tests {
             tol.v - a * a > 1e-9,
             "it should stop before the exact minimum"
         );
+        assert!(n_tol < n_exact, "{n_tol} evaluations, exact {n_exact}");
+    }
+
+    /// A minimum at a kink (`r = 100 (1 + |t|)`, as a delay's `|τ|` at 0): the damped
+    /// steps shorten and the gradient never vanishes; the likelihood tolerance stops within
+    /// it of the minimum, the exact stop crawls on until twelve trials fail.
+    #[test]
+    fn the_likelihood_tolerance_stops_at_a_kink() {
+        let run = |settings: LmSettings| {
+            let evals = std::cell::Cell::new(0);
+            let f = |t: &[f64], r: &mut Vec<f64>| {
+                evals.set(evals.get() + 1);
+                r.clear();
+                r.push(100.0 * (1.0 + t[0].abs()));
+            };
+            let res = lm_box(f, &[0.3], &[1.0], &[-1.0], &[1.0], &settings);
+            (res, evals.get())
+        };
+        let (exact, n_exact) = run(LmSettings::exact(80));
+        let (tol, n_tol) = run(LmSettings::likelihood(80));
+        assert!(tol.v - 1e4 < V_TOL, "V = {}", tol.v);
+        assert!(exact.v - 1e4 < tol.v - 1e4, "the exact stop goes further");
         assert!(n_tol < n_exact, "{n_tol} evaluations, exact {n_exact}");
     }
 
