@@ -27,6 +27,34 @@ pub struct Channels {
 }
 
 impl Channels {
+    /// Test data: the response of `truth` at `omega` on `entries` times `gain`, with noise
+    /// radius `rel·|G| + floor` (no noise added).
+    #[cfg(test)]
+    pub(crate) fn of_model(
+        truth: &crate::model::physical::PhysicalModel,
+        omega: Vec<f64>,
+        entries: Vec<(usize, usize)>,
+        gain: f64,
+        (rel, floor): (f64, f64),
+    ) -> Self {
+        let g: Vec<Vec<Complex64>> = entries
+            .iter()
+            .map(|e| omega.iter().map(|w| truth.eval(*w)[*e] * gain).collect())
+            .collect();
+        let radius = g
+            .iter()
+            .map(|c| c.iter().map(|x| rel * x.norm() + floor).collect())
+            .collect();
+        Self {
+            path: "test".into(),
+            radius_source: vec![String::new(); entries.len()],
+            omega,
+            entries,
+            g,
+            radius,
+        }
+    }
+
     /// One SISO channel (the noise radius must be known).
     pub fn from_siso(s: &Siso) -> Result<Self> {
         let radius = s.radius.clone().ok_or_else(|| {

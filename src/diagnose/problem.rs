@@ -110,24 +110,15 @@ impl<'a> Problem<'a> {
             core0.push(cores.iter().map(|c| c[*e]).collect());
             path0.push(data.omega.iter().map(|w| path_at(base, *w, *e)).collect());
         }
-        let mode_rho = data
-            .entries
-            .iter()
-            .map(|e| {
-                (0..base.mode.len())
-                    .map(|i| Cand::ModeShift(i).base_residue(base, *e))
-                    .collect()
-            })
-            .collect();
-        let rigid_rho = data
-            .entries
-            .iter()
-            .map(|e| {
-                (0..base.rigid_body.len())
-                    .map(|i| Cand::Friction(i).base_residue(base, *e))
-                    .collect()
-            })
-            .collect();
+        // Residues of the configured terms a candidate changes, `[ch][term]`.
+        let table = |n: usize, cand: fn(usize) -> Cand| -> Vec<Vec<f64>> {
+            data.entries
+                .iter()
+                .map(|e| (0..n).map(|i| cand(i).base_residue(base, *e)).collect())
+                .collect()
+        };
+        let mode_rho = table(base.mode.len(), Cand::ModeShift);
+        let rigid_rho = table(base.rigid_body.len(), Cand::Friction);
         Ok(Self {
             base,
             data,
@@ -443,22 +434,7 @@ mod tests {
         };
         let omega = crate::system::logspace(100.0, 3000.0, 80);
         let entries = vec![(0, 0), (0, 1), (0, 2)];
-        let g: Vec<Vec<Complex64>> = entries
-            .iter()
-            .map(|e| omega.iter().map(|w| base.eval(*w)[*e] * 1.1).collect())
-            .collect();
-        let radius = g
-            .iter()
-            .map(|c| c.iter().map(|x| 0.02 * x.norm() + 1e-3).collect())
-            .collect();
-        let data = Channels {
-            path: "test".into(),
-            omega,
-            entries,
-            g,
-            radius,
-            radius_source: vec![String::new(); 3],
-        };
+        let data = Channels::of_model(&base, omega, entries, 1.1, (0.02, 1e-3));
         let p = Problem::new(&base, &data).expect("problem");
         let mask: Vec<usize> = (0..data.len()).step_by(2).collect();
         let th = vec![450f64.ln(), 0.03f64.ln(), 2e3, -7e2, 1.1e3];

@@ -439,23 +439,13 @@ mod tests {
 
     fn channels(truth: &PhysicalModel) -> Channels {
         let omega = crate::system::logspace(100.0, 3000.0, 150);
-        let entries = vec![(0, 0), (0, 1), (0, 2)];
-        let g: Vec<Vec<Complex64>> = entries
-            .iter()
-            .map(|e| omega.iter().map(|w| truth.eval(*w)[*e]).collect())
-            .collect();
-        let radius = g
-            .iter()
-            .map(|c| c.iter().map(|x| 0.01 * x.norm() + 1e-4).collect())
-            .collect();
-        Channels {
-            path: "test".into(),
+        Channels::of_model(
+            truth,
             omega,
-            entries,
-            g,
-            radius,
-            radius_source: vec![String::new(); 3],
-        }
+            vec![(0, 0), (0, 1), (0, 2)],
+            1.0,
+            (0.01, 1e-4),
+        )
     }
 
     /// The variable-projection Jacobian against central differences of the residual with
@@ -592,23 +582,7 @@ mod tests {
         };
         let truth = two(1.05);
         let omega = crate::system::logspace(100.0, 3000.0, 120);
-        let entries = vec![(0, 0), (1, 0)];
-        let g: Vec<Vec<Complex64>> = entries
-            .iter()
-            .map(|e| omega.iter().map(|w| truth.eval(*w)[*e]).collect())
-            .collect();
-        let radius = g
-            .iter()
-            .map(|c| c.iter().map(|x| 0.01 * x.norm() + 1e-4).collect())
-            .collect();
-        let data = Channels {
-            path: "test".into(),
-            omega,
-            entries,
-            g,
-            radius,
-            radius_source: vec![String::new(); 2],
-        };
+        let data = Channels::of_model(&truth, omega, vec![(0, 0), (1, 0)], 1.0, (0.01, 1e-4));
         let start = two(1.0);
         let (lin, nl) = slots(&start, &data);
         assert_eq!(blocks(&lin, &data).len(), 2);
