@@ -30,7 +30,7 @@ use super::polish::settle;
 use super::problem::{Measures, Problem};
 use super::report::{DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats};
 use super::retune::retune_within;
-use super::search::{roots, search, Node, SearchResult, SearchSettings};
+use super::search::{roots, screen_configured, search, Node, SearchResult, SearchSettings};
 use super::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
@@ -108,13 +108,18 @@ pub fn diagnose_channels(
         });
     }
     let mut phases = Phases::default();
-    let [configured, retuned_node] = phases.time("retune", || roots(base, data))?;
+    // The configured model's screen does not need the retune: both at once.
+    let (roots, first_screen) = phases.time("retune", || {
+        rayon::join(|| roots(base, data), || screen_configured(base, data))
+    });
+    let [configured, retuned_node] = roots?;
+    let first_screen = first_screen?;
     let root_model = retuned_node.model.clone();
     let retuned = retuned_node.measures;
     let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
-    let mut res = search(vec![configured, retuned_node], data, s)?;
+    let mut res = search(vec![configured, retuned_node], data, s, Some(first_screen))?;
     for p in &res.phases.0 {
         phases.add(p.phase, p.seconds, p.count);
     }

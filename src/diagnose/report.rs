@@ -279,7 +279,8 @@ pub struct SearchStats {
 /// The wall time of one phase of `diagnose`.
 #[derive(Debug, Clone, Serialize)]
 pub struct PhaseTime {
-    /// What ran: `retune`, `screen` (each candidate fitted alone), `joint refits` (with
+    /// What ran: `retune` (with the configured model's screen beside it), `screen` (each
+    /// candidate fitted alone on the other nodes), `joint refits` (with
     /// their consistency polish), `first level`, `holdout`, `backward elimination`,
     /// `final refit`, `ties`, `report`.
     pub phase: &'static str,

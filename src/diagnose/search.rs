@@ -75,15 +75,27 @@ struct Expansion {
 }
 
 /// Screens node `ni` of `nodes` (see [`Expansion`]).
-fn expand(nodes: &[Node], ni: usize, data: &Channels, s: &SearchSettings) -> Result<Expansion> {
+/// `screened`, when given, is the node's screen done beforehand ([`screen_configured`]).
+fn expand(
+    nodes: &[Node],
+    ni: usize,
+    data: &Channels,
+    s: &SearchSettings,
+    screened: Option<Vec<Screened>>,
+) -> Result<Expansion> {
     let node = &nodes[ni];
-    let p = Problem::new(&node.model, data)?;
-    let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
-    let cands: Vec<Cand> = candidate_list(&node.model, data)
-        .into_iter()
-        .filter(|c| *c == Cand::Mode || !used.contains(c))
-        .collect();
-    let screened = p.screen(&cands, node.measures);
+    let screened = match screened {
+        Some(sc) => sc,
+        None => {
+            let p = Problem::new(&node.model, data)?;
+            let used: Vec<Cand> = node.effects.iter().map(|e| e.0).collect();
+            let cands: Vec<Cand> = candidate_list(&node.model, data)
+                .into_iter()
+                .filter(|c| *c == Cand::Mode || !used.contains(c))
+                .collect();
+            p.screen(&cands, node.measures)
+        }
+    };
     let mut tried = 0;
     let refit = screened
         .iter()
@@ -106,6 +118,15 @@ fn expand(nodes: &[Node], ni: usize, data: &Channels, s: &SearchSettings) -> Res
         refit,
         ref_v,
     })
+}
+
+/// The configured model's screen (every catalogue candidate fitted alone on it), as the
+/// search's first level does it: it does not depend on the retune, so `diagnose` runs it
+/// beside the retune and hands it to [`search`].
+pub(crate) fn screen_configured(base: &PhysicalModel, data: &Channels) -> Result<Vec<Screened>> {
+    let p = Problem::new(base, data)?;
+    let m0 = p.measures(&Default::default());
+    Ok(p.screen(&candidate_list(base, data), m0))
 }
 
 /// Search settings.
@@ -229,8 +250,15 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     ])
 }
 
-/// Runs the beam search from the roots (the first one's screen is the first level).
-pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<SearchResult> {
+/// Runs the beam search from the roots (the first one's screen is the first level;
+/// `first_screen`, when given, is that screen done beforehand by [`screen_configured`]).
+pub fn search(
+    roots: Vec<Node>,
+    data: &Channels,
+    s: &SearchSettings,
+    first_screen: Option<Vec<Screened>>,
+) -> Result<SearchResult> {
+    let mut first_screen = first_screen;
     s.validate()
         .map_err(|e| crate::error::Error::Invalid(e.to_string()))?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
@@ -250,9 +278,18 @@ pub fn search(roots: Vec<Node>, data: &Channels, s: &SearchSettings) -> Result<S
         // one batch: independent computations in parallel (rayon's indexed collects keep
         // their order, so the result does not depend on the scheduling).
         let t_screen = std::time::Instant::now();
+        let pre: Vec<Option<Vec<Screened>>> = level
+            .iter()
+            .map(|&ni| {
+                (depth == 1 && ni == 0)
+                    .then(|| first_screen.take())
+                    .flatten()
+            })
+            .collect();
         let expansions = level
             .par_iter()
-            .map(|&ni| expand(&nodes, ni, data, s))
+            .zip(pre)
+            .map(|(&ni, pre)| expand(&nodes, ni, data, s, pre))
             .collect::<Result<Vec<_>>>()?;
         phases.add("screen", t_screen.elapsed().as_secs_f64(), level.len());
         expanded += level.len();
