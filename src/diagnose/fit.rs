@@ -12,7 +12,7 @@ pub struct LmResult {
     pub v: f64,
     /// `JᵀJ` at the optimum (for the covariance `(2JᵀJ)⁻¹` when `v` is a `−ln L`).
     pub jtj: DMatrix<f64>,
-    /// The fit gave up ([`LmSettings::give_up`]): `theta` is where it stopped, not an
+    /// The fit gave up (`LmSettings::give_up`): `theta` is where it stopped, not an
     /// optimum.
     pub abandoned: bool,
 }

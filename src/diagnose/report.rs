@@ -267,8 +267,8 @@ pub struct SearchStats {
     pub nodes_expanded: usize,
     /// Joint refits of every parameter.
     pub joint_refits: usize,
-    /// Joint refits given up: still far above their reference cost after 40 iterations
-    /// ([`super::search::GIVE_UP_FACTOR`]).
+    /// Joint refits given up: still above three times their reference cost after 10
+    /// iterations (they could not pass).
     pub refits_given_up: usize,
     /// Wall time, s.
     pub seconds: f64,

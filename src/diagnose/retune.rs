@@ -35,7 +35,7 @@ use num_complex::Complex64;
 use rayon::prelude::*;
 
 /// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
-pub(crate) const GIVE_UP_AFTER: usize = 40;
+pub(crate) const GIVE_UP_AFTER: usize = 10;
 
 /// Names of modes and terms `diagnose` adds start with this.
 pub const ADDED_NOTE: &str = "added by rshape diagnose";

@@ -41,9 +41,11 @@ use rayon::prelude::*;
 /// A child's joint refit whose cost is still above this many times its reference (the
 /// node's, or the better root's for the configured model) after
 /// [`GIVE_UP_AFTER`](super::retune::GIVE_UP_AFTER)
-/// iterations is given up: a child counts only below its reference (ΔBIC > 10), the cost
-/// of a least-squares fit never rises, and across the diagnose suites (2169 configured and
-/// 3675 other children) no refit that far above after 40 iterations ended below it.
+/// iterations is given up: a child counts only below its reference (ΔBIC > 10) and the
+/// cost of a least-squares fit never rises.  Across the diagnose suites (5840 child refits,
+/// 2167 of them of the configured root), every refit that ended able to pass and ran past
+/// 10 iterations (1264) was already below its reference there (at most 0.9995 of it); 115
+/// were above 3 times it, and none of those could pass.
 pub const GIVE_UP_FACTOR: f64 = 3.0;
 
 /// BICs closer than this are the same fit: each least-squares cost is within
