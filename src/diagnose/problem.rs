@@ -7,6 +7,7 @@ use super::candidates::Cand;
 use super::channels::Channels;
 use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
 use super::fit::{lm_box_jac, LmSettings};
+use super::slots::{mode_den, mode_log_slope};
 use crate::error::{Error, Result};
 use crate::model::physical::{EffectPath, PhysicalModel};
 use nalgebra::DMatrix;
@@ -326,12 +327,11 @@ impl<'a> Problem<'a> {
             for (q, &k) in mask.iter().enumerate() {
                 let row = 2 * (ch * mask.len() + q);
                 let s = Complex64::new(0.0, self.data.omega[k]);
-                let d = s * s + 2.0 * z * w * s + w * w;
                 let p = self.path0[ch][k] * self.inv_sigma[ch][k];
-                let by_rho = -p / d;
-                let by_w = -by_rho * rho * (2.0 * z * w * s + 2.0 * w * w) / d;
+                let by_rho = -p / mode_den(s, w, z);
+                let by_w = by_rho * rho * mode_log_slope(s, w, z, true);
                 let by_z = if z_free {
-                    -by_rho * rho * (2.0 * z * w * s) / d
+                    by_rho * rho * mode_log_slope(s, w, z, false)
                 } else {
                     Complex64::new(0.0, 0.0)
                 };

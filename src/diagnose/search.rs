@@ -258,9 +258,8 @@ pub fn search(
     roots: Vec<Node>,
     data: &Channels,
     s: &SearchSettings,
-    first_screen: Option<Vec<Screened>>,
+    mut first_screen: Option<Vec<Screened>>,
 ) -> Result<SearchResult> {
-    let mut first_screen = first_screen;
     s.validate()
         .map_err(|e| crate::error::Error::Invalid(e.to_string()))?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
@@ -288,12 +287,14 @@ pub fn search(
                     .flatten()
             })
             .collect();
+        let n_screened = pre.iter().filter(|p| p.is_none()).count();
         let expansions = level
             .par_iter()
             .zip(pre)
             .map(|(&ni, pre)| expand(&nodes, ni, data, s, pre))
             .collect::<Result<Vec<_>>>()?;
-        phases.add("screen", t_screen.elapsed().as_secs_f64(), level.len());
+        // A screen done beforehand was timed where it ran.
+        phases.add("screen", t_screen.elapsed().as_secs_f64(), n_screened);
         expanded += level.len();
         let jobs: Vec<(usize, usize)> = expansions
             .iter()
@@ -324,20 +325,14 @@ pub fn search(
             })
             .collect();
         phases.add("joint refits", t_refit.elapsed().as_secs_f64(), jobs.len());
-        let mut per_node: Vec<Vec<Option<Result<Option<Refit>>>>> = expansions
-            .iter()
-            .map(|e| e.screened.iter().map(|_| None).collect())
-            .collect();
-        for (&(li, j), r) in jobs.iter().zip(done) {
-            per_node[li][j] = Some(r);
-        }
-        for ((&ni, e), refits) in level.iter().zip(&expansions).zip(per_node) {
+        // The refits in job order: node by node, candidate by candidate.
+        let mut done = done.into_iter();
+        for (&ni, e) in level.iter().zip(&expansions) {
             let node = nodes[ni].clone();
-            let screened = &e.screened;
             let ref_v = e.ref_v;
-            for (sc, refit) in screened.iter().zip(refits) {
+            for (sc, go) in e.screened.iter().zip(&e.refit) {
                 let mut child_node = None;
-                if let Some(refit) = refit {
+                if let Some(refit) = go.then(|| done.next()).flatten() {
                     joint_refits += 1;
                     let Some((model, m, v_fit, n_refit)) = refit? else {
                         gave_up += 1;

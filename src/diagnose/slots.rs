@@ -253,6 +253,22 @@ pub(super) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) 
 /// The weighted design matrix of the linear slots `lin` of `m` (nonlinear ones fixed) on the
 /// data at `mask`, and the weighted data: rows are `(Re, Im)` of `√2/r · (·)` per channel and
 /// datum, so `‖y − A x‖²` is the cost `V` with the linear parameters `x`.
+/// A mode's denominator `d(s) = s² + 2ζω_n s + ω_n²` (its shape is `1/(m d)`).
+pub(super) fn mode_den(s: Complex64, w: f64, z: f64) -> Complex64 {
+    s * s + 2.0 * z * w * s + w * w
+}
+
+/// The relative derivative of a mode's shape `1/d(s)` along `ln ω_n` (`by_w`) or `ln ζ`:
+/// `−(2ζω_n s + 2ω_n²)/d` or `−2ζω_n s/d` (the shape's derivative is this times the shape).
+pub(super) fn mode_log_slope(s: Complex64, w: f64, z: f64, by_w: bool) -> Complex64 {
+    let num = if by_w {
+        2.0 * z * w * s + 2.0 * w * w
+    } else {
+        2.0 * z * w * s
+    };
+    -num / mode_den(s, w, z)
+}
+
 pub(super) fn design(
     m: &PhysicalModel,
     lin: &[Lin],

@@ -21,7 +21,9 @@
 //! the forward-difference Jacobian of the whole residual.
 
 use super::channels::Channels;
-use super::slots::{block_matrix, blocks, design, gains_of, set_nl, Lin, Nl, Term};
+use super::slots::{
+    block_matrix, blocks, design, gains_of, mode_den, mode_log_slope, set_nl, Lin, Nl, Term,
+};
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -150,16 +152,7 @@ impl VarPro<'_> {
                     .data
                     .omega
                     .iter()
-                    .map(|om| {
-                        let s = Complex64::new(0.0, *om);
-                        let den = s * s + 2.0 * z * w * s + w * w;
-                        let num = if by_w {
-                            2.0 * z * w * s + 2.0 * w * w
-                        } else {
-                            2.0 * z * w * s
-                        };
-                        -num / den
-                    })
+                    .map(|om| mode_log_slope(Complex64::new(0.0, *om), w, z, by_w))
                     .collect();
                 scaled(Term::Mode(i), &|_| true, &|kq| fac[kq]);
             }
@@ -336,8 +329,7 @@ impl<'a> ModeGrid<'a> {
         for j in 0..own.len() {
             for row in (0..own_a.nrows()).step_by(2) {
                 let s = Complex64::new(0.0, data.omega[mask[(row % rows_per_ch) / 2]]);
-                let d = s * s + 2.0 * z * w * s + w * w;
-                coef.push(Complex64::new(own_a[(row, j)], own_a[(row + 1, j)]) * d);
+                coef.push(Complex64::new(own_a[(row, j)], own_a[(row + 1, j)]) * mode_den(s, w, z));
             }
         }
         if coef.iter().any(|c| !c.is_finite()) {
@@ -358,10 +350,7 @@ impl<'a> ModeGrid<'a> {
         let inv_d: Vec<Complex64> = self
             .mask
             .iter()
-            .map(|k| {
-                let s = Complex64::new(0.0, self.data.omega[*k]);
-                (s * s + 2.0 * z * w * s + w * w).inv()
-            })
+            .map(|k| mode_den(Complex64::new(0.0, self.data.omega[*k]), w, z).inv())
             .collect();
         let rows = self.r_o.len();
         let pairs = rows / 2;
