@@ -30,10 +30,12 @@ pub(crate) mod shard;
 pub(crate) mod summary;
 
 pub use combine::combine;
-pub use discover::{discover_dir, discover_manifest, Dataset};
+pub use discover::{discover_dir, discover_manifest, safe_name, Dataset};
 pub use merge::{merge, merge_then, MergeOutcome};
 pub use runner::{run_all, run_one, BatchSettings, DatasetResult};
 pub use shard::Shard;
+/// `summary.csv`'s text from its rows (for callers that run the datasets themselves).
+pub use summary::render as render_summary;
 pub use summary::SummaryRow;
 
 use crate::consistency::{check, Envelope};

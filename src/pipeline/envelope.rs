@@ -98,7 +98,12 @@ pub fn envelope_of_file(
 /// Reads a config's data file (closed-loop spectra or FRF) and applies its `[channel]` when
 /// the data are larger than the model.
 pub fn load_data(config: &Config, data_path: &Path) -> Result<FrfData> {
-    let mut data = closed_loop::read_data(config, data_path)?;
+    select_channel(config, closed_loop::read_data(config, data_path)?)
+}
+
+/// Applies a config's `[channel]` to data larger than the model, as [`load_data`] does for
+/// a file (for data that come from elsewhere, e.g. arrays of the Python package).
+pub fn select_channel(config: &Config, mut data: FrfData) -> Result<FrfData> {
     let f = &config.factorization;
     if let Some(ch) = config.raw.channel {
         let fits = (data.outputs(), data.inputs()) == (f.outputs(), f.inputs());

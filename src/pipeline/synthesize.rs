@@ -387,26 +387,7 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "A": rows(&k.a), "B": rows(&k.b), "C": rows(&k.c), "D": rows(&k.d),
         "feedback": "negative",
     });
-    let rep = &o.stability.report;
-    let synthesis = serde_json::json!({
-        "method": if o.hinf.is_some() { "hinf_weighted" } else { "glover_mcfarlane" },
-        "hinf": o.hinf.as_ref().map(|(label, h)| serde_json::json!({"r": label, "synthesis": h})),
-        "b_opt": o.gm.b_opt,
-        "gamma_min": o.gm.gamma_min,
-        "gamma": o.gm.gamma,
-        "gamma_factor": o.gm.gamma / o.gm.gamma_min,
-        "rho_xz": o.gm.rho,
-        "riccati_residuals": o.gm.riccati_residuals,
-        "b_gk": rep.b_gk,
-        "controller_order": k.states(),
-        "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
-        "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
-        "reduction": &o.reduction,
-        "merit": &o.merit,
-        "bounds": &o.bounds,
-        "robust": o.robust,
-        "notes": &o.notes,
-    });
+    let synthesis = synthesis_json(o);
     let json = |v: &serde_json::Value| {
         serde_json::to_string_pretty(v).map_err(|e| Error::Invalid(format!("json: {e}")))
     };
@@ -445,6 +426,32 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "Theorem 1: 1/σ_max(T) vs |r| — the synthesized controller",
     )?);
     Ok(written)
+}
+
+/// The content of `synthesis.json`: method, `b_opt`, `γ_min`, `γ`, residuals, the
+/// controller's order and poles, the closed-loop poles, reduction, merit, one row per bound.
+pub fn synthesis_json(o: &SynthesisOutcome) -> serde_json::Value {
+    let k = &o.gm.k;
+    let rep = &o.stability.report;
+    serde_json::json!({
+        "method": if o.hinf.is_some() { "hinf_weighted" } else { "glover_mcfarlane" },
+        "hinf": o.hinf.as_ref().map(|(label, h)| serde_json::json!({"r": label, "synthesis": h})),
+        "b_opt": o.gm.b_opt,
+        "gamma_min": o.gm.gamma_min,
+        "gamma": o.gm.gamma,
+        "gamma_factor": o.gm.gamma / o.gm.gamma_min,
+        "rho_xz": o.gm.rho,
+        "riccati_residuals": o.gm.riccati_residuals,
+        "b_gk": rep.b_gk,
+        "controller_order": k.states(),
+        "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        "reduction": &o.reduction,
+        "merit": &o.merit,
+        "bounds": &o.bounds,
+        "robust": o.robust,
+        "notes": &o.notes,
+    })
 }
 
 /// The summary the CLI prints: the optimum, the controller, then the proof.
