@@ -14,7 +14,17 @@ use std::sync::Arc;
 /// `(index, name, path, noise_radius)` of a dataset.
 type DatasetTuple = (usize, String, PathBuf, Option<f64>);
 /// A `summary.csv` row: index, name, ok, n_data, max_r_min, consistent, n_failing, data, error.
-type RowTuple = (usize, String, bool, usize, Option<f64>, Option<bool>, usize, String, String);
+type RowTuple = (
+    usize,
+    String,
+    bool,
+    usize,
+    Option<f64>,
+    Option<bool>,
+    usize,
+    String,
+    String,
+);
 
 /// The datasets of `--data-dir DIR` or `--manifest FILE`, as `rshape batch` finds them.
 #[pyfunction]
@@ -99,7 +109,12 @@ pub fn _run_dataset(
             noise_radius,
             per_dataset_files: false,
         };
-        let r = batch::run_one(&cfg, &self::dataset(dataset), &opts, std::path::Path::new("."));
+        let r = batch::run_one(
+            &cfg,
+            &self::dataset(dataset),
+            &opts,
+            std::path::Path::new("."),
+        );
         result_out(r, &cfg)
     })
 }
@@ -154,7 +169,9 @@ pub fn _batch(
     noise_arg(noise_radius)?;
     let order = order_arg(order, max_order)?;
     if jobs == Some(0) {
-        return Err(input("jobs=0: give a number of worker threads ≥ 1 (default: all cores)"));
+        return Err(input(
+            "jobs=0: give a number of worker threads ≥ 1 (default: all cores)",
+        ));
     }
     let cfg = config.inner.clone();
     guarded(py, move || {
@@ -210,11 +227,18 @@ pub fn _batch(
                     },
                 )
                 .py()?;
-                let fit = rep.r_fitted.as_ref().map(|j| fit_from_json(j)).transpose()?;
+                let fit = rep
+                    .r_fitted
+                    .as_ref()
+                    .map(|j| fit_from_json(j))
+                    .transpose()?;
                 (fit, rep.fit_error)
             }
             None => match &combined {
-                None => (None, Some("no dataset succeeded: nothing to fit".to_string())),
+                None => (
+                    None,
+                    Some("no dataset succeeded: nothing to fit".to_string()),
+                ),
                 Some(c) => match crate::core::fit_envelope(&wrap(c.clone()), order) {
                     Ok(f) => (Some(f), None),
                     Err(e) => (None, Some(e.to_string())),

@@ -22,7 +22,9 @@ fn matrix(name: &str, rows: &[Vec<f64>], r: usize, c: usize) -> PyResult<DMatrix
         )));
     }
     if rows.iter().flatten().any(|x| !x.is_finite()) {
-        return Err(input(format!("controller: {name} has a value that is not finite")));
+        return Err(input(format!(
+            "controller: {name} has a value that is not finite"
+        )));
     }
     Ok(DMatrix::from_fn(r, c, |i, j| rows[i][j]))
 }
@@ -172,7 +174,8 @@ pub fn _synthesize(
         .py()?;
         let j = |v: &serde_json::Value| serde_json::to_string(v).map_err(|e| input(e.to_string()));
         let synthesis = j(&syn::synthesis_json(&out))?;
-        let report = serde_json::to_string(&out.stability.report).map_err(|e| input(e.to_string()))?;
+        let report =
+            serde_json::to_string(&out.stability.report).map_err(|e| input(e.to_string()))?;
         let k = &out.gm.k;
         let toml = syn::controller_toml(k, &out.gm, out.hinf.is_some());
         Ok((

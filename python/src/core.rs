@@ -6,8 +6,8 @@
 
 use crate::data::{Config, Frf};
 use crate::errors::{guarded, input, FitError, NotAdmissible, OrRaise};
-use numpy::{IntoPyArray, PyArray1};
 use num_complex::Complex64;
+use numpy::{IntoPyArray, PyArray1};
 use pyo3::prelude::*;
 use rshape::consistency::Envelope as LibEnvelope;
 use rshape::fit::OrderChoice;
@@ -197,7 +197,12 @@ pub fn unit(num: Vec<f64>, den: Vec<f64>, what: &str) -> PyResult<TransferFuncti
 
 /// The check of `r = num/den` against the envelope (JSON of the library's report).
 #[pyfunction]
-pub fn _check(py: Python<'_>, num: Vec<f64>, den: Vec<f64>, envelope: &Envelope) -> PyResult<String> {
+pub fn _check(
+    py: Python<'_>,
+    num: Vec<f64>,
+    den: Vec<f64>,
+    envelope: &Envelope,
+) -> PyResult<String> {
     let env = envelope.inner.clone();
     guarded(py, || {
         let r = unit(num, den, "r")?;
@@ -263,16 +268,16 @@ pub fn order_arg(order: &Bound<'_, PyAny>, max_order: usize) -> PyResult<OrderCh
 /// The fit of `rshape run` (and `rshape fit`'s defaults): the smallest certified unit above
 /// the envelope, below the A1 limit of the envelope's model.
 pub fn fit_envelope(env: &Envelope, order: OrderChoice) -> PyResult<FitHandle> {
-    let f = env.config.as_deref().and_then(closed_loop::a1_factorization);
+    let f = env
+        .config
+        .as_deref()
+        .and_then(closed_loop::a1_factorization);
     let a1 = f.map(|f| move |w: f64| f.a1_limit(w));
     let a1: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
     let fitted = integration::fit_r(&env.inner, a1, order, None)
         .map_err(|e| FitError::new_err(crate::errors::message(&e)))?;
     let json = serde_json::to_string(&fitted.json).map_err(|e| input(e.to_string()))?;
-    Ok(FitHandle {
-        r: fitted.r,
-        json,
-    })
+    Ok(FitHandle { r: fitted.r, json })
 }
 
 /// Fits `r` above the envelope (`order`: "auto" sweeps 0..=max_order).

@@ -221,7 +221,10 @@ impl Frf {
             }
         };
         let flat: Vec<Complex64> = r.iter().copied().collect();
-        if let Some(i) = flat.iter().position(|z| !(z.re.is_finite() && z.im.is_finite())) {
+        if let Some(i) = flat
+            .iter()
+            .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+        {
             return Err(input(format!(
                 "Frf: response at omega[{}] = {} rad/s is not finite ({}): drop or repair that datum",
                 i / (p * m),
@@ -255,25 +258,34 @@ impl Frf {
             let v = vector("std", a, Some(n))?;
             nonneg("std", &v)?;
             if !(std_factor.is_finite() && std_factor > 0.0) {
-                return Err(input(format!("Frf: std_factor = {std_factor}: give a finite number > 0")));
+                return Err(input(format!(
+                    "Frf: std_factor = {std_factor}: give a finite number > 0"
+                )));
             }
             Some(v.iter().map(|s| std_factor * s).collect())
         } else if let Some(a) = coherence {
             siso("coherence")?;
             let v = vector("coherence", a, Some(n))?;
             if let Some(i) = v.iter().position(|c| *c <= 0.0 || *c > 1.0) {
-                return Err(input(format!("Frf: coherence[{i}] = {} is not a coherence in (0, 1]", v[i])));
+                return Err(input(format!(
+                    "Frf: coherence[{i}] = {} is not a coherence in (0, 1]",
+                    v[i]
+                )));
             }
             let avg = averages.filter(|a| *a >= 1).ok_or_else(|| {
                 input("Frf: coherence needs averages (the number of averages of the H1 estimate, ≥ 1)")
             })?;
             if !(coverage.is_finite() && coverage > 0.0) {
-                return Err(input(format!("Frf: coverage = {coverage}: give a finite number > 0")));
+                return Err(input(format!(
+                    "Frf: coverage = {coverage}: give a finite number > 0"
+                )));
             }
             Some(
                 v.iter()
                     .zip(&response)
-                    .map(|(c, h)| coverage * rshape::data::h1_random_error(*c, avg) * h[(0, 0)].norm())
+                    .map(|(c, h)| {
+                        coverage * rshape::data::h1_random_error(*c, avg) * h[(0, 0)].norm()
+                    })
                     .collect(),
             )
         } else {
@@ -317,10 +329,7 @@ impl Frf {
     /// Per-datum noise radii, or None.
     #[getter]
     fn noise_radius<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
-        self.inner
-            .noise_radius
-            .clone()
-            .map(|v| v.into_pyarray(py))
+        self.inner.noise_radius.clone().map(|v| v.into_pyarray(py))
     }
 
     /// Where the data came from.

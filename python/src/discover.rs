@@ -16,9 +16,7 @@ use rshape::pipeline::closed_loop::discovery_inputs;
 
 fn channel_arg(c: Option<(usize, usize)>) -> PyResult<Option<(usize, usize)>> {
     match c {
-        Some((o, i)) if o == 0 || i == 0 => Err(input(
-            "channel=(OUT, IN): two 1-based indices",
-        )),
+        Some((o, i)) if o == 0 || i == 0 => Err(input("channel=(OUT, IN): two 1-based indices")),
         c => Ok(c),
     }
 }
@@ -66,7 +64,12 @@ pub struct DiagnosisHandle {
 impl DiagnosisHandle {
     /// The revised config text (`--apply K|chosen --write`), and the effect added.
     #[pyo3(signature = (what, force=false))]
-    fn apply(&self, py: Python<'_>, what: &Bound<'_, PyAny>, force: bool) -> PyResult<(String, String)> {
+    fn apply(
+        &self,
+        py: Python<'_>,
+        what: &Bound<'_, PyAny>,
+        force: bool,
+    ) -> PyResult<(String, String)> {
         let what = if what.extract::<String>().is_ok_and(|s| s == "chosen") {
             Apply::Chosen
         } else {

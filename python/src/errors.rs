@@ -8,7 +8,12 @@ use pyo3::prelude::*;
 use rshape::Error;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-create_exception!(_rshape, RshapeError, PyException, "Base class of rshape's exceptions.");
+create_exception!(
+    _rshape,
+    RshapeError,
+    PyException,
+    "Base class of rshape's exceptions."
+);
 create_exception!(
     _rshape,
     InputError,
