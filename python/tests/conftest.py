@@ -47,11 +47,12 @@ def cli_run(cli, tmp_path_factory):
     """`rshape run CONFIG --out DIR` once per config: the DIR."""
     cache = {}
 
-    def run(config: str) -> Path:
+    def run(config: str):
+        """The output folder, and the error line when the CLI refused the config (exit 2)."""
         if config not in cache:
             out = tmp_path_factory.mktemp(Path(config).stem)
-            cli("run", CONFIGS / config, "--out", out)
-            cache[config] = out
+            p = cli("run", CONFIGS / config, "--out", out, check=False)
+            cache[config] = (out, p.stderr.strip() if p.returncode == 2 else None)
         return cache[config]
 
     return run
