@@ -46,9 +46,17 @@ create_exception!(
     "A bug in rshape (a Rust panic caught at the boundary); please report it with the inputs."
 );
 
-/// The one line the CLI prints after `error: ` for a library error.
+/// The one line the CLI prints after `error: ` for a library error: the message and its
+/// sources, as `anyhow`'s `{:#}` writes them.
 pub fn message(e: &Error) -> String {
-    rshape::report::fmt::one_line(&e.to_string())
+    let mut text = e.to_string();
+    let mut source = std::error::Error::source(e);
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    rshape::report::fmt::one_line(&text)
 }
 
 /// The exception of a library error.
