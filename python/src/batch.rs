@@ -227,11 +227,7 @@ pub fn _batch(
                     },
                 )
                 .py()?;
-                let fit = rep
-                    .r_fitted
-                    .as_ref()
-                    .map(|j| fit_from_json(j))
-                    .transpose()?;
+                let fit = rep.r_fitted.as_ref().map(fit_from_json).transpose()?;
                 (fit, rep.fit_error)
             }
             None => match &combined {

@@ -38,7 +38,8 @@ impl Envelope {
                 r_min.len()
             )));
         }
-        if (1..n).any(|k| !(omega[k] > omega[k - 1])) || !(omega[0] > 0.0) {
+        let increasing = (1..n).all(|k| omega[k] > omega[k - 1]);
+        if !increasing || omega[0].is_nan() || omega[0] <= 0.0 {
             return Err(input(
                 "Envelope: omega must be positive and strictly increasing",
             ));
