@@ -134,3 +134,29 @@ def test_config_pickles_for_workers():
     back = pickle.loads(pickle.dumps(cfg))
     assert back.path == cfg.path and back.r == cfg.r
     assert np.array_equal(rshape.envelope(back).r_min, rshape.envelope(cfg).r_min)
+
+
+def test_long_calls_release_the_gil():
+    import threading
+    import time
+
+    cfg = rshape.Config.load(SISO)
+    env = rshape.envelope(cfg)
+    done = threading.Event()
+    ticks = 0
+
+    def work():
+        rshape.fit(env, order=5)
+        done.set()
+
+    t = threading.Thread(target=work)
+    start = time.perf_counter()
+    t.start()
+    while not done.is_set():  # pure-Python work: runs only while the fit has no GIL
+        ticks += 1
+        time.sleep(0)
+    t.join()
+    elapsed = time.perf_counter() - start
+    # With the GIL held for the whole fit this loop would see about one switch interval
+    # (5 ms) of turns; it sees many while the fit runs.
+    assert elapsed > 0.02 and ticks > 1000, (elapsed, ticks)
