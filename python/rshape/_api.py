@@ -302,11 +302,14 @@ class Diagnosis(Record):
         object.__setattr__(self, "_handle", handle)
         object.__setattr__(self, "converted", handle.converted)
 
-    def apply(self, what: Union[str, int] = "chosen", force: bool = False) -> str:
+    def apply(self, what: Union[str, int] = "chosen", force: bool = False,
+              write: Optional[PathLike] = None) -> str:
         """The revised config's TOML text with the chosen effect set (``"chosen"``) or the
         K-th ranked candidate (``what=K``, 1-based; a rejected one only with force=True), as
-        ``rshape diagnose --apply … --write`` writes it."""
-        text, _label = self._handle.apply(what, force)
+        ``rshape diagnose --apply … --write FILE`` writes it. With ``write=FILE`` the file is
+        written; without, the text is for a file beside the diagnosed config (its data
+        paths are relative to that folder)."""
+        text, _label = self._handle.apply(what, force, None if write is None else os.fspath(write))
         return text
 
 

@@ -13,6 +13,7 @@ use rshape::diagnose::{
 };
 use rshape::model::physical::PhysicalModel;
 use rshape::pipeline::closed_loop::discovery_inputs;
+use std::path::{Path, PathBuf};
 
 fn channel_arg(c: Option<(usize, usize)>) -> PyResult<Option<(usize, usize)>> {
     match c {
@@ -62,13 +63,17 @@ pub struct DiagnosisHandle {
 
 #[pymethods]
 impl DiagnosisHandle {
-    /// The revised config text (`--apply K|chosen --write`), and the effect added.
-    #[pyo3(signature = (what, force=false))]
+    /// The revised config text (`--apply K|chosen --write PATH`) and the effect added.
+    /// With `path` the file is written there, as the CLI writes it; without, the text is
+    /// that of a revision beside the diagnosed config (its data paths relative to that
+    /// folder), made in a temporary file there that is removed again.
+    #[pyo3(signature = (what, force=false, path=None))]
     fn apply(
         &self,
         py: Python<'_>,
         what: &Bound<'_, PyAny>,
         force: bool,
+        path: Option<PathBuf>,
     ) -> PyResult<(String, String)> {
         let what = if what.extract::<String>().is_ok_and(|s| s == "chosen") {
             Apply::Chosen
@@ -83,24 +88,40 @@ impl DiagnosisHandle {
             }
         };
         guarded(py, || {
-            let dir = tempfile::tempdir().map_err(|e| input(format!("a temporary folder: {e}")))?;
-            let out = dir.path().join("revised.toml");
-            let rev = write_revision(
-                &Revise {
-                    config: &self.config,
-                    raw: &self.raw,
-                    data: &self.data,
-                    diagnosis: &self.diagnosis,
-                    base: &self.base,
-                    what,
-                    force,
-                },
-                &out,
-            )
-            .py()?;
-            let text = std::fs::read_to_string(&out)
-                .map_err(|e| input(format!("{}: {e}", out.display())))?;
-            Ok((text, rev.label))
+            let write = |out: &Path| -> PyResult<(String, String)> {
+                let rev = write_revision(
+                    &Revise {
+                        config: &self.config,
+                        raw: &self.raw,
+                        data: &self.data,
+                        diagnosis: &self.diagnosis,
+                        base: &self.base,
+                        what,
+                        force,
+                    },
+                    out,
+                )
+                .py()?;
+                let text = std::fs::read_to_string(out)
+                    .map_err(|e| input(format!("{}: {e}", out.display())))?;
+                Ok((text, rev.label))
+            };
+            if let Some(p) = &path {
+                return write(p);
+            }
+            let beside = self
+                .config
+                .path
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            let tmp = tempfile::Builder::new()
+                .prefix(".rshape-revision-")
+                .suffix(".toml")
+                .tempfile_in(beside)
+                .or_else(|_| tempfile::NamedTempFile::new())
+                .map_err(|e| input(format!("a temporary file: {e}")))?;
+            write(tmp.path())
         })
     }
 }

@@ -115,7 +115,7 @@ def test_synthesized_gamma_and_alpha_equal_the_cli(method, cli, cli_run, tmp_pat
         close(getattr(s, name_), np.asarray(k[name_], dtype=float).reshape(getattr(s, name_).shape))
 
 
-def test_compare_and_diagnose_equal_the_cli(cli):
+def test_compare_and_diagnose_equal_the_cli(cli, tmp_path):
     name = CONFIGS / "twomass_rigid.toml"
     cmp_cli = json.loads(cli("compare", name, "--json").stdout)
     cmp_py = rshape.compare(name)
@@ -124,3 +124,13 @@ def test_compare_and_diagnose_equal_the_cli(cli):
     d_py = rshape.diagnose(name)
     strip = lambda d: {k: v for k, v in d.items() if k != "search"}  # the search's timings differ
     assert strip(d_py.to_dict()) == strip(d_cli)
+    assert len(d_py.candidates) > 0
+    # apply("chosen") is the text `diagnose --apply chosen --write` writes.
+    revised = tmp_path / "revised.toml"
+    cli("diagnose", name, "--apply", "chosen", "--write", revised)
+    assert d_py.apply("chosen", write=tmp_path / "py.toml") == revised.read_text()
+    assert (tmp_path / "py.toml").read_text() == revised.read_text()
+    # Without write: the text for a file beside the config, which loads from there.
+    beside = d_py.apply("chosen")
+    assert rshape.Config.from_toml(beside, CONFIGS / "revised.toml").data == rshape.Config.load(name).data
+    assert not list(CONFIGS.glob(".rshape-revision-*"))
