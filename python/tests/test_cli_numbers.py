@@ -82,7 +82,6 @@ def test_stability_alpha_equals_the_cli(name, controller, cli, cli_run):
     p = cli("stability", CONFIGS / name, "--controller", CONFIGS / controller,
             "--r-json", out / "r.json", "--json")
     cli_rep = json.loads(p.stdout)
-    f = rshape.Fit  # noqa: F841 (documentation: the bound may be a Fit or (num, den))
     r = read_json(out / "r.json")
     st = rshape.stability(CONFIGS / name, CONFIGS / controller, r=(r["num"], r["den"]))
     assert st.internally_stable == cli_rep["internally_stable"]
