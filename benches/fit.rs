@@ -162,7 +162,7 @@ fn sweep24_auto(bencher: divan::Bencher) {
 }
 
 /// Issue 38: `--order 6` (order 6 alone) on each of the 24 envelopes of the sweep (the
-/// comparison with dkpy's order-6 fit: `tests/dkpy_compare.py`).
+/// comparison with dkpy's order-6 fit: `benches/dkpy_compare.py`).
 #[divan::bench(sample_count = 1)]
 fn sweep24_order6(bencher: divan::Bencher) {
     let envs: Vec<Envelope> = random_envelopes::sweep_specs()
