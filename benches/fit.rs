@@ -8,6 +8,9 @@
 //! (`jagged_2000_auto`), order 6 on 100,000 points ≤ 6 s (`jagged_100000`), the fit of
 //! ISS `stability --fit` ≤ 5 s (`iss_stability_fit`), paper `run` ≤ 0.4 s (`paper_run`).
 
+#[path = "support/random_envelopes.rs"]
+mod random_envelopes;
+
 use rshape::consistency::{Envelope, EnvelopeMethod};
 use rshape::fit::{fit_auto, fit_unit, FitSettings};
 use rshape::system::logspace;
@@ -123,6 +126,58 @@ fn jagged_2000_auto(bencher: divan::Bencher) {
     let env = envelope_n(true, 2000);
     let set = FitSettings::default();
     bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+}
+
+/// Issue 38: `--order auto` on a smooth 4-decade 2000-point envelope with two bumps
+/// (`random_envelopes::smooth_bumps`).  Target ≤ 1 s.
+#[divan::bench(sample_count = 2)]
+fn smooth_2000_bumps_auto(bencher: divan::Bencher) {
+    let env = random_envelopes::smooth_bumps(2000);
+    let set = FitSettings::default();
+    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+}
+
+/// Issue 38: `--order auto` on the same envelope at 21 points.  Target ≤ 0.2 s.
+#[divan::bench(sample_count = 3)]
+fn smooth_21_bumps_auto(bencher: divan::Bencher) {
+    let env = random_envelopes::smooth_bumps(21);
+    let set = FitSettings::default();
+    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+}
+
+/// Issue 38: `--order auto` on each of the 24 random envelopes of the sweep
+/// (`random_envelopes::sweep_specs`, fixed seed), one after the other.  Target ≤ 15 s.
+#[divan::bench(sample_count = 1)]
+fn sweep24_auto(bencher: divan::Bencher) {
+    let envs: Vec<Envelope> = random_envelopes::sweep_specs()
+        .iter()
+        .map(random_envelopes::envelope)
+        .collect();
+    let set = FitSettings::default();
+    bencher.bench(|| {
+        for env in &envs {
+            fit_auto(env, None, &set, 8).expect("fit");
+        }
+    });
+}
+
+/// Issue 38: `--order 6` (order 6 alone) on each of the 24 envelopes of the sweep (the
+/// comparison with dkpy's order-6 fit: `benches/dkpy_compare.py`).
+#[divan::bench(sample_count = 1)]
+fn sweep24_order6(bencher: divan::Bencher) {
+    let envs: Vec<Envelope> = random_envelopes::sweep_specs()
+        .iter()
+        .map(random_envelopes::envelope)
+        .collect();
+    let set = FitSettings {
+        order: 6,
+        ..Default::default()
+    };
+    bencher.bench(|| {
+        for env in &envs {
+            fit_unit(env, None, &set).expect("fit");
+        }
+    });
 }
 
 /// The shipped config `name` with its envelope (Theorem 2 on its data).
