@@ -6,7 +6,7 @@
 //! cargo run --release --example docs_figures -- OUT_DIR   # writes them elsewhere
 //! ```
 //!
-//! `tests/docs_figures.rs` runs [`regenerate`] into a scratch folder and checks that the
+//! `tests/docs/docs_figures.rs` runs [`regenerate`] into a scratch folder and checks that the
 //! committed figures are current.
 use rshape::fit::OrderChoice;
 use rshape::pipeline::{self, outputs::figures};

@@ -1,5 +1,5 @@
 //! The library API of `rshape fit`, as docs/guide/run-check-fit.md shows it (the guide's
-//! block is this file, checked by tests/docs_snippets.rs): the paper's MIMO example, its
+//! block is this file, checked by tests/docs/docs_snippets.rs): the paper's MIMO example, its
 //! envelope, a fixed-order fit, the automatic order and the whole `rshape fit` job.
 use rshape::fit::{fit_auto, fit_unit, run_fit, FitSettings, OrderChoice};
 use rshape::{envelope, read_frf_csv, Config};
