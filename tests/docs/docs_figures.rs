@@ -9,7 +9,7 @@ use crate::common;
 
 #[allow(dead_code)]
 #[path = "../../examples/docs_figures.rs"]
-mod docs_figures;
+mod example;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -65,8 +65,8 @@ fn the_committed_figures_are_current() {
         common::repo("").canonicalize().unwrap(),
         "run from the repository's root (as `cargo test` does)"
     );
-    let fresh = docs_figures::regenerate(dir.path()).unwrap();
-    let expected: usize = docs_figures::FIGURES.iter().map(|(_, _, f)| f.len()).sum();
+    let fresh = example::regenerate(dir.path()).unwrap();
+    let expected: usize = example::FIGURES.iter().map(|(_, _, f)| f.len()).sum();
     assert_eq!(fresh.len(), expected, "figures drawn: {fresh:?}");
     let mut stale = Vec::new();
     for f in &fresh {
