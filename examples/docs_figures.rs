@@ -44,7 +44,7 @@ pub fn regenerate(out: &Path) -> Result<Vec<PathBuf>, Box<dyn std::error::Error>
         let data = pipeline::envelope::load_data(&config, &data_path)?;
         // As `rshape run CONFIG` with its defaults: the noise of the config, order auto.
         let order: OrderChoice = "auto".parse()?;
-        let outcome = pipeline::run(&config, &data, None, order, None)?;
+        let outcome = pipeline::run(&config, &data, order, &pipeline::RunOptions::default())?;
         for (name, svg) in figures(&config, &data, &outcome)? {
             let stem = name.trim_end_matches(".svg");
             if shown.contains(&stem) {

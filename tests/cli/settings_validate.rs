@@ -69,9 +69,13 @@ fn noisy_envelope_names_the_bad_mu_setting() {
 #[test]
 fn fit_names_the_bad_tolerance() {
     let (config, data) = siso();
-    let env = rshape::pipeline::envelope::envelope(&config, &data, Some(0.01))
-        .expect("envelope")
-        .envelope;
+    let env = rshape::pipeline::envelope::envelope(
+        &config,
+        &data,
+        &rshape::RunOptions::noise_radius(Some(0.01)),
+    )
+    .expect("envelope")
+    .envelope;
     let settings = FitSettings {
         bisection_tol: 0.0,
         ..Default::default()

@@ -29,7 +29,7 @@ struct Route {
 
 fn route(config: &Config, controller: &Controller, thorough: bool) -> Route {
     let data = read_frf_csv(config.data.as_ref().expect("data")).expect("data");
-    let env = rshape::envelope(config, &data, None)
+    let env = rshape::envelope(config, &data, &rshape::RunOptions::default())
         .expect("envelope")
         .envelope;
     let f = &config.factorization;
