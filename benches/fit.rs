@@ -185,7 +185,7 @@ fn shipped(name: &str) -> (rshape::Config, Envelope) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(name);
     let config = rshape::Config::load(&path).expect("config");
     let data = rshape::read_frf_csv(config.data.as_ref().expect("data")).expect("data");
-    let env = rshape::envelope(&config, &data, None)
+    let env = rshape::envelope(&config, &data, &rshape::RunOptions::default())
         .expect("envelope")
         .envelope;
     (config, env)
@@ -211,5 +211,6 @@ fn paper_run(bencher: divan::Bencher) {
     let config = rshape::Config::load(&path).expect("config");
     let data = rshape::read_frf_csv(config.data.as_ref().expect("data")).expect("data");
     let order = rshape::fit::OrderChoice::Auto { max: 8 };
-    bencher.bench(|| rshape::run(&config, &data, None, order, None).expect("run"));
+    bencher
+        .bench(|| rshape::run(&config, &data, order, &rshape::RunOptions::default()).expect("run"));
 }

@@ -26,12 +26,16 @@ fn inputs(k: usize, points: usize) -> (rshape::Config, rshape::data::FrfData, te
 fn run_200_modes(bencher: divan::Bencher) {
     let (config, data, _dir) = inputs(200, 1000);
     let order = rshape::fit::OrderChoice::Auto { max: 8 };
-    bencher.bench(|| rshape::run(&config, &data, None, order, None).expect("run"));
+    bencher
+        .bench(|| rshape::run(&config, &data, order, &rshape::RunOptions::default()).expect("run"));
 }
 
 /// The noisy envelope (Theorem 4) of the same model and data.
 #[divan::bench(sample_count = 3)]
 fn envelope_200_modes(bencher: divan::Bencher) {
     let (config, data, _dir) = inputs(200, 1000);
-    bencher.bench(|| rshape::pipeline::envelope::envelope(&config, &data, None).expect("envelope"));
+    bencher.bench(|| {
+        rshape::pipeline::envelope::envelope(&config, &data, &rshape::RunOptions::default())
+            .expect("envelope")
+    });
 }

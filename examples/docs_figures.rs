@@ -6,7 +6,7 @@
 //! cargo run --release --example docs_figures -- OUT_DIR   # writes them elsewhere
 //! ```
 //!
-//! `tests/docs_figures.rs` runs [`regenerate`] into a scratch folder and checks that the
+//! `tests/docs/docs_figures.rs` runs [`regenerate`] into a scratch folder and checks that the
 //! committed figures are current.
 use rshape::fit::OrderChoice;
 use rshape::pipeline::{self, outputs::figures};
@@ -44,7 +44,7 @@ pub fn regenerate(out: &Path) -> Result<Vec<PathBuf>, Box<dyn std::error::Error>
         let data = pipeline::envelope::load_data(&config, &data_path)?;
         // As `rshape run CONFIG` with its defaults: the noise of the config, order auto.
         let order: OrderChoice = "auto".parse()?;
-        let outcome = pipeline::run(&config, &data, None, order, None)?;
+        let outcome = pipeline::run(&config, &data, order, &pipeline::RunOptions::default())?;
         for (name, svg) in figures(&config, &data, &outcome)? {
             let stem = name.trim_end_matches(".svg");
             if shown.contains(&stem) {

@@ -45,6 +45,39 @@ pub enum Error {
     /// Inputs that do not fit together (sizes, missing parts).
     #[error("{0}")]
     Invalid(String),
+    /// A numerical method failed on these inputs: a Riccati, Lyapunov, eigenvalue or H∞
+    /// iteration that found no (stabilizing) solution or did not converge, a matrix that must
+    /// be inverted and is singular.
+    #[error("{what}: {msg}")]
+    Numerical {
+        /// The computation (`"X∞"`, `"H∞ norm"`, `"synthesis"`, …).
+        what: String,
+        /// Why it failed and, where known, what to do.
+        msg: String,
+    },
+}
+
+impl Error {
+    /// A [`Error::Numerical`] failure of `what`.
+    pub fn numerical(what: impl Into<String>, msg: impl Into<String>) -> Self {
+        Self::Numerical {
+            what: what.into(),
+            msg: msg.into(),
+        }
+    }
+
+    /// The same error with `; hint` appended to its message, its kind kept for
+    /// [`Error::Invalid`] and [`Error::Numerical`]; `None` for the other kinds.
+    pub fn with_hint(self, hint: &str) -> std::result::Result<Self, Self> {
+        match self {
+            Self::Invalid(msg) => Ok(Self::Invalid(format!("{msg}; {hint}"))),
+            Self::Numerical { what, msg } => Ok(Self::Numerical {
+                what,
+                msg: format!("{msg}; {hint}"),
+            }),
+            other => Err(other),
+        }
+    }
 }
 
 /// What to check for an I/O error, by its kind.
@@ -65,3 +98,28 @@ fn io_hint(e: &std::io::Error) -> &'static str {
 
 /// Result alias of the library.
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_numerical_failure_reads_as_the_message_it_replaced() {
+        let e = Error::numerical("X∞", "the sign iteration did not converge in 100 steps");
+        assert_eq!(
+            e.to_string(),
+            "X∞: the sign iteration did not converge in 100 steps"
+        );
+        let hinted = e.with_hint("check (A, B)").unwrap();
+        assert!(matches!(&hinted, Error::Numerical { what, .. } if what == "X∞"));
+        assert_eq!(
+            hinted.to_string(),
+            "X∞: the sign iteration did not converge in 100 steps; check (A, B)"
+        );
+        let io = Error::Io {
+            path: "a.csv".into(),
+            source: std::io::Error::from(std::io::ErrorKind::NotFound),
+        };
+        assert!(matches!(io.with_hint("x"), Err(Error::Io { .. })));
+    }
+}

@@ -23,7 +23,7 @@
 //! envelope:
 //!
 //! ```
-//! use rshape::{check, envelope, fit_unit, Config, FitSettings, FrfData};
+//! use rshape::{check, envelope, fit_unit, Config, FitSettings, FrfData, RunOptions};
 //! use nalgebra::DMatrix;
 //! use num_complex::Complex64;
 //! use std::path::Path;
@@ -48,7 +48,7 @@
 //!     response,
 //!     noise_radius: None,
 //! };
-//! let env = envelope(&config, &data, None)?.envelope;
+//! let env = envelope(&config, &data, &RunOptions::default())?.envelope;
 //! // The smallest consistent |r| per datum (Theorem 2) is finite and positive.
 //! assert!(env.r_min.iter().all(|r| r.is_finite() && *r > 0.0));
 //! // A constant r = 0.02 is too small for a 10 % gain error somewhere in the band.
@@ -97,8 +97,8 @@ pub use fit::{fit_auto, fit_unit, Certificate, FitError, FitResult, FitSettings}
 /// Model in: a loaded config ([`model::Config`]) and its factorization.
 pub use model::{Config, Factorization};
 pub use pipeline::envelope::{envelope, EnvelopeOutcome};
-/// The whole `rshape run` pipeline on loaded inputs.
-pub use pipeline::{run, RunOutcome};
+/// The whole `rshape run` pipeline on loaded inputs, and the options of its entry points.
+pub use pipeline::{run, RunOptions, RunOutcome};
 /// A settings field out of its range.
 pub use settings::InvalidSetting;
 /// Robust stability of a controller with a given `r` (Theorem 1).

@@ -97,8 +97,8 @@ fn fill(
         )));
     }
     res.n_data = data.len();
-    let outcome =
-        crate::pipeline::envelope::envelope(config, &data, d.noise_radius.or(opts.noise_radius))?;
+    let options = crate::pipeline::RunOptions::noise_radius(d.noise_radius.or(opts.noise_radius));
+    let outcome = crate::pipeline::envelope::envelope(config, &data, &options)?;
     let env = outcome.envelope;
     res.warnings = outcome.warnings;
     res.max_r_min = env.r_min.iter().copied().reduce(f64::max);

@@ -86,9 +86,9 @@ impl InputArgs {
     /// Loads inputs and computes their envelope ([`crate::pipeline::envelope::envelope`]).
     pub fn envelope(&self) -> Result<(Inputs, Envelope)> {
         let inputs = self.load()?;
+        let options = crate::pipeline::RunOptions::noise_radius(self.noise_radius);
         let env =
-            crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, self.noise_radius)?
-                .envelope;
+            crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, &options)?.envelope;
         Ok((inputs, env))
     }
 }
@@ -240,10 +240,14 @@ pub fn fit_bound(
         Some(&a1),
         &crate::fit::FitSettings::default(),
         crate::fit::OrderChoice::Auto { max: 8 },
-        out,
         Some(&progress),
-    )?;
+    );
     view.finish();
-    let text = outcome.text + &crate::fit::work_line(&outcome.result, outcome.seconds);
+    let outcome = outcome?;
+    let mut text = outcome.text.clone();
+    for f in crate::pipeline::write_fit_exports(&outcome, out)? {
+        text.push_str(&format!("wrote {}\n", f.display()));
+    }
+    text.push_str(&crate::fit::work_line(&outcome.result, outcome.seconds));
     Ok((text, outcome.result.r))
 }

@@ -74,7 +74,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
             let _manifest = super::common::prepare_out(&a.out, &[path])?;
-            run_fit(&env, None, &settings, a.order, &a.out, Some(progress))
+            run_fit(&env, None, &settings, a.order, Some(progress))
         }
         (None, Some(config)) => {
             let input = InputArgs {
@@ -86,13 +86,16 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
-            run_fit(&env, Some(&a1), &settings, a.order, &a.out, Some(progress))
+            run_fit(&env, Some(&a1), &settings, a.order, Some(progress))
         }
         (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),
     };
     view.finish();
     let outcome = outcome?;
     print!("{}", outcome.text);
+    for f in crate::pipeline::write_fit_exports(&outcome, &a.out)? {
+        println!("wrote {}", f.display());
+    }
     print!("{}", work_line(&outcome.result, outcome.seconds));
     if a.verbose {
         print!("{}", events_text(&outcome.result));

@@ -68,14 +68,12 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     let view = super::progress::FitProgressView::new("run: fit");
     let progress = |p| view.update(p);
     let envelope_progress = |done, total| view.data("envelope", done, total);
-    let mut out = pipeline::run_observed(
-        config,
-        data,
-        a.input.noise_radius,
-        a.order,
-        Some(&progress),
-        Some(&envelope_progress),
-    )?;
+    let options = pipeline::RunOptions {
+        noise_radius: a.input.noise_radius,
+        envelope_progress: Some(&envelope_progress),
+        fit_progress: Some(&progress),
+    };
+    let mut out = pipeline::run(config, data, a.order, &options)?;
     view.finish();
     out.timings.0.insert("load".into(), load_ms);
     let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;

@@ -1,10 +1,10 @@
-//! `rshape fit` as a library call: fit (fixed order or automatic), certificate, exports, and
-//! the text to print.  The CLI subcommand is a thin wrapper around [`run_fit`].
+//! `rshape fit` as a library call: fit (fixed order or automatic), certificate, and the text
+//! to print.  The fit writes nothing: [`crate::pipeline::write_fit_exports`] writes the
+//! exports of a [`FitOutcome`].  The CLI subcommand is a thin wrapper around both.
 
 use super::order::{fit_auto_observed, format_table, OrderRow};
 use super::{fit_unit_observed, A1Fn, FitError, FitResult, FitSettings, ProgressFn};
 use crate::consistency::Envelope;
-use std::path::{Path, PathBuf};
 
 /// `--order N` or `--order auto` (sweep `0..=max`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,37 +40,23 @@ pub struct FitOutcome {
     pub result: FitResult,
     /// The order table (auto only).
     pub table: Option<Vec<OrderRow>>,
-    /// Human-readable report: order table (auto), r, certificate, files written (the
-    /// solver events are in [`events_text`], for `--verbose`).
+    /// Human-readable report: order table (auto), r, certificate (the solver events are in
+    /// [`events_text`], for `--verbose`).
     pub text: String,
-    /// Wall-clock seconds of the fit and certificate (exports excluded).
+    /// Wall-clock seconds of the fit and certificate.
     pub seconds: f64,
-    /// Files written.
-    pub files: Vec<PathBuf>,
 }
 
-/// Errors of [`run_fit`]: the fit, or writing the outputs.
-#[derive(Debug, thiserror::Error)]
-pub enum RunError {
-    /// The fit failed (see [`FitError`]).
-    #[error(transparent)]
-    Fit(#[from] FitError),
-    /// An output could not be written.
-    #[error(transparent)]
-    Io(#[from] crate::error::Error),
-}
-
-/// Fits, certifies, writes `r.json`, `r.m`, `r.py`, `r.jl` into `out_dir`, and returns the
-/// printable report; `progress` hears of each order as it starts.  Nothing is written
-/// unless the fit is certified.
+/// Fits and certifies, and returns the printable report; `progress` hears of each order as
+/// it starts.  An uncertified fit is an error, so a caller that writes the exports of the
+/// outcome ([`crate::pipeline::write_fit_exports`]) writes only certified ones.
 pub fn run_fit(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
     order: OrderChoice,
-    out_dir: &Path,
     progress: Option<ProgressFn<'_>>,
-) -> Result<FitOutcome, RunError> {
+) -> Result<FitOutcome, FitError> {
     let start = std::time::Instant::now();
     let (result, table) = match order {
         OrderChoice::Fixed(n) => {
@@ -91,16 +77,11 @@ pub fn run_fit(
         text.push_str(&format_table(t, result.order, settings.auto_tolerance));
     }
     text.push_str(&summary(&result));
-    let files = crate::report::write_fit_exports(&result, table.as_deref(), out_dir)?;
-    for f in &files {
-        text.push_str(&format!("wrote {}\n", f.display()));
-    }
     Ok(FitOutcome {
         result,
         table,
         text,
         seconds,
-        files,
     })
 }
 

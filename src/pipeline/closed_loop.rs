@@ -38,15 +38,16 @@ pub fn a1_factorization(config: &Config) -> Option<&Factorization> {
 }
 
 /// The envelope of the data for either kind of config, its warnings, and the closed-loop
-/// diagnostics (closed-loop configs only).
-pub fn envelope(
+/// diagnostics (closed-loop configs only).  Callers go through [`super::envelope::envelope`],
+/// which resolves the noise radii first.
+pub(super) fn envelope_by_kind(
     config: &Config,
     data: &FrfData,
     radii: Option<&[f64]>,
     progress: Option<crate::consistency::DatumProgressFn<'_>>,
 ) -> Result<(Envelope, Vec<String>, Option<ClosedLoopReport>)> {
     let Some(cl) = &config.closed_loop else {
-        let (e, w) = integration::envelope(&config.factorization, data, radii, progress)?;
+        let (e, w) = integration::open_loop_envelope(&config.factorization, data, radii, progress)?;
         return Ok((e, w, None));
     };
     let rep = closed_loop_envelope(cl, data, radii, &VBisectionSettings::default())?;

@@ -6,6 +6,7 @@
 
 use super::closed_loop;
 use super::integration;
+use super::RunOptions;
 use crate::consistency::closed_loop::ClosedLoopReport;
 use crate::consistency::stream::noise_free_envelope_rows;
 use crate::consistency::Envelope;
@@ -29,25 +30,17 @@ pub struct EnvelopeOutcome {
     pub closed_loop: Option<ClosedLoopReport>,
 }
 
-/// The envelope of loaded data for a config.  `cli_noise` is a global noise radius that
-/// overrides the config (`--noise-radius`).  Noisy open-loop MIMO data are an error naming
-/// the data file: the paper's noisy test (Theorem 4) is SISO.
+/// The envelope of loaded data for a config: the one entry point of every subcommand and of
+/// the library.  `options.noise_radius` is a global noise radius that overrides the config
+/// (`--noise-radius`); `options.envelope_progress` hears of the data done by a noisy
+/// envelope.  Noisy open-loop MIMO data are an error naming the data file: the paper's noisy
+/// test (Theorem 4) is SISO.
 pub fn envelope(
     config: &Config,
     data: &FrfData,
-    cli_noise: Option<f64>,
+    options: &RunOptions<'_>,
 ) -> Result<EnvelopeOutcome> {
-    envelope_observed(config, data, cli_noise, None)
-}
-
-/// As [`envelope`], reporting the data done by a noisy envelope to `progress`.
-pub fn envelope_observed(
-    config: &Config,
-    data: &FrfData,
-    cli_noise: Option<f64>,
-    progress: Option<crate::consistency::DatumProgressFn<'_>>,
-) -> Result<EnvelopeOutcome> {
-    let radii = integration::noise_radii(config, data, cli_noise)?;
+    let radii = integration::noise_radii(config, data, options.noise_radius)?;
     if radii.is_some()
         && config.closed_loop.is_none()
         && (data.outputs() != 1 || data.inputs() != 1)
@@ -60,7 +53,7 @@ pub fn envelope_observed(
         )));
     }
     let (envelope, warnings, closed_loop) =
-        closed_loop::envelope(config, data, radii.as_deref(), progress)?;
+        closed_loop::envelope_by_kind(config, data, radii.as_deref(), options.envelope_progress)?;
     Ok(EnvelopeOutcome {
         envelope,
         noise_radii: radii,
@@ -92,7 +85,7 @@ pub fn envelope_of_file(
         }
     }
     let data = load_data(config, data_path)?;
-    Ok(envelope(config, &data, cli_noise)?.envelope)
+    Ok(envelope(config, &data, &RunOptions::noise_radius(cli_noise))?.envelope)
 }
 
 /// Reads a config's data file (closed-loop spectra or FRF) and applies its `[channel]` when

@@ -23,7 +23,12 @@ use serde_json::Value;
 /// Per-datum noise radii with the precedence of [`crate::model::noise::resolve_noise`]:
 /// `--noise-radius` (or a manifest's per-dataset radius) > the config's `[noise]` > the data
 /// file's `noise_radius` column.  `None` (noise-free) when none is given or all are zero.
-pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<Option<Vec<f64>>> {
+/// (The raw radii, zeros kept, are [`crate::model::noise::noise_radii`].)
+pub(super) fn noise_radii(
+    config: &Config,
+    data: &FrfData,
+    cli: Option<f64>,
+) -> Result<Option<Vec<f64>>> {
     let radii = crate::model::noise::noise_radii(cli, Some(config), data)?;
     Ok(radii.filter(|r| r.iter().any(|x| *x > 0.0)))
 }
@@ -32,7 +37,8 @@ pub fn noise_radii(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<
 /// noisy SISO (Theorem 4, bisection on `|r|` of the μ test) otherwise.  Returns the
 /// envelope and any warning worth showing.
 /// `progress` hears of the data done by the noisy envelope (the noise-free one is closed form).
-pub fn envelope(
+/// Callers go through [`super::envelope::envelope`].
+pub(super) fn open_loop_envelope(
     f: &Factorization,
     data: &FrfData,
     radii: Option<&[f64]>,
@@ -83,6 +89,19 @@ pub fn mu_per_datum(
     Some(out)
 }
 
+/// Why the pipeline's fit of `r` failed, for a caller to match on ([`RunOutcome::fit`](super::RunOutcome::fit),
+/// `rshape batch`'s combined fit).
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum FitFailure {
+    /// The fit itself failed: inadmissible data, A1 against coverage, no feasible or no
+    /// certified `r` (see [`crate::fit::FitError`]).
+    #[error("fit: {0}")]
+    Fit(#[from] crate::fit::FitError),
+    /// The fitted `r` could not be written as `r.json` (rshape's own document: a bug).
+    #[error("r.json: {0}")]
+    Json(String),
+}
+
 /// A fitted unit `r` with its certificate, ready to be written as `r.json`.
 #[derive(Debug, Clone)]
 pub struct FittedR {
@@ -108,12 +127,10 @@ pub fn fit_r(
     a1: Option<&dyn Fn(f64) -> f64>,
     order: OrderChoice,
     progress: Option<ProgressFn<'_>>,
-) -> Result<FittedR> {
-    let err = |e: crate::fit::FitError| Error::Invalid(format!("fit: {e}"));
+) -> std::result::Result<FittedR, FitFailure> {
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
-            let (r, t) =
-                fit_auto_observed(env, a1, &FitSettings::default(), max, progress).map_err(err)?;
+            let (r, t) = fit_auto_observed(env, a1, &FitSettings::default(), max, progress)?;
             (r, Some(t))
         }
         OrderChoice::Fixed(n) => {
@@ -121,12 +138,11 @@ pub fn fit_r(
                 order: n,
                 ..FitSettings::default()
             };
-            (fit_unit_observed(env, a1, &s, progress).map_err(err)?, None)
+            (fit_unit_observed(env, a1, &s, progress)?, None)
         }
     };
     let text = crate::report::export::r_json(&result, table.as_deref());
-    let json: Value =
-        serde_json::from_str(&text).map_err(|e| Error::Invalid(format!("r.json: {e}")))?;
+    let json: Value = serde_json::from_str(&text).map_err(|e| FitFailure::Json(e.to_string()))?;
     let certificate = json
         .get("certificate")
         .cloned()
@@ -138,6 +154,16 @@ pub fn fit_r(
         result,
         table,
     })
+}
+
+/// Writes the exports of `rshape fit`'s outcome (`r.json`, `r.m`, `r.py`, `r.jl`) into `dir`
+/// and returns the files written: the fit ([`crate::fit::run_fit`]) computes, the pipeline
+/// writes.
+pub fn write_fit_exports(
+    outcome: &crate::fit::FitOutcome,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>> {
+    crate::report::write_fit_exports(&outcome.result, outcome.table.as_deref(), dir)
 }
 
 /// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` and returns the files written.

@@ -13,6 +13,7 @@ use crate::data::FrfData;
 use crate::error::Result;
 use crate::model::Config;
 use integration::FittedR;
+pub use integration::{write_fit_exports, FitFailure};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -41,7 +42,7 @@ pub struct RunOutcome {
     /// The check of the configured `r` (`None` when the config has no `[r]`).
     pub check: Option<CheckReport>,
     /// The fitted `r`, or why the fit failed (a failed fit does not stop the run).
-    pub fit: std::result::Result<FittedR, String>,
+    pub fit: std::result::Result<FittedR, integration::FitFailure>,
     /// `μ_Γ` per datum for the configured `r` (noisy data, when available).
     pub mu: Option<Vec<f64>>,
     /// Warnings for the reader.
@@ -52,28 +53,40 @@ pub struct RunOutcome {
     pub closed_loop: Option<crate::consistency::closed_loop::ClosedLoopReport>,
 }
 
+/// What the caller adds to a config and its data at the pipeline's entry points
+/// ([`envelope::envelope`], [`run`]): a global noise radius, and who hears of the progress of
+/// the long stages.  `RunOptions::default()` is a noise radius from the config or the data,
+/// and no progress.
+#[derive(Clone, Copy, Default)]
+pub struct RunOptions<'a> {
+    /// A global noise radius overriding the config's (`--noise-radius`, or a batch
+    /// manifest's per-dataset radius).
+    pub noise_radius: Option<f64>,
+    /// Hears of the data done by a noisy envelope (Theorem 4's μ search per datum, the long
+    /// stage of a large physical model).
+    pub envelope_progress: Option<crate::consistency::DatumProgressFn<'a>>,
+    /// Hears of each order of the fit as it starts (see [`crate::fit::FitProgress`]).
+    pub fit_progress: Option<crate::fit::ProgressFn<'a>>,
+}
+
+impl RunOptions<'_> {
+    /// No progress, the given global noise radius (`None`: the config's or the data's).
+    pub fn noise_radius(noise_radius: Option<f64>) -> Self {
+        Self {
+            noise_radius,
+            ..Self::default()
+        }
+    }
+}
+
 /// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
 /// sizes, a failed assumption at a datum) is an error; the fit and μ failures are kept in
-/// the outcome.  `progress` hears of each order of the fit as it starts.
+/// the outcome.  `options` give the global noise radius and the progress callbacks.
 pub fn run(
     config: &Config,
     data: &FrfData,
-    noise_radius: Option<f64>,
     order: crate::fit::OrderChoice,
-    progress: Option<crate::fit::ProgressFn<'_>>,
-) -> Result<RunOutcome> {
-    run_observed(config, data, noise_radius, order, progress, None)
-}
-
-/// As [`run`], with `envelope_progress` hearing of the data done by a noisy envelope
-/// (Theorem 4's μ search per datum, the long stage of a large physical model).
-pub fn run_observed(
-    config: &Config,
-    data: &FrfData,
-    noise_radius: Option<f64>,
-    order: crate::fit::OrderChoice,
-    progress: Option<crate::fit::ProgressFn<'_>>,
-    envelope_progress: Option<crate::consistency::DatumProgressFn<'_>>,
+    options: &RunOptions<'_>,
 ) -> Result<RunOutcome> {
     let mut timings = Timings::default();
     let f = &config.factorization;
@@ -82,9 +95,7 @@ pub fn run_observed(
         noise_radii: radii,
         mut warnings,
         closed_loop,
-    } = timings.time("envelope", || {
-        envelope::envelope_observed(config, data, noise_radius, envelope_progress)
-    })?;
+    } = timings.time("envelope", || envelope::envelope(config, data, options))?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
         let a1 = |w: f64| f.a1_limit(w);
@@ -92,11 +103,13 @@ pub fn run_observed(
             Some(_) => Some(&a1),
             None => None,
         };
-        integration::fit_r(&envelope, a1, order, progress)
-            .map_err(|e| crate::report::fmt::one_line(&e.to_string()))
+        integration::fit_r(&envelope, a1, order, options.fit_progress)
     });
     if let Err(e) = &fit {
-        warnings.push(format!("fit failed: {e}"));
+        warnings.push(format!(
+            "fit failed: {}",
+            crate::report::fmt::one_line(&e.to_string())
+        ));
     }
     let mu = match (&radii, &config.r) {
         (Some(rad), Some(r)) => {

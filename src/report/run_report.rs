@@ -169,7 +169,11 @@ impl RunReport {
             }),
             r_fitted: out.fit.as_ref().ok().map(|f| f.json.clone()),
             certificate: out.fit.as_ref().ok().map(|f| f.certificate.clone()),
-            fit_error: out.fit.as_ref().err().cloned(),
+            fit_error: out
+                .fit
+                .as_ref()
+                .err()
+                .map(|e| crate::report::fmt::one_line(&e.to_string())),
             data_points,
             warnings: out.warnings.clone(),
             files: files

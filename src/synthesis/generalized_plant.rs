@@ -129,8 +129,12 @@ impl GeneralizedPlant {
     pub fn closed_loop(&self, k: &StateSpace) -> Result<StateSpace> {
         let mu = self.b2.ncols();
         let e = DMatrix::<f64>::identity(mu, mu) - &k.d * &self.d22;
-        let bad =
-            || Error::Invalid("H∞ synthesis: the loop is ill-posed (I − K(∞)·D₂₂ singular)".into());
+        let bad = || {
+            Error::numerical(
+                "H∞ synthesis",
+                "the loop is ill-posed (I − K(∞)·D₂₂ singular)",
+            )
+        };
         let lu = e.lu();
         // u = E⁻¹(C_K x_K + D_K (C₂ x + D₂₁ w)), y = C₂x + D₂₁w + D₂₂u.
         let ux = lu.solve(&(&k.d * &self.c2)).ok_or_else(bad)?;
@@ -194,7 +198,7 @@ pub fn normalize(p: &GeneralizedPlant) -> Result<NormalizedPlant> {
         .d21
         .clone()
         .try_inverse()
-        .ok_or_else(|| Error::Invalid("H∞ synthesis: D₂₁ is singular".into()))?;
+        .ok_or_else(|| Error::numerical("H∞ synthesis", "D₂₁ is singular"))?;
     let ut = u.transpose();
     let mut d12 = DMatrix::zeros(pz, m);
     d12.view_mut((py, 0), (m, m))

@@ -85,14 +85,14 @@ pub fn optimum(ncf: &NormalizedLcf) -> Result<GmOptimum> {
     let s = DMatrix::<f64>::identity(p, p) + d * d.transpose();
     let r_lu = r.clone().lu();
     let s_lu = s.lu();
-    let bad = || Error::Invalid("synthesis: I + DᵀD is singular".into());
+    let bad = || Error::numerical("synthesis", "I + DᵀD is singular");
     let abar = a - b * r_lu.solve(&(d.transpose() * c)).ok_or_else(bad)?;
     let g = symmetric(&(b * r_lu.solve(&b.transpose()).ok_or_else(bad)?));
     let q = symmetric(&(c.transpose() * s_lu.solve(c).ok_or_else(bad)?));
     let xs = care(&abar, &g, &q, "control Riccati equation of the plant").map_err(|e| {
-        Error::Invalid(format!(
-            "{e}; Glover–McFarlane synthesis needs (A, B) stabilizable and (A, C) detectable"
-        ))
+        let hint = "Glover–McFarlane synthesis needs (A, B) stabilizable and (A, C) detectable";
+        e.with_hint(hint)
+            .unwrap_or_else(|other| Error::Invalid(format!("{other}; {hint}")))
     })?;
     let z = ncf.riccati.x.clone();
     let zh = psd_sqrt(&z);
@@ -128,20 +128,18 @@ pub fn central_controller(ncf: &NormalizedLcf, opt: &GmOptimum, gamma: f64) -> R
     let f = -r
         .lu()
         .solve(&(d.transpose() * c + b.transpose() * &opt.x))
-        .ok_or_else(|| Error::Invalid("synthesis: I + DᵀD is singular".into()))?;
+        .ok_or_else(|| Error::numerical("synthesis", "I + DᵀD is singular"))?;
     let g2 = gamma * gamma;
     let l = DMatrix::<f64>::identity(n, n) * (1.0 - g2) + &opt.x * &opt.z;
     let sv = l.clone().svd(false, false).singular_values;
     if n > 0 && (sv.min().is_nan() || sv.min() <= 1e-13 * sv.max().max(1.0)) {
-        return Err(Error::Invalid(format!(
-            "synthesis: L = (1 − γ²)I + XZ is singular at γ = {gamma} (too close to γ_min = {gamma_min}): raise the γ factor"
-        )));
+        return Err(Error::numerical("synthesis", format!("L = (1 − γ²)I + XZ is singular at γ = {gamma} (too close to γ_min = {gamma_min}): raise the γ factor")));
     }
     let w = l
         .transpose()
         .lu()
         .solve(&(&opt.z * c.transpose()))
-        .ok_or_else(|| Error::Invalid("synthesis: L is singular".into()))?;
+        .ok_or_else(|| Error::numerical("synthesis", "L is singular"))?;
     let k = StateSpace {
         a: a + b * &f + (&w * (c + d * &f)) * g2,
         b: &w * g2,
@@ -169,9 +167,7 @@ pub fn synthesize(ncf: &NormalizedLcf, factor: f64) -> Result<GmController> {
         spectral_abscissa(&eigenvalues(&cl, "closed-loop poles")?)
     };
     if abscissa.is_nan() || abscissa >= 0.0 {
-        return Err(Error::Invalid(format!(
-            "synthesis: the central controller does not stabilize the plant (closed-loop pole with real part {abscissa:.3e}); the Riccati solutions are too inaccurate"
-        )));
+        return Err(Error::numerical("synthesis", format!("the central controller does not stabilize the plant (closed-loop pole with real part {abscissa:.3e}); the Riccati solutions are too inaccurate")));
     }
     Ok(GmController {
         b_opt: opt.b_opt,

@@ -263,9 +263,7 @@ pub fn central_controller(
     let w = DMatrix::<f64>::identity(n, n) - &sol.y * &sol.x / (gamma * gamma);
     let w_lu = w.lu();
     let bad = || {
-        Error::Invalid(format!(
-            "H∞ synthesis: I − γ⁻²Y∞X∞ is singular at γ = {gamma} (too close to the optimum): raise the γ factor"
-        ))
+        Error::numerical("H∞ synthesis", format!("I − γ⁻²Y∞X∞ is singular at γ = {gamma} (too close to the optimum): raise the γ factor"))
     };
     let zb2 = w_lu.solve(&(&p.b2 + &l12)).ok_or_else(bad)?;
     let zl2 = w_lu.solve(&l2).ok_or_else(bad)?;
@@ -281,7 +279,10 @@ pub fn central_controller(
     // Loop shifting: y = y₀ + D₂₂u and u = K₀y₀ give K = K₀(I + D₂₂K₀)⁻¹.
     let ed = DMatrix::<f64>::identity(mu, mu) + &k0.d * &p.d22;
     let ed_inv = ed.try_inverse().ok_or_else(|| {
-        Error::Invalid("H∞ synthesis: the loop shift is ill-posed (I + D̂₁₁D₂₂ singular)".into())
+        Error::numerical(
+            "H∞ synthesis",
+            "the loop shift is ill-posed (I + D̂₁₁D₂₂ singular)",
+        )
     })?;
     let k = StateSpace {
         a: &k0.a - &k0.b * &p.d22 * &ed_inv * &k0.c,

@@ -105,9 +105,10 @@ pub fn eigenvalues(a: &DMatrix<f64>, what: &str) -> Result<Vec<Complex64>> {
         })
     });
     let schur = schur.ok_or_else(|| {
-        Error::Invalid(format!(
-            "{what}: the eigenvalue (Schur) iteration did not converge in {MAX_SWEEPS} sweeps"
-        ))
+        Error::numerical(
+            what,
+            format!("the eigenvalue (Schur) iteration did not converge in {MAX_SWEEPS} sweeps"),
+        )
     })?;
     Ok(schur.complex_eigenvalues().iter().copied().collect())
 }

@@ -121,9 +121,8 @@ fn hamiltonian(ss: &StateSpace, gamma: f64) -> Option<DMatrix<f64>> {
 /// Frequencies `ω ≥ 0` where `jω` is (to a generous tolerance: a spurious candidate only
 /// costs a probe) an eigenvalue of `H(level)`.
 fn hamiltonian_crossings(ss: &StateSpace, level: f64) -> Result<Vec<f64>> {
-    let h = hamiltonian(ss, level).ok_or_else(|| {
-        Error::Invalid("H∞ norm: singular D-term matrix in the Hamiltonian".into())
-    })?;
+    let h = hamiltonian(ss, level)
+        .ok_or_else(|| Error::numerical("H∞ norm", "singular D-term matrix in the Hamiltonian"))?;
     let eigs = eigenvalues(&h, "H∞ norm: Hamiltonian")?;
     let hn = h.amax().max(1.0);
     Ok(eigs
@@ -194,8 +193,9 @@ fn pencil_crossings(ss: &StateSpace, level: f64, shift: f64) -> Result<Vec<f64>>
         }
     }
     let Some((_, s0, x1)) = best else {
-        return Err(Error::Invalid(
-            "H∞ norm: extended pencil: singular for every shift tried".into(),
+        return Err(Error::numerical(
+            "H∞ norm",
+            "extended pencil: singular for every shift tried",
         ));
     };
     let xn = x1.amax();
@@ -346,7 +346,8 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
             }
         }
     }
-    Err(Error::Invalid(format!(
-        "H∞ norm: no convergence in {MAX_ITER} Hamiltonian iterations"
-    )))
+    Err(Error::numerical(
+        "H∞ norm",
+        format!("no convergence in {MAX_ITER} Hamiltonian iterations"),
+    ))
 }

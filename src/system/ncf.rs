@@ -24,7 +24,7 @@
 use super::freq_eval::FreqEvaluator;
 use super::riccati::{care, CareSolution};
 use super::state_space::StateSpace;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -68,11 +68,9 @@ impl NormalizedLcf {
         let g = c.transpose() * &rt_inv * c;
         let q = b * &r_inv * b.transpose();
         let riccati = care(&abar.transpose(), &g, &q, "filter Riccati equation of the plant")
-            .map_err(|e| match e {
-                Error::Invalid(msg) => Error::Invalid(format!(
-                    "{msg}; normalized coprime factors need (A, C) detectable and no uncontrollable mode of (A, B) on the imaginary axis"
-                )),
-                other => other,
+            .map_err(|e| {
+                e.with_hint("normalized coprime factors need (A, C) detectable and no uncontrollable mode of (A, B) on the imaginary axis")
+                    .unwrap_or_else(|other| other)
             })?;
         let y = &riccati.x;
         let l = -(b * d.transpose() + y * c.transpose()) * &rt_inv;

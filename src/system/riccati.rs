@@ -82,9 +82,7 @@ fn sign(z0: DMatrix<f64>, what: &str) -> Result<(DMatrix<f64>, usize)> {
     let mut scaling = true;
     for k in 1..=MAX_SIGN_ITER {
         let Some((zinv, logdet)) = inverse_with_logdet(&z) else {
-            return Err(Error::Invalid(format!(
-                "{what}: the Hamiltonian has eigenvalues on the imaginary axis (singular in the sign iteration): no stabilizing solution"
-            )));
+            return Err(Error::numerical(what, "the Hamiltonian has eigenvalues on the imaginary axis (singular in the sign iteration): no stabilizing solution"));
         };
         let c = if scaling && logdet.is_finite() {
             (-logdet / n).exp()
@@ -104,9 +102,7 @@ fn sign(z0: DMatrix<f64>, what: &str) -> Result<(DMatrix<f64>, usize)> {
             break;
         }
     }
-    Err(Error::Invalid(format!(
-        "{what}: the sign iteration did not converge in {MAX_SIGN_ITER} steps (eigenvalues on or near the imaginary axis): no stabilizing solution"
-    )))
+    Err(Error::numerical(what, format!("the sign iteration did not converge in {MAX_SIGN_ITER} steps (eigenvalues on or near the imaginary axis): no stabilizing solution")))
 }
 
 /// Solves the Lyapunov equation `FᵀX + XF + Q = 0` for Hurwitz `F` by the sign function of
@@ -117,9 +113,10 @@ pub fn lyapunov(f: &DMatrix<f64>, q: &DMatrix<f64>, what: &str) -> Result<DMatri
     let mut scaling = true;
     for _ in 0..MAX_SIGN_ITER {
         let Some((finv, logdet)) = inverse_with_logdet(&fk) else {
-            return Err(Error::Invalid(format!(
-                "{what}: Lyapunov equation with a singular state matrix"
-            )));
+            return Err(Error::numerical(
+                what,
+                "Lyapunov equation with a singular state matrix",
+            ));
         };
         let c = if scaling && logdet.is_finite() {
             (-logdet / n).exp()
@@ -138,17 +135,19 @@ pub fn lyapunov(f: &DMatrix<f64>, q: &DMatrix<f64>, what: &str) -> Result<DMatri
             // sign(F) = −I exactly when F is Hurwitz.
             let id = DMatrix::<f64>::identity(f.nrows(), f.nrows());
             if one_norm(&(&fk + id)) > 1e-6 {
-                return Err(Error::Invalid(format!(
-                    "{what}: the Lyapunov state matrix is not Hurwitz"
-                )));
+                return Err(Error::numerical(
+                    what,
+                    "the Lyapunov state matrix is not Hurwitz",
+                ));
             }
             let x = qk * 0.5;
             return Ok((&x + x.transpose()) * 0.5);
         }
     }
-    Err(Error::Invalid(format!(
-        "{what}: the Lyapunov sign iteration did not converge in {MAX_SIGN_ITER} steps"
-    )))
+    Err(Error::numerical(
+        what,
+        format!("the Lyapunov sign iteration did not converge in {MAX_SIGN_ITER} steps"),
+    ))
 }
 
 /// Riccati residual `AᵀX + XA − XGX + Q` with compensated dot products
@@ -277,14 +276,10 @@ pub fn care(
         .map(|v| v.abs())
         .fold(f64::INFINITY, f64::min);
     if rmin.is_nan() || rmin <= 1e-13 * rmax {
-        return Err(Error::Invalid(format!(
-            "{what}: the stable invariant subspace of the Hamiltonian is not a graph (an unstable mode is unobservable or uncontrollable): no stabilizing solution"
-        )));
+        return Err(Error::numerical(what, "the stable invariant subspace of the Hamiltonian is not a graph (an unstable mode is unobservable or uncontrollable): no stabilizing solution"));
     }
     let mut x = r.solve_upper_triangular(&qt_rhs).ok_or_else(|| {
-        Error::Invalid(format!(
-            "{what}: singular subspace basis: no stabilizing solution"
-        ))
+        Error::numerical(what, "singular subspace basis: no stabilizing solution")
     })?;
     x = (&x + x.transpose()) * 0.5;
     let mut residual = relative_residual(a, g, q, &x);
@@ -314,15 +309,11 @@ pub fn care(
         residual = relative_residual(a, g, q, &x);
     }
     if residual.is_nan() || residual >= RESIDUAL_TOL {
-        return Err(Error::Invalid(format!(
-            "{what}: relative residual {residual:.1e} after refinement (above {RESIDUAL_TOL:.0e}): the equation is too ill-conditioned or has no stabilizing solution"
-        )));
+        return Err(Error::numerical(what, format!("relative residual {residual:.1e} after refinement (above {RESIDUAL_TOL:.0e}): the equation is too ill-conditioned or has no stabilizing solution")));
     }
     let abscissa = spectral_abscissa(&eigenvalues(&(a - g * &x), what)?);
     if abscissa.is_nan() || abscissa >= 0.0 {
-        return Err(Error::Invalid(format!(
-            "{what}: the solution is not stabilizing (closed-loop eigenvalue with real part {abscissa:.3e}): an unstable mode is unobservable or uncontrollable"
-        )));
+        return Err(Error::numerical(what, format!("the solution is not stabilizing (closed-loop eigenvalue with real part {abscissa:.3e}): an unstable mode is unobservable or uncontrollable")));
     }
     Ok(CareSolution {
         x,
@@ -376,6 +367,10 @@ mod tests {
         let g = DMatrix::from_row_slice(2, 2, &[0.0, 0.0, 0.0, 1.0]);
         let q = DMatrix::identity(2, 2);
         let e = care(&a, &g, &q, "filter Riccati equation").unwrap_err();
+        assert!(
+            matches!(&e, Error::Numerical { what, .. } if what == "filter Riccati equation"),
+            "{e:?}"
+        );
         assert!(
             e.to_string().contains("no stabilizing solution")
                 || e.to_string().contains("not stabilizing"),

@@ -1,4 +1,4 @@
-"""Reference values for tests/eq8_accuracy.rs: the minimum-norm ‖Δ‖ of Boulet & Francis 1998
+"""Reference values for tests/consistency/eq8_accuracy.rs: the minimum-norm ‖Δ‖ of Boulet & Francis 1998
 eq. (8), r_min = sqrt(λ_max(U (I + Φ*Φ)^{-1} U*)), U = Ñ − M̃Φ, computed with mpmath at 60
 digits from the exact double inputs printed below.  Run: python3 tests/reference/eq8_mpmath.py
 (prints the Rust table pasted into the test).  the seed is fixed, so the output is stable."""

@@ -12,7 +12,7 @@
 //! The sensitivity is the **true** plant's `(I + P₀C)⁻¹`.  Corollary 1 as printed has
 //! `(I + P̂C)⁻¹` — its proof writes `(P₀D̂ − N̂) = (P̂N_c + D_c)Δ` where the factor is
 //! `P₀N_c + D_c` — while Corollary 2 (`C̄ = C`) has `1/(1 + P₀C̄)`, which agrees with (*).
-//! The test `tests/closed_loop_noise_free.rs` reconstructs `P₀` from both forms: (*)
+//! The test `tests/consistency/closed_loop_noise_free.rs` reconstructs `P₀` from both forms: (*)
 //! reproduces it to rounding, the printed form does not.
 //!
 //! The data give the closed-loop map `Φ = (I + P₀C̄)⁻¹P₀` of the experiment (controller
@@ -145,7 +145,7 @@ pub fn delta_bar_corollary1_printed(
 /// `D + C̄N = A + (C̄ − C)D_cΔ̄`, `A = D̂ + C̄N̂`, so
 /// `(D + C̄N)⁻¹ = (I − M₁₁Δ̄)⁻¹A⁻¹` needs `M₁₁ = A⁻¹(C − C̄)D_c`; expanding
 /// `N̂(I − M₁₁Δ̄)⁻¹` then gives exactly the printed `M₂₁` and `M₂₂`.  The test
-/// `tests/closed_loop_noise_free.rs` checks `F_u(M, Δ̄) = Φ` with `C̄ ≠ C`: it holds with
+/// `tests/consistency/closed_loop_noise_free.rs` checks `F_u(M, Δ̄) = Φ` with `C̄ ≠ C`: it holds with
 /// this sign and fails with the printed one.  (For `C̄ = C` both give `M₁₁ = 0`.)
 pub fn lft_m(at: &ClosedLoopAt) -> Option<[DMatrix<Complex64>; 4]> {
     let p = at.p_hat.nrows();

@@ -1,0 +1,26 @@
+//! Test binary `cli` (tests/README.md says which binary a new test joins).
+//!
+//! The command line end to end: subcommands' outputs and exit codes, bad input (one-line errors,
+//! exit 2, nothing half-written), batch and merge, output folders, kill safety, help texts,
+//! settings validation and the figures' legibility.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod a1_verdict;
+mod bad_input;
+mod bad_input_batch;
+mod bad_input_kinds;
+mod batch_cli;
+mod batch_vocabulary;
+mod cli_help;
+mod closed_loop_cli;
+mod configs_every;
+mod figures_glance;
+mod fuzz_inputs;
+mod kill_safety;
+mod output_modes;
+mod output_policy;
+mod quiet_output;
+mod run_cli;
+mod settings_validate;

@@ -1,0 +1,15 @@
+//! Test binary `control` (tests/README.md says which binary a new test joins).
+//!
+//! Robust stability (Theorem 1), H-infinity norms, controller synthesis (Glover-McFarlane,
+//! H-infinity with r) and model reduction.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod closed_loop_stability_large;
+mod hinf_near_d;
+mod iss_reduction;
+mod stability;
+mod stability_special;
+mod synthesize;
+mod synthesize_hinf;

@@ -1,0 +1,15 @@
+//! Test binary `fit` (tests/README.md says which binary a new test joins).
+//!
+//! The fit of r(s): certificates, reference fitters, random envelopes, the paper's examples,
+//! work reports.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod certificate_exact;
+mod fit_defects;
+mod fit_paper;
+mod fit_random;
+mod fit_reference;
+mod fit_thorough;
+mod fit_work_report;
