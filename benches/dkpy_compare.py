@@ -3,7 +3,7 @@ overbounding fit by cvxpy bisection) on the 24 envelopes of the random sweep.
 
 Write the envelopes first (release build):
 
-    RSHAPE_SWEEP_CSV=/tmp/sweep cargo test --release --test fit_sweep -- --ignored --nocapture
+    RSHAPE_SWEEP_CSV=/tmp/sweep cargo test --release --test fit fit_sweep:: -- --ignored --nocapture
 
 (or any directory of `omega_rad_s,r_min` CSV files), then, with dkpy installed
 (`pip install dkpy`):

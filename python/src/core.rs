@@ -166,7 +166,12 @@ pub fn envelope(
     guarded(py, || {
         noise_arg(noise_radius)?;
         let data = config_data(&cfg, frf)?;
-        let out = env_mod::envelope(&cfg, &data, noise_radius).py()?;
+        let out = env_mod::envelope(
+            &cfg,
+            &data,
+            &rshape::pipeline::RunOptions::noise_radius(noise_radius),
+        )
+        .py()?;
         Ok(Envelope {
             inner: Arc::new(out.envelope),
             config: Some(cfg.clone()),

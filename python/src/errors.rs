@@ -48,7 +48,7 @@ create_exception!(
 
 /// The one line the CLI prints after `error: ` for a library error: the message and its
 /// sources, as `anyhow`'s `{:#}` writes them.
-pub fn message(e: &Error) -> String {
+pub fn message(e: &(dyn std::error::Error + 'static)) -> String {
     let mut text = e.to_string();
     let mut source = std::error::Error::source(e);
     while let Some(s) = source {

@@ -11,5 +11,6 @@ mod fit_defects;
 mod fit_paper;
 mod fit_random;
 mod fit_reference;
+mod fit_sweep;
 mod fit_thorough;
 mod fit_work_report;

@@ -4,12 +4,12 @@
 //! the speed work of issue 38 is stored in `tests/data/fit_sweep_reference.csv`; no order may
 //! rise above it by more than 0.002 decade, and every order must stay certified.
 //!
-//! Heavy (a few minutes in release): `cargo test --release --test fit_sweep -- --ignored
+//! Heavy (a few minutes in release): `cargo test --release --test fit fit_sweep:: -- --ignored
 //! --nocapture`.  It prints LPs and seconds per envelope.  `RSHAPE_SWEEP_WRITE=1` rewrites
 //! the reference table instead of checking it (only on the code the table is meant to record);
 //! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`.
 
-#[path = "../benches/support/random_envelopes.rs"]
+#[path = "../../benches/support/random_envelopes.rs"]
 mod random_envelopes;
 
 use random_envelopes::{envelope, sweep_specs, to_csv, SWEEP_LEN};
@@ -165,7 +165,7 @@ fn bench_case_figures() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/iss1r_reduced.toml");
     let config = rshape::Config::load(&path).expect("config");
     let data = rshape::read_frf_csv(config.data.as_ref().expect("data")).expect("data");
-    let env = rshape::envelope(&config, &data, None)
+    let env = rshape::envelope(&config, &data, &Default::default())
         .expect("envelope")
         .envelope;
     let f = &config.factorization;
