@@ -13,7 +13,12 @@ use std::time::{Duration, Instant};
 /// Exit code 2, one line starting `error: `, no panic, every needle present.
 fn assert_one_line_error(o: &std::process::Output, needles: &[&str]) {
     let err = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "stderr: {err}\nstdout: {}", stdout(o));
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "stderr: {err}\nstdout: {}",
+        stdout(o)
+    );
     assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
     assert!(err.starts_with("error: "), "{err}");
     assert!(!err.contains("panicked"), "{err}");
@@ -51,7 +56,10 @@ fn small_gain_tf_plant_keeps_its_unstable_pole() {
         let out = stdout(&o);
         assert_eq!(o.status.code(), Some(1), "{out}{}", stderr(&o));
         assert!(out.contains("NOT internally stable"), "{out}");
-        assert!(out.contains("1+0j"), "the pole at s = 1 must be named: {out}");
+        assert!(
+            out.contains("1+0j"),
+            "the pole at s = 1 must be named: {out}"
+        );
     }
 }
 
@@ -171,5 +179,227 @@ proptest! {
             }
             (t, s) => prop_assert!(false, "k = {}: tf {:?} vs state space {:?}", k, t, s),
         }
+    }
+}
+
+// ---------------------------------------------------------------- item 3: synthesize
+
+/// A plant without states (`tf = [[2]]`, `[[0]]`, the shipped rigid-body accelerance)
+/// panicked in the eigen-decomposition of a 0×0 matrix. The closed form: b_opt = 1 with
+/// the static K = Dᵀ, which the Theorem 1 proof (an independent route: ‖T‖∞ of the loop)
+/// confirms as b(G,K) = 1; and the exported controller reads back.
+#[test]
+fn static_plant_synthesizes_in_closed_form() {
+    let dir = tempfile::tempdir().unwrap();
+    for d in ["2", "0", "-0.5"] {
+        let cfg = write(
+            dir.path(),
+            "st.toml",
+            &format!("[plant]\ntf = [[{d}]]\n[r]\nnum = [0.1]\nden = [1]\n"),
+        );
+        let out = dir.path().join(format!("o{d}"));
+        let o = rshape(&["synthesize", &cfg, "--out", out.to_str().unwrap()]);
+        let text = stdout(&o);
+        assert_eq!(o.status.code(), Some(0), "{text}{}", stderr(&o));
+        assert!(text.contains("b_opt = 1 "), "{text}");
+        assert!(text.contains("b(G,K) = 1 "), "{text}");
+        assert!(
+            !text.contains("inf\n") || !text.contains("largest real part inf"),
+            "{text}"
+        );
+        let k = out.join("controller.toml");
+        let o = rshape(&["stability", &cfg, "--controller", k.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+        assert!(
+            stdout(&o).contains("internally stable: no closed-loop poles"),
+            "{}",
+            stdout(&o)
+        );
+    }
+    let o = rshape(&[
+        "synthesize",
+        repo("configs/pyfrf_rigid.toml").to_str().unwrap(),
+        "--out",
+        dir.path().join("rigid").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+    assert!(!stderr(&o).contains("panicked"));
+}
+
+/// `--gamma-factor 1e300` overflowed γ² (a panic on 2×2, an endless loop on 4×4): now
+/// refused before any work, as are 1, NaN and inf; nothing is written.
+#[test]
+fn gamma_factor_out_of_range_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for f in ["1e300", "1e4", "1", "NaN", "inf"] {
+        let t = Instant::now();
+        let o = rshape(&[
+            "synthesize",
+            repo("configs/plant_first.toml").to_str().unwrap(),
+            "--gamma-factor",
+            f,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, &["--gamma-factor", "1000"]);
+        assert!(t.elapsed() < Duration::from_secs(60));
+        assert!(!out.exists(), "{f}: output folder left");
+    }
+}
+
+// ---------------------------------------------------------------- items 5, 6: outputs
+
+/// A config with a `[noise] coherence` file and a std file beside the data.
+fn noisy_copy(dir: &Path) -> String {
+    let src = repo("configs/data/pyfrf");
+    std::fs::create_dir_all(dir.join("data/pyfrf")).unwrap();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), dir.join("data/pyfrf").join(e.file_name())).unwrap();
+    }
+    let text = std::fs::read_to_string(repo("configs/pyfrf_rigid.toml")).unwrap();
+    write(dir, "rigid.toml", &text)
+}
+
+/// `compare --svg`, `history --svg` and `diagnose --write` onto the coherence file the run
+/// reads (the guard knew only the config and data) destroyed it with exit 0.
+#[test]
+fn outputs_never_overwrite_a_noise_file_the_run_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = noisy_copy(dir.path());
+    let coh = dir.path().join("data/pyfrf/frf_h1_20_1200_coherence.csv");
+    let before = std::fs::read(&coh).unwrap();
+    let c = coh.to_str().unwrap();
+    for args in [
+        vec!["compare", &cfg, "--svg", c],
+        vec!["history", &cfg, "--svg", c],
+        vec!["diagnose", &cfg, "--write", c, "--apply", "1"],
+    ] {
+        let o = rshape(&args);
+        assert_one_line_error(&o, &["is the input"]);
+        assert_eq!(
+            std::fs::read(&coh).unwrap(),
+            before,
+            "{args:?} changed the input"
+        );
+    }
+}
+
+/// An output onto a device or FIFO was renamed over it (a regular file replaced
+/// `/dev/null` as root): refused, the special file untouched.
+#[cfg(unix)]
+#[test]
+fn outputs_refuse_special_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo");
+    let ok = std::process::Command::new("mkfifo").arg(&fifo).status();
+    let cfg = repo("configs/plant_first.toml");
+    let cfg = cfg.to_str().unwrap();
+    let mut targets = vec!["/dev/null".to_string()];
+    if ok.is_ok_and(|s| s.success()) {
+        targets.push(fifo.to_str().unwrap().to_string());
+    }
+    for t in &targets {
+        let o = rshape(&["compare", cfg, "--noise-radius", "0.01", "--svg", t]);
+        assert_one_line_error(&o, &["not a regular file"]);
+        let m = std::fs::metadata(t).unwrap();
+        assert!(!m.is_file(), "{t} was replaced by a regular file");
+    }
+}
+
+/// `compare --svg X --against MISSING` wrote X before reading --against.
+#[test]
+fn compare_against_missing_leaves_no_figure() {
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("x.svg");
+    let missing = dir.path().join("missing.csv");
+    let o = rshape(&[
+        "compare",
+        repo("configs/plant_first.toml").to_str().unwrap(),
+        "--noise-radius",
+        "0.01",
+        "--svg",
+        svg.to_str().unwrap(),
+        "--against",
+        missing.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["missing.csv"]);
+    assert!(!svg.exists(), "figure left behind by a refusal");
+}
+
+// ---------------------------------------------------------------- item 7: weights
+
+/// `--weights /dev/zero` grew past 4 GB and a FIFO blocked forever: the guarded reader
+/// refuses both at once.
+#[cfg(unix)]
+#[test]
+fn weights_go_through_the_guarded_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("w.fifo");
+    let mut targets = vec!["/dev/zero".to_string()];
+    if std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success())
+    {
+        targets.push(fifo.to_str().unwrap().to_string());
+    }
+    let out = dir.path().join("out");
+    for w in &targets {
+        let t = Instant::now();
+        let o = rshape(&[
+            "synthesize",
+            repo("configs/plant_first.toml").to_str().unwrap(),
+            "--weights",
+            w,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_one_line_error(&o, &["not a regular file"]);
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "{w}: {:?}",
+            t.elapsed()
+        );
+        assert!(!out.exists());
+    }
+}
+
+// ---------------------------------------------------------------- minor
+
+/// `--data MISSING` was silently ignored by stability and synthesize; `--max-effects 0`
+/// and `--beam 0` were silently changed to 1.
+#[test]
+fn silently_ignored_flags_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = repo("configs/plant_first.toml");
+    let cfg = cfg.to_str().unwrap();
+    let k = repo("configs/plant_first_controller.toml");
+    let missing = dir.path().join("missing.csv");
+    let m = missing.to_str().unwrap();
+    let out = dir.path().join("out");
+    let o = rshape(&[
+        "stability",
+        cfg,
+        "--controller",
+        k.to_str().unwrap(),
+        "--data",
+        m,
+    ]);
+    assert_one_line_error(&o, &["--data", "missing.csv"]);
+    let o = rshape(&[
+        "synthesize",
+        cfg,
+        "--data",
+        m,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_one_line_error(&o, &["--data", "missing.csv"]);
+    assert!(!out.exists());
+    for flag in ["--max-effects", "--beam"] {
+        let o = rshape(&["diagnose", cfg, "--noise-radius", "0.01", flag, "0"]);
+        assert_one_line_error(&o, &[flag, "at least 1"]);
     }
 }

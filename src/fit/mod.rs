@@ -48,7 +48,9 @@ pub use order::{fit_auto, fit_auto_observed, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
 pub use provenance::{EventKind, Origin, PoleSet};
 pub use realization::realize;
-pub use run::{events_text, run_fit, work_line, FitOutcome, OrderChoice, RunError};
+pub use run::{
+    events_text, fit_in_memory, run_fit, work_line, write_fit, FitOutcome, OrderChoice, RunError,
+};
 pub use settings_check::MAX_ORDER;
 pub use spectral::Zpk;
 

@@ -71,6 +71,21 @@ pub fn run_fit(
     out_dir: &Path,
     progress: Option<ProgressFn<'_>>,
 ) -> Result<FitOutcome, RunError> {
+    let mut outcome = fit_in_memory(env, a1, settings, order, progress)?;
+    write_fit(&mut outcome, out_dir)?;
+    Ok(outcome)
+}
+
+/// As [`run_fit`] without writing anything (`files` empty): for a caller that has more to
+/// check before any output may exist (`synthesize --fit` proves the controller first),
+/// then calls [`write_fit`].
+pub fn fit_in_memory(
+    env: &Envelope,
+    a1: Option<A1Fn<'_>>,
+    settings: &FitSettings,
+    order: OrderChoice,
+    progress: Option<ProgressFn<'_>>,
+) -> Result<FitOutcome, RunError> {
     let start = std::time::Instant::now();
     let (result, table) = match order {
         OrderChoice::Fixed(n) => {
@@ -91,17 +106,25 @@ pub fn run_fit(
         text.push_str(&format_table(t, result.order, settings.auto_tolerance));
     }
     text.push_str(&summary(&result));
-    let files = crate::report::write_fit_exports(&result, table.as_deref(), out_dir)?;
-    for f in &files {
-        text.push_str(&format!("wrote {}\n", f.display()));
-    }
     Ok(FitOutcome {
         result,
         table,
         text,
         seconds,
-        files,
+        files: Vec::new(),
     })
+}
+
+/// Writes the exports of a fit made by [`fit_in_memory`] into `out_dir` and adds their
+/// `wrote` lines to its text.
+pub fn write_fit(outcome: &mut FitOutcome, out_dir: &Path) -> Result<(), RunError> {
+    let files =
+        crate::report::write_fit_exports(&outcome.result, outcome.table.as_deref(), out_dir)?;
+    for f in &files {
+        outcome.text.push_str(&format!("wrote {}\n", f.display()));
+    }
+    outcome.files = files;
+    Ok(())
 }
 
 /// A short text summary of a certified fit.

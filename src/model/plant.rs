@@ -87,10 +87,19 @@ pub(crate) fn state_space(
     what: &str,
 ) -> std::result::Result<StateSpace, String> {
     let a = matrix(a, &format!("{what} a"), 0)?;
-    let b = matrix(b, &format!("{what} b"), 0)?;
+    let d_given = match d {
+        Some(d) => Some(matrix(d, &format!("{what} d"), 0)?),
+        None => None,
+    };
+    // With no states, `b = []` has D's columns (a static controller as exported).
+    let b = matrix(
+        b,
+        &format!("{what} b"),
+        d_given.as_ref().map_or(0, |d| d.ncols()),
+    )?;
     let c = matrix(c, &format!("{what} c"), a.nrows())?;
-    let d = match d {
-        Some(d) => matrix(d, &format!("{what} d"), b.ncols())?,
+    let d = match d_given {
+        Some(d) => d,
         None => DMatrix::zeros(c.nrows(), b.ncols()),
     };
     let ss = StateSpace { a, b, c, d };
