@@ -403,3 +403,96 @@ fn silently_ignored_flags_are_errors() {
         assert_one_line_error(&o, &[flag, "at least 1"]);
     }
 }
+
+// ---------------------------------------------------------------- item 2: A1 certificate
+
+/// A mode with ζ = 1e-7 at 478.77 rad/s (configs/twomass_rev1.toml with its damping
+/// changed): `run` reported "certificate passed" with A1 checked on "function", while
+/// σ_min(M̃) dips 1e-7 wide at the mode, between any grid points. The certificate now
+/// evaluates A1 at the lightly damped zeros of M̃ (`Factorization::a1_dips`). Cross-check:
+/// σ_min(M̃) at the mode computed directly, and the same certificate without the dips
+/// (the old behaviour) passing — so the test fails when the dips are not used.
+#[test]
+fn a1_notch_of_a_lightly_damped_mode_fails_the_certificate() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("configs/twomass_rev1.toml"))
+        .unwrap()
+        .replace("zeta = 0.020144090247561523", "zeta = 1e-7")
+        .replace(
+            "\"data/",
+            &format!("\"{}/", repo("configs/data").to_str().unwrap()),
+        );
+    assert!(text.contains("zeta = 1e-7"));
+    let cfg = write(dir.path(), "tm.toml", &text);
+    let config = Config::load(Path::new(&cfg)).unwrap();
+    let f = &config.factorization;
+    let wn = 478.7728546626137;
+    let dips = f.a1_dips();
+    assert!(
+        dips.iter().any(|d| (d - wn).abs() < 1e-6 * wn),
+        "no dip at the mode: {dips:?}"
+    );
+    // The notch: σ_min(M̃) at the mode is far below its values 1 % either side.
+    let at = |w: f64| f.a1_limit(w);
+    let deep = at(wn);
+    let side = at(0.99 * wn).min(at(1.01 * wn));
+    assert!(deep < 1e-3 * side, "{deep} vs {side}");
+    // A constant r between the two: above σ_min at the notch, below it elsewhere.
+    let c = (deep * side).sqrt();
+    let r = rshape::fit::Zpk {
+        gain: c,
+        zeros: vec![],
+        poles: vec![],
+    };
+    let omega: Vec<f64> = (0..200).map(|k| 100.0 * 1.01f64.powi(k)).collect();
+    let r_min = vec![c * 0.5; omega.len()];
+    let a1 = |w: f64| f.a1_limit(w);
+    let mk = |dips: &'static [f64]| rshape::fit::CertInput {
+        omega: &omega,
+        r_min: &r_min,
+        a1: Some(&a1),
+        a1_data: None,
+        a1_dips: dips,
+        margin: 0.0,
+        floor: 1e-12,
+        per_decade: 100,
+        extend_decades: 2.0,
+        no_dip: true,
+        axis_tol: 1e-9,
+    };
+    let old = rshape::fit::certify(&r, &mk(&[]));
+    assert!(
+        old.passed,
+        "the grid alone should miss the notch: {:?}",
+        old.failures
+    );
+    let dips: &'static [f64] = Box::leak(dips.into_boxed_slice());
+    let new = rshape::fit::certify(&r, &mk(dips));
+    assert!(!new.passed);
+    assert!(
+        new.failures.iter().any(|m| m.contains("A1 fails")),
+        "{:?}",
+        new.failures
+    );
+    let w = new.worst_a1_omega.unwrap();
+    assert!((w - wn).abs() < 1e-4 * wn, "{w}");
+    assert!(new.worst_a1_margin.unwrap() < 1.0);
+}
+
+/// ζ = 5e-324 was accepted; below 1e-12 a damping ratio is refused with a one-line error.
+#[test]
+fn subnormal_damping_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(repo("configs/twomass_rev1.toml"))
+        .unwrap()
+        .replace("zeta = 0.020144090247561523", "zeta = 5e-324")
+        .replace(
+            "\"data/",
+            &format!("\"{}/", repo("configs/data").to_str().unwrap()),
+        );
+    let cfg = write(dir.path(), "tm.toml", &text);
+    let out = dir.path().join("out");
+    let o = rshape(&["run", &cfg, "--out", out.to_str().unwrap()]);
+    assert_one_line_error(&o, &["zeta = 5e-324", "below 1e-12"]);
+    assert!(!out.exists());
+}

@@ -280,7 +280,10 @@ pub fn fit_bound_in_memory(
     let outcome = crate::fit::fit_in_memory(
         env,
         Some(&a1),
-        &crate::fit::FitSettings::default(),
+        &crate::fit::FitSettings {
+            a1_dips: f.a1_dips(),
+            ..Default::default()
+        },
         crate::fit::OrderChoice::Auto { max: 8 },
         Some(&progress),
     )?;

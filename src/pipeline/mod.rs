@@ -92,7 +92,12 @@ pub fn run_observed(
             Some(_) => Some(&a1),
             None => None,
         };
-        integration::fit_r(&envelope, a1, order, progress)
+        let dips = if a1.is_some() {
+            f.a1_dips()
+        } else {
+            Vec::new()
+        };
+        integration::fit_r(&envelope, a1, dips, order, progress)
             .map_err(|e| crate::report::fmt::one_line(&e.to_string()))
     });
     if let Err(e) = &fit {
