@@ -114,6 +114,8 @@ fn check_no_pole_lost(g: &TfMatrix, min: &StateSpace) -> std::result::Result<(),
     let eigs = crate::system::eig::eigenvalues(&min.balanced().a, "[plant] tf realization")
         .map_err(|e| e.to_string())?;
     let cols = g.cols();
+    // Absolute scale of the poles: a pole at 0 is matched within 1e-11 of it.
+    let scale = eigs.iter().map(|z| z.norm()).fold(0.0, f64::max);
     for (k, t) in g.entries().iter().enumerate() {
         if t.num.is_zero() {
             continue;
@@ -126,7 +128,7 @@ fn check_no_pole_lost(g: &TfMatrix, min: &StateSpace) -> std::result::Result<(),
         let rho = poles.roots.iter().map(|p| p.norm()).fold(0.0, f64::max);
         for p in &poles.roots {
             // Loose enough for the √ε accuracy of a double root.
-            let tol = 1e-3 * p.norm().max(1e-8 * rho).max(f64::MIN_POSITIVE);
+            let tol = 1e-3 * p.norm().max(1e-8 * rho.max(scale)).max(f64::MIN_POSITIVE);
             let near = |z: &num_complex::Complex64| (z - p).norm() <= tol;
             if eigs.iter().any(near) || zeros.iter().any(near) {
                 continue;

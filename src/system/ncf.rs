@@ -51,12 +51,12 @@ fn spd_power(p: &DMatrix<f64>, power: f64) -> DMatrix<f64> {
     &eig.eigenvectors * d * eig.eigenvectors.transpose()
 }
 
-/// The same plant after the state similarity `x ↦ αx` (`α` a power of two) that gives
-/// `C` the norm `‖B‖^w·‖C‖^(1−w)` … in short: `w = 1/2` equalizes `‖B‖` and `‖C‖`, `w = 0`
-/// puts the whole gain into `B` (`‖C‖ ≈ 1`). The transfer function is unchanged; the filter
-/// Riccati solution scales by `α²`, which keeps it O(1) for a plant scaled by `10^k`
-/// (a stable plant with a large gain wants `w = 1/2`, an unstable one with a small gain
-/// `w = 0`, where the unscaled solution grows like `10^(−2k)`).
+/// The same plant after the state similarity `x ↦ x/α` (`α` a power of two, `B ↦ αB`,
+/// `C ↦ C/α`) chosen so that `‖C/α‖ = ‖B‖^w·‖C‖^(1−w)`: `w = 1/2` equalizes `‖B‖` and
+/// `‖C‖`, `w = 1` swaps them (the gain moves from `C` into `B`). The transfer function is unchanged; the filter Riccati solution scales by `α²`, which keeps
+/// it O(1) for a plant scaled by `10^k` (a stable plant with a large gain wants `w = 1/2`;
+/// an unstable one with a small gain, whose unscaled solution grows like `10^(−2k)`, wants
+/// the gain moved into `B`).
 fn rescaled(plant: &StateSpace, w: f64) -> Option<StateSpace> {
     let (nb, nc) = (plant.b.norm(), plant.c.norm());
     if plant.a.nrows() == 0 || !(nb > 0.0 && nc > 0.0 && nb.is_finite() && nc.is_finite()) {
@@ -82,14 +82,14 @@ impl NormalizedLcf {
     /// mode on the imaginary axis that the input does not reach).
     ///
     /// The plant is tried as given; when the Riccati equation fails, it is retried in two
-    /// rescaled state coordinates ([`rescaled`]) before the failure is reported, so that
+    /// rescaled state coordinates (see `rescaled`) before the failure is reported, so that
     /// the verdict does not depend on the plant's gain scale.
     pub fn new(plant: StateSpace) -> Result<Self> {
         plant.validate("plant")?;
         match Self::in_coordinates(plant.clone()) {
             Ok(f) => Ok(f),
             Err(e) => {
-                for w in [0.5, 0.0, 1.0] {
+                for w in [0.5, 1.0] {
                     if let Some(f) = rescaled(&plant, w).and_then(|s| Self::in_coordinates(s).ok())
                     {
                         return Ok(f);
