@@ -23,6 +23,18 @@ pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
     write_via_temp(path, contents, false)
 }
 
+/// Refuses an output path that exists and is not a regular file (a device such as
+/// `/dev/null`, a FIFO, a socket): the atomic rename would replace it with a regular file.
+pub fn check_not_special(path: &Path) -> Result<()> {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => Err(Error::Invalid(format!(
+            "{}: is a device, FIFO or socket, not a regular file; rshape writes results to regular files only: give a file name",
+            path.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 fn write_via_temp(path: &Path, contents: &[u8], sync: bool) -> Result<()> {
     let mut file = AtomicFile::create(path)?;
     (file.out.write_all(contents)).map_err(|source| Error::Io {
@@ -44,6 +56,7 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts writing `path` (its directory is created if needed).
     pub fn create(path: &Path) -> Result<Self> {
+        check_not_special(path)?;
         let dir = path
             .parent()
             .filter(|p| !p.as_os_str().is_empty())

@@ -212,7 +212,8 @@ pub fn finish(
     let t = std::time::Instant::now();
     let a1 = inp.factorization.map(|f| move |w: f64| f.a1_limit(w));
     let a1_dyn: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
-    let fit = combined.map(|env| integration::fit_r(env, a1_dyn, inp.order, None));
+    let dips = inp.factorization.map(|f| f.a1_dips()).unwrap_or_default();
+    let fit = combined.map(|env| integration::fit_r(env, a1_dyn, dips, inp.order, None));
     timings.insert("fit".into(), t.elapsed().as_secs_f64() * 1e3);
     let t = std::time::Instant::now();
     if let Some(env) = combined {

@@ -34,8 +34,10 @@ impl InputArgs {
     /// (an output the subcommand writes may not be one of them, [`check_out_file`]).
     pub fn files(&self) -> Vec<PathBuf> {
         let mut files = vec![self.config.clone()];
-        files.extend(self.data.clone());
-        files.extend(config_data(&self.config));
+        if let Some(d) = &self.data {
+            files.extend(data_and_siblings(d));
+        }
+        files.extend(config_files(&self.config));
         files
     }
 
@@ -140,6 +142,7 @@ pub fn check_out_file(
             path.display()
         ));
     }
+    crate::util::check_not_special(path)?;
     if let Ok(p) = path.canonicalize() {
         for input in inputs.iter().map(|i| i.as_ref()) {
             if input.canonicalize().is_ok_and(|i| i == p) {
@@ -154,9 +157,28 @@ pub fn check_out_file(
     Ok(())
 }
 
-/// The data file a config names (for the output checks), if it loads.
-pub fn config_data(config: &std::path::Path) -> Option<PathBuf> {
-    crate::model::Config::load(config).ok().and_then(|c| c.data)
+/// Every file a config makes a run read (itself, its data, noise std or coherence file,
+/// plant file: [`Config::files_read`]), for the output checks; just the path when it does
+/// not load.
+pub fn config_files(config: &std::path::Path) -> Vec<PathBuf> {
+    match crate::model::Config::load(config) {
+        Ok(c) => c.files_read(),
+        Err(_) => vec![config.to_path_buf()],
+    }
+}
+
+/// A `--data` file and the per-frequency noise files a run may read beside it
+/// (`<stem>_std.csv`, `<stem>_coherence.csv`).
+pub fn data_and_siblings(data: &std::path::Path) -> Vec<PathBuf> {
+    let stem = data
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    vec![
+        data.to_path_buf(),
+        data.with_file_name(format!("{stem}_std.csv")),
+        data.with_file_name(format!("{stem}_coherence.csv")),
+    ]
 }
 
 /// A bound `r` with its label (`configured`, `fitted`).
@@ -197,6 +219,15 @@ impl BoundArgs {
         config_path: &std::path::Path,
         config: &Config,
     ) -> Result<(Vec<LabelledBound>, Option<FitInput>)> {
+        // --data only shapes the figure's grid here: a missing file was silently ignored.
+        if let Some(d) = &self.data {
+            if !d.is_file() {
+                return Err(anyhow!(
+                    "--data {}: no such file (or not a regular file); check the path",
+                    d.display()
+                ));
+            }
+        }
         if config.closed_loop.is_some() && self.fit {
             return Err(anyhow!(
                 "{}: --fit on a [closed_loop] config would fit its weight V, not a factor bound r: give --r-json r.json",
@@ -228,9 +259,19 @@ impl BoundArgs {
 /// and the fitted `r`.
 pub fn fit_bound(
     label: &str,
-    (inputs, env): &FitInput,
+    input: &FitInput,
     out: &std::path::Path,
 ) -> Result<(String, crate::system::TransferFunction)> {
+    let outcome = fit_bound_in_memory(label, input)?;
+    write_fit_text(outcome, out)
+}
+
+/// As [`fit_bound`], writing nothing: the caller checks the rest, then writes the fit and
+/// prints its text with [`write_fit_text`].
+pub fn fit_bound_in_memory(
+    label: &str,
+    (inputs, env): &FitInput,
+) -> Result<crate::fit::FitOutcome> {
     let f = &inputs.config.factorization;
     let a1 = |w: f64| f.a1_limit(w);
     let view = super::progress::FitProgressView::new(label);
@@ -238,12 +279,23 @@ pub fn fit_bound(
     let outcome = crate::fit::run_fit(
         env,
         Some(&a1),
-        &crate::fit::FitSettings::default(),
+        &crate::fit::FitSettings {
+            a1_dips: f.a1_dips(),
+            ..Default::default()
+        },
         crate::fit::OrderChoice::Auto { max: 8 },
         Some(&progress),
     );
     view.finish();
-    let outcome = outcome?;
+    Ok(outcome?)
+}
+
+/// Writes the fit's exports into `out` (`pipeline::write_fit_exports`) and returns its
+/// printable text (the files written, the work line) and the fitted `r`.
+pub fn write_fit_text(
+    outcome: crate::fit::FitOutcome,
+    out: &std::path::Path,
+) -> Result<(String, crate::system::TransferFunction)> {
     let mut text = outcome.text.clone();
     for f in crate::pipeline::write_fit_exports(&outcome, out)? {
         text.push_str(&format!("wrote {}\n", f.display()));

@@ -112,10 +112,28 @@ pub fn fmt_bands(b: &[Band]) -> String {
 pub fn run(a: &CompareArgs) -> Result<i32> {
     if let Some(svg) = &a.svg {
         let mut inputs = a.input.files();
-        inputs.extend(a.against.clone());
+        if let Some(p) = &a.against {
+            inputs.extend(super::common::data_and_siblings(p));
+        }
         super::common::check_out_file("--svg", svg, &inputs)?;
     }
     let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?)?;
+    // Everything is read and checked before the figure is written (no figure left behind
+    // by a refusal such as a missing --against file).
+    let agreement = match &a.against {
+        Some(p) => {
+            let inputs = a.input.load()?;
+            let other = crate::data::read_frf_csv(p)?;
+            let sb = prepare(
+                &inputs.config,
+                &other,
+                Some(siso.channel),
+                a.input.noise_radius,
+            )?;
+            Some(data_vs_data(&siso, &sb)?)
+        }
+        None => None,
+    };
     if let Some(path) = &a.svg {
         let invalid: Vec<bool> = rep.rows.iter().map(|r| r.invalid).collect();
         // The model is drawn on a dense grid (it can be evaluated anywhere); a frequency
@@ -150,20 +168,6 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         )?;
         rep.figure = Some(path.display().to_string());
     }
-    let agreement = match &a.against {
-        Some(p) => {
-            let inputs = a.input.load()?;
-            let other = crate::data::read_frf_csv(p)?;
-            let sb = prepare(
-                &inputs.config,
-                &other,
-                Some(siso.channel),
-                a.input.noise_radius,
-            )?;
-            Some(data_vs_data(&siso, &sb)?)
-        }
-        None => None,
-    };
     if a.json {
         let mut v = serde_json::to_value(&rep)?;
         if let Some(ag) = &agreement {

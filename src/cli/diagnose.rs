@@ -94,6 +94,14 @@ fn channels(
 
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
+    // 0 was silently taken as 1: say so instead.
+    for (flag, v) in [("--max-effects", a.max_effects), ("--beam", a.beam)] {
+        if v == 0 {
+            return Err(anyhow::anyhow!(
+                "{flag} 0: must be at least 1 (the default is 3)"
+            ));
+        }
+    }
     if let Some(w) = &a.write {
         super::common::check_out_file("--write", w, &a.input.files())?;
     }

@@ -54,11 +54,13 @@ pub struct Revision {
 pub fn run(a: &HistoryArgs) -> Result<i32> {
     if let Some(svg) = &a.svg {
         let mut inputs = a.configs.clone();
-        inputs.extend(a.data.clone());
+        if let Some(d) = &a.data {
+            inputs.extend(super::common::data_and_siblings(d));
+        }
         inputs.extend(
             a.configs
                 .iter()
-                .filter_map(|c| super::common::config_data(c)),
+                .flat_map(|c| super::common::config_files(c)),
         );
         super::common::check_out_file("--svg", svg, &inputs)?;
     }

@@ -4,7 +4,7 @@
 
 use crate::model::Config;
 use crate::pipeline::synthesize;
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -51,14 +51,9 @@ pub enum MethodArg {
 
 /// Runs `rshape synthesize`.
 pub fn run(a: &SynthesizeArgs) -> Result<i32> {
+    crate::synthesis::check_gamma_factor(a.gamma_factor)?;
     let config = Config::load(&a.config)?;
     synthesize::plant_factors(&config, &a.config)?;
-    if !(a.gamma_factor.is_finite() && a.gamma_factor > 1.0) {
-        return Err(anyhow!(
-            "--gamma-factor {}: must be a number > 1 (gamma = F * gamma_min; the central controller is undefined at gamma_min)",
-            a.gamma_factor
-        ));
-    }
     let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     let inputs: Vec<&Path> = std::iter::once(a.config.as_path())
         .chain(a.bounds.files())
@@ -89,19 +84,22 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         synthesize::run(&config, &a.config, rs, &settings, data, &controller_path)
     };
     let dry = prove(&rs)?;
-    let _manifest = super::common::prepare_out(&a.out, &inputs)?;
-    // Without --fit the run above is the outcome; with it, the proof is repeated with the
-    // fitted r added.
-    let mut fit_text = String::new();
-    let outcome = match &fit_input {
-        None => dry,
+    // Without --fit the run above is the outcome; with it, r is fitted in memory and the
+    // proof repeated with the fitted r added, all before anything is written (a refusal,
+    // e.g. --reduce on an unstable H∞ controller, leaves no r.json behind).
+    let (outcome, fit) = match &fit_input {
+        None => (dry, None),
         Some(input) => {
-            let (text, r) = super::common::fit_bound("synthesize --fit", input, &a.out)?;
-            fit_text = text;
-            rs.push(("fitted".into(), r));
-            prove(&rs)?
+            let fit = super::common::fit_bound_in_memory("synthesize --fit", input)?;
+            rs.push(("fitted".into(), fit.result.r.clone()));
+            (prove(&rs)?, Some(fit))
         }
     };
+    let _manifest = super::common::prepare_out(&a.out, &inputs)?;
+    let mut fit_text = String::new();
+    if let Some(fit) = fit {
+        fit_text = super::common::write_fit_text(fit, &a.out)?.0;
+    }
     let written = synthesize::write_outputs(&a.out, &outcome)?;
     let code = if outcome.robust { 0 } else { 1 };
     if a.json {

@@ -270,7 +270,18 @@ fn attained_min(sq: &SquaredMagnitude, xa: f64, xb: f64, b2: f64) -> (f64, f64, 
 /// Proves (or refutes) `|r(jω)| ≥ bound·(1 − TOL)` on `[w_a, w_b]` and brackets the minimum
 /// of `|r|/bound` where it dips.
 pub fn check_interval(sq: &SquaredMagnitude, w_a: f64, w_b: f64, bound: f64) -> IntervalCheck {
-    let b2 = bound * bound;
+    // Prescaled: the bound goes into the gain as (g/b)², so that a bound of 1e-300 (whose
+    // square underflows to 0) does not turn every ratio into inf and the proof into a
+    // spurious "did not close". A ratio beyond 1e300 is capped there: a smaller gain only
+    // makes the proof harder, so what is proved with the cap holds without it.
+    let ratio = sq.gain2.sqrt() / bound;
+    let scaled = SquaredMagnitude {
+        gain2: (ratio * ratio).min(1e300),
+        zeros: sq.zeros.clone(),
+        poles: sq.poles.clone(),
+    };
+    let sq = &scaled;
+    let b2 = 1.0;
     let (xa, xb) = (w_a * w_a, w_b * w_b);
     let (mut m2, mut mx, mut nodes) = attained_min(sq, xa, xb, b2);
     let mut level = 1.0 - TOL;
@@ -396,6 +407,20 @@ mod tests {
         // The witness is real: evaluated independently it is below the bound.
         let b = r.mag(2.9).min(r.mag(3.2));
         assert!(r.mag(c.omega) / b < 0.1);
+    }
+
+    #[test]
+    fn tiny_bound_does_not_underflow() {
+        // b = 1e-300: b² underflows to 0; the proof must still close (|r|/b ≈ 1e300 ≥ 1),
+        // as it does for b = 1e-100, and a bound far above |r| must still fail.
+        let r = zpk(1.0, &[(-2.0, 0.0)], &[(-0.5, 0.0)]);
+        let sq = SquaredMagnitude::new(&r);
+        for b in [1e-100, 1e-300, 5e-324] {
+            let c = check_interval(&sq, 1.0, 2.0, b);
+            assert!(!c.capped && c.lower >= 1.0 - TOL, "b = {b}: {c:?}");
+        }
+        let c = check_interval(&sq, 1.0, 2.0, 10.0 * r.mag(2.0));
+        assert!(c.lower < 1.0 && c.attained < 0.2, "{c:?}");
     }
 
     #[test]

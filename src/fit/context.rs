@@ -153,12 +153,13 @@ pub(crate) fn prepare<'a>(
 }
 
 impl Context<'_> {
-    pub(crate) fn cert_input(&self, set: &FitSettings) -> certificate::CertInput<'_> {
+    pub(crate) fn cert_input<'s>(&'s self, set: &'s FitSettings) -> certificate::CertInput<'s> {
         certificate::CertInput {
             omega: &self.env.omega,
             r_min: &self.env.r_min,
             a1: self.a1,
             a1_data: self.env.a1_limit.as_deref(),
+            a1_dips: &set.a1_dips,
             margin: set.margin,
             floor: self.floor,
             per_decade: set.cert_per_decade,

@@ -120,6 +120,12 @@ pub struct FitSettings {
     /// from the best level known). On the shipped examples 0.7–1.6× the LPs, each dearer.
     /// Default false.
     pub thorough: bool,
+    /// Frequencies (rad/s) where `σ_min(M̃(jω))` may dip sharply: the lightly damped zeros
+    /// of `M̃` ([`crate::model::Factorization::a1_dips`]). The certificate evaluates A1
+    /// there and refines around each, so that a notch narrower than its grid (a mode with
+    /// ζ = 1e-7) is not missed. Empty: the grid alone.
+    #[serde(skip)]
+    pub a1_dips: Vec<f64>,
 }
 
 impl Default for FitSettings {
@@ -142,6 +148,7 @@ impl Default for FitSettings {
             chain: false,
             auto_tolerance: 0.01,
             thorough: false,
+            a1_dips: Vec::new(),
         }
     }
 }

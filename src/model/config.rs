@@ -248,6 +248,26 @@ fn tf_rows(
 }
 
 impl Config {
+    /// Every file this config makes a run read besides itself: the data, the noise
+    /// `std_file` or `coherence`, a `[plant] file` (resolved against the config's folder).
+    /// The output checks compare every output path with these, so that no figure or
+    /// revised config is written over an input.
+    pub fn files_read(&self) -> Vec<PathBuf> {
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        let mut files = vec![self.path.clone()];
+        files.extend(self.data.clone());
+        files.extend(self.noise_std.as_ref().map(|(p, _)| p.clone()));
+        files.extend(self.raw.noise.coherence.as_ref().map(|c| base.join(c)));
+        files.extend(
+            self.raw
+                .plant
+                .as_ref()
+                .and_then(|p| p.file.as_ref())
+                .map(|f| base.join(f)),
+        );
+        files
+    }
+
     /// Reads and validates a config file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::util::read_text_file(path)?;

@@ -227,6 +227,39 @@ impl Factorization {
         self.at(omega).plant()
     }
 
+    /// Frequencies (rad/s) where `σ_min(M̃(jω))` may dip sharply: `|z|` and `|Im z|` of each
+    /// lightly damped (`|Re z| < |z|/2`) zero `z` of `M̃` — the eigenvalues of the plant's
+    /// `A` for normalized factors (the zeros of `M̃ = [A + LC | L; R̃^(−1/2)C | R̃^(−1/2)]`),
+    /// else the numerator roots of `M̃`'s entries (exact for a diagonal `M̃`, candidates
+    /// otherwise). At most 2000, the least damped first. For the fit's certificate.
+    pub fn a1_dips(&self) -> Vec<f64> {
+        let zeros: Vec<Complex64> = match &self.realization {
+            Some(ncf) => crate::system::eigenvalues(&ncf.plant.a, "A1 dips").unwrap_or_default(),
+            None => self
+                .m
+                .entries()
+                .iter()
+                .filter(|t| !t.num.is_zero())
+                .flat_map(|t| t.zeros())
+                .collect(),
+        };
+        let mut light: Vec<(f64, Complex64)> = zeros
+            .into_iter()
+            .filter(|z| z.im >= 0.0 && z.norm() > 0.0 && z.re.abs() < 0.5 * z.norm())
+            .map(|z| (z.re.abs() / z.norm(), z))
+            .collect();
+        light.sort_by(|a, b| a.0.total_cmp(&b.0));
+        light.truncate(2000);
+        let mut out = Vec::with_capacity(2 * light.len());
+        for (_, z) in light {
+            out.push(z.norm());
+            if z.im > 0.0 {
+                out.push(z.im);
+            }
+        }
+        out
+    }
+
     /// `σ_min(M̃(jω))`, the A1 limit on `|r(jω)|`.
     pub fn a1_limit(&self, omega: f64) -> f64 {
         if self.realization.is_none()

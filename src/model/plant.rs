@@ -87,15 +87,62 @@ pub(crate) fn state_space(
     what: &str,
 ) -> std::result::Result<StateSpace, String> {
     let a = matrix(a, &format!("{what} a"), 0)?;
-    let b = matrix(b, &format!("{what} b"), 0)?;
+    let d_given = match d {
+        Some(d) => Some(matrix(d, &format!("{what} d"), 0)?),
+        None => None,
+    };
+    // With no states, `b = []` has D's columns (a static controller as exported).
+    let b = matrix(
+        b,
+        &format!("{what} b"),
+        d_given.as_ref().map_or(0, |d| d.ncols()),
+    )?;
     let c = matrix(c, &format!("{what} c"), a.nrows())?;
-    let d = match d {
-        Some(d) => matrix(d, &format!("{what} d"), b.ncols())?,
+    let d = match d_given {
+        Some(d) => d,
         None => DMatrix::zeros(c.nrows(), b.ncols()),
     };
     let ss = StateSpace { a, b, c, d };
     ss.validate(what).map_err(|e| e.to_string())?;
     Ok(ss)
+}
+
+/// A second route for the minimal realization of a tf plant: every pole of every entry
+/// that no zero of the same entry cancels must be an eigenvalue of the realization. A pole
+/// the staircase dropped anyway is an error naming it, never a silent change of plant.
+fn check_no_pole_lost(g: &TfMatrix, min: &StateSpace) -> std::result::Result<(), String> {
+    let eigs = crate::system::eig::eigenvalues(&min.balanced().a, "[plant] tf realization")
+        .map_err(|e| e.to_string())?;
+    let cols = g.cols();
+    // Absolute scale of the poles: a pole at 0 is matched within 1e-11 of it.
+    let scale = eigs.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    for (k, t) in g.entries().iter().enumerate() {
+        if t.num.is_zero() {
+            continue;
+        }
+        let poles = t.den.roots();
+        if !poles.converged {
+            continue;
+        }
+        let zeros = t.num.roots().roots;
+        let rho = poles.roots.iter().map(|p| p.norm()).fold(0.0, f64::max);
+        for p in &poles.roots {
+            // Loose enough for the √ε accuracy of a double root.
+            let tol = 1e-3 * p.norm().max(1e-8 * rho.max(scale)).max(f64::MIN_POSITIVE);
+            let near = |z: &num_complex::Complex64| (z - p).norm() <= tol;
+            if eigs.iter().any(near) || zeros.iter().any(near) {
+                continue;
+            }
+            return Err(format!(
+                "[plant] tf[{}][{}]: the pole at {:.6e}{:+.6e}j was lost in the minimal realization (a numerically unobservable or uncontrollable state); write the plant as a state space (a, b, c, d) or rescale it",
+                k / cols + 1,
+                k % cols + 1,
+                p.re,
+                p.im
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl PlantSection {
@@ -140,7 +187,9 @@ impl PlantSection {
                 }
             }
             let g = TfMatrix::from_rows(tfs).ok_or("[plant] tf is not rectangular")?;
-            StateSpace::from_tf_matrix(&g).minimal(1e-10)
+            let min = StateSpace::from_tf_matrix(&g).minimal(1e-10);
+            check_no_pole_lost(&g, &min)?;
+            min
         } else if inline {
             match (&self.a, &self.b, &self.c, &self.d) {
                 (Some(a), Some(b), Some(c), d) => state_space(a, b, c, d.as_deref(), "[plant]")?,

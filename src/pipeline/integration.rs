@@ -125,19 +125,21 @@ pub struct FittedR {
 pub fn fit_r(
     env: &Envelope,
     a1: Option<&dyn Fn(f64) -> f64>,
+    a1_dips: Vec<f64>,
     order: OrderChoice,
     progress: Option<ProgressFn<'_>>,
 ) -> std::result::Result<FittedR, FitFailure> {
+    let base = FitSettings {
+        a1_dips,
+        ..FitSettings::default()
+    };
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto_observed(env, a1, &FitSettings::default(), max, progress)?;
+            let (r, t) = fit_auto_observed(env, a1, &base, max, progress)?;
             (r, Some(t))
         }
         OrderChoice::Fixed(n) => {
-            let s = FitSettings {
-                order: n,
-                ..FitSettings::default()
-            };
+            let s = FitSettings { order: n, ..base };
             (fit_unit_observed(env, a1, &s, progress)?, None)
         }
     };

@@ -103,7 +103,12 @@ pub fn run(
             Some(_) => Some(&a1),
             None => None,
         };
-        integration::fit_r(&envelope, a1, order, options.fit_progress)
+        let dips = if a1.is_some() {
+            f.a1_dips()
+        } else {
+            Vec::new()
+        };
+        integration::fit_r(&envelope, a1, dips, order, options.fit_progress)
     });
     if let Err(e) = &fit {
         warnings.push(format!(

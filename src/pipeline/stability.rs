@@ -215,11 +215,18 @@ pub fn text(o: &StabilityOutcome) -> String {
         );
         return s;
     }
-    let _ = writeln!(
-        s,
-        "internally stable: {n} closed-loop poles (the loop's and the factors' own), largest real part {}",
-        fmt_g(rep.abscissa)
-    );
+    if n == 0 {
+        let _ = writeln!(
+            s,
+            "internally stable: no closed-loop poles (a static loop: plant, controller and factors without states)"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "internally stable: {n} closed-loop poles (the loop's and the factors' own), largest real part {}",
+            fmt_g(rep.abscissa)
+        );
+    }
     if let Some(t) = &rep.t_norm {
         let form = match o.kind {
             FactorizationKind::Standard => "T = [K; I](I+GK)^-1 M~^-1",

@@ -79,6 +79,17 @@ fn psd_sqrt(p: &DMatrix<f64>) -> DMatrix<f64> {
 /// eigenvalue of the symmetric `Z^(1/2)XZ^(1/2)` (the same spectrum, computed stably).
 pub fn optimum(ncf: &NormalizedLcf) -> Result<GmOptimum> {
     let plant = &ncf.plant;
+    if plant.states() == 0 {
+        // A static plant G = D: [Ñ M̃] is constant, its Hankel norm 0, so b_opt = 1
+        // (attained by K = Dᵀ: b(D, Dᵀ) = 1, see `central_controller`).
+        return Ok(GmOptimum {
+            x: DMatrix::zeros(0, 0),
+            z: DMatrix::zeros(0, 0),
+            rho: 0.0,
+            b_opt: 1.0,
+            residuals: [0.0, 0.0],
+        });
+    }
     let (p, m) = plant.d.shape();
     let (a, b, c, d) = (&plant.a, &plant.b, &plant.c, &plant.d);
     let r = DMatrix::<f64>::identity(m, m) + d.transpose() * d;
@@ -124,6 +135,17 @@ pub fn central_controller(ncf: &NormalizedLcf, opt: &GmOptimum, gamma: f64) -> R
             "synthesis: γ = {gamma} must exceed γ_min = {gamma_min} (the central controller is undefined at the optimum)"
         )));
     }
+    if n == 0 {
+        // Eq. (9.67) with no states is the static K = −Dᵀ (u = +K·y), i.e. Dᵀ for
+        // u = −K·y, for every γ: [I; Dᵀ](I + DDᵀ)⁻¹[I  D] is the orthogonal projector onto
+        // the range of [I; Dᵀ], of norm 1, so b(D, Dᵀ) = 1 = b_opt.
+        return Ok(StateSpace {
+            a: DMatrix::zeros(0, 0),
+            b: DMatrix::zeros(0, d.nrows()),
+            c: DMatrix::zeros(m, 0),
+            d: d.transpose(),
+        });
+    }
     let r = DMatrix::<f64>::identity(m, m) + d.transpose() * d;
     let f = -r
         .lu()
@@ -131,6 +153,13 @@ pub fn central_controller(ncf: &NormalizedLcf, opt: &GmOptimum, gamma: f64) -> R
         .ok_or_else(|| Error::numerical("synthesis", "I + DᵀD is singular"))?;
     let g2 = gamma * gamma;
     let l = DMatrix::<f64>::identity(n, n) * (1.0 - g2) + &opt.x * &opt.z;
+    // γ² can overflow (a huge factor times a large γ_min): never hand an infinite matrix
+    // to the SVD (it panics or loops).
+    if !g2.is_finite() || l.iter().any(|v| !v.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "synthesis: γ = {gamma:.3e} is too large (γ² overflows); choose a smaller --gamma-factor"
+        )));
+    }
     let sv = l.clone().svd(false, false).singular_values;
     if n > 0 && (sv.min().is_nan() || sv.min() <= 1e-13 * sv.max().max(1.0)) {
         return Err(Error::numerical("synthesis", format!("L = (1 − γ²)I + XZ is singular at γ = {gamma} (too close to γ_min = {gamma_min}): raise the γ factor")));
@@ -147,17 +176,18 @@ pub fn central_controller(ncf: &NormalizedLcf, opt: &GmOptimum, gamma: f64) -> R
         c: -(b.transpose() * &opt.x),
         d: d.transpose(),
     };
+    if k.a.iter().chain(k.b.iter()).any(|v| !v.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "synthesis: the central controller at γ = {gamma:.3e} is not finite; choose a smaller --gamma-factor"
+        )));
+    }
     Ok(k)
 }
 
 /// `b_opt` and the central controller at `γ = factor·γ_min` (`factor > 1`; 1.1 is the usual
 /// practice), with the closed loop's stability checked.
 pub fn synthesize(ncf: &NormalizedLcf, factor: f64) -> Result<GmController> {
-    if !(factor.is_finite() && factor > 1.0) {
-        return Err(Error::Invalid(format!(
-            "--gamma-factor {factor}: must be a number > 1 (γ = factor·γ_min; the central controller is undefined at γ_min)"
-        )));
-    }
+    check_gamma_factor(factor)?;
     let opt = optimum(ncf)?;
     let gamma_min = 1.0 / opt.b_opt;
     let gamma = factor * gamma_min;
@@ -177,6 +207,21 @@ pub fn synthesize(ncf: &NormalizedLcf, factor: f64) -> Result<GmController> {
         riccati_residuals: opt.residuals,
         k,
     })
+}
+
+/// Largest `--gamma-factor`: `γ = factor·γ_min` beyond 1e3·γ_min buys nothing (the
+/// central controller tends to a limit) and its `γ²` terms overflow long before 1e300.
+pub const MAX_GAMMA_FACTOR: f64 = 1e3;
+
+/// Validates `--gamma-factor` (`1 < factor ≤ 1e3`), before any work.
+pub fn check_gamma_factor(factor: f64) -> Result<()> {
+    if !(factor.is_finite() && factor > 1.0 && factor <= MAX_GAMMA_FACTOR) {
+        return Err(Error::Invalid(format!(
+            "--gamma-factor {}: must be a number with 1 < factor ≤ 1000 (γ = factor·γ_min; the central controller is undefined at γ_min, and 1.1 is the usual practice)",
+            crate::report::fmt::sig(factor)
+        )));
+    }
+    Ok(())
 }
 
 /// The state matrix of the loop `u = −K·y` around `G` (states `[x_G; x_K]`).

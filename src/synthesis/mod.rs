@@ -11,7 +11,8 @@ pub(crate) mod weights;
 
 pub use generalized_plant::{normalize, GeneralizedPlant, NormalizedPlant};
 pub use glover_mcfarlane::{
-    central_controller, closed_loop_matrix, optimum, synthesize, GmController, GmOptimum,
+    central_controller, check_gamma_factor, closed_loop_matrix, optimum, synthesize, GmController,
+    GmOptimum,
 };
 pub use hinf_weighted::{
     gamma_test, synthesize_weighted, weighted_plant, GammaFailure, GammaSolution, GammaStep,

@@ -84,10 +84,9 @@ fn diagonal(
 impl Weights {
     /// Reads `[weights]` from `path` for a plant with `m` inputs and `p` outputs.
     pub fn load(path: &Path, m: usize, p: usize) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        // The guarded reader of every input: a size cap, no FIFO or device (`/dev/zero`
+        // grew past 4 GB, a FIFO blocked forever).
+        let text = crate::util::read_text_file(path)?;
         let raw: WeightsFile = toml::from_str(&text).map_err(|e| Error::Config {
             path: path.to_path_buf(),
             msg: format!(

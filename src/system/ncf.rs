@@ -51,12 +51,56 @@ fn spd_power(p: &DMatrix<f64>, power: f64) -> DMatrix<f64> {
     &eig.eigenvectors * d * eig.eigenvectors.transpose()
 }
 
+/// The same plant after the state similarity `x ↦ x/α` (`α` a power of two, `B ↦ αB`,
+/// `C ↦ C/α`) chosen so that `‖C/α‖ = ‖B‖^w·‖C‖^(1−w)`: `w = 1/2` equalizes `‖B‖` and
+/// `‖C‖`, `w = 1` swaps them (the gain moves from `C` into `B`). The transfer function is unchanged; the filter Riccati solution scales by `α²`, which keeps
+/// it O(1) for a plant scaled by `10^k` (a stable plant with a large gain wants `w = 1/2`;
+/// an unstable one with a small gain, whose unscaled solution grows like `10^(−2k)`, wants
+/// the gain moved into `B`).
+fn rescaled(plant: &StateSpace, w: f64) -> Option<StateSpace> {
+    let (nb, nc) = (plant.b.norm(), plant.c.norm());
+    if plant.a.nrows() == 0 || !(nb > 0.0 && nc > 0.0 && nb.is_finite() && nc.is_finite()) {
+        return None;
+    }
+    // ‖C‖/α = nb^w nc^(1−w)  ⇒  log2 α = w (log2 nc − log2 nb).
+    let e = (w * (nc.log2() - nb.log2())).round();
+    if e == 0.0 || !e.is_finite() {
+        return None;
+    }
+    let alpha = 2f64.powi(e as i32);
+    Some(StateSpace {
+        a: plant.a.clone(),
+        b: &plant.b * alpha,
+        c: &plant.c / alpha,
+        d: plant.d.clone(),
+    })
+}
+
 impl NormalizedLcf {
     /// Computes the factors; fails with a one-line error when the filter Riccati equation
     /// has no stabilizing solution (an unstable mode that the output does not see, or a
     /// mode on the imaginary axis that the input does not reach).
+    ///
+    /// The plant is tried as given; when the Riccati equation fails, it is retried in two
+    /// rescaled state coordinates (see `rescaled`) before the failure is reported, so that
+    /// the verdict does not depend on the plant's gain scale.
     pub fn new(plant: StateSpace) -> Result<Self> {
         plant.validate("plant")?;
+        match Self::in_coordinates(plant.clone()) {
+            Ok(f) => Ok(f),
+            Err(e) => {
+                for w in [0.5, 1.0] {
+                    if let Some(f) = rescaled(&plant, w).and_then(|s| Self::in_coordinates(s).ok())
+                    {
+                        return Ok(f);
+                    }
+                }
+                Err(e)
+            }
+        }
+    }
+
+    fn in_coordinates(plant: StateSpace) -> Result<Self> {
         let (p, m) = plant.d.shape();
         let (a, b, c, d) = (&plant.a, &plant.b, &plant.c, &plant.d);
         let rt = DMatrix::<f64>::identity(p, p) + d * d.transpose();
@@ -69,6 +113,14 @@ impl NormalizedLcf {
         let q = b * &r_inv * b.transpose();
         let riccati = care(&abar.transpose(), &g, &q, "filter Riccati equation of the plant")
             .map_err(|e| {
+                // A gain far from 1 makes the Hamiltonian ill-conditioned: say so instead of
+                // blaming detectability (the false reason for a plant scaled by 1e150).
+                let spread = plant.b.norm() * plant.c.norm() / plant.a.norm();
+                if spread.is_finite() && spread > 1e20 {
+                    return crate::Error::Invalid(format!(
+                        "filter Riccati equation of the plant: the plant's gain scale ‖B‖‖C‖/‖A‖ ≈ {spread:.1e} is too extreme for its normalized coprime factors in double precision; express the plant in other units so that its gain is nearer 1"
+                    ));
+                }
                 e.with_hint("normalized coprime factors need (A, C) detectable and no uncontrollable mode of (A, B) on the imaginary axis")
                     .unwrap_or_else(|other| other)
             })?;

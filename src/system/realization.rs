@@ -99,10 +99,22 @@ impl StateSpace {
     }
 
     /// A minimal realization: the controllable part by an orthogonal block-Arnoldi
-    /// (staircase) reduction, then the observable part of that by duality. Directions with
-    /// a singular value below `tol·‖[A B; C D]‖` count as absent.
+    /// (staircase) reduction, then the observable part of that by duality.
+    ///
+    /// The rank decisions are scale-invariant: `A` is balanced first (an exact diagonal
+    /// similarity), each column of `B` (each row of `C` in the dual pass) is normalized
+    /// before the first Krylov block is ranked (scaling an input or output does not change
+    /// the controllable or observable subspace), and later blocks `A·V` (`V` orthonormal)
+    /// are ranked relative to `‖A‖`. A direction with a singular value below `tol` times
+    /// that reference counts as absent. So a plant scaled by `10^k` keeps its states for
+    /// any finite `k` (a small output gain no longer makes every state "unobservable").
     pub fn minimal(&self, tol: f64) -> Self {
-        let c = self.controllable_part(tol);
+        let sys = if self.states() > 0 {
+            self.balanced()
+        } else {
+            self.clone()
+        };
+        let c = sys.controllable_part(tol);
         let dual = StateSpace {
             a: c.a.transpose(),
             b: c.c.transpose(),
@@ -123,9 +135,18 @@ impl StateSpace {
         if n == 0 {
             return self.clone();
         }
-        let scale = self.a.norm().max(self.b.norm()).max(f64::MIN_POSITIVE);
-        let mut basis: Vec<nalgebra::DVector<f64>> = Vec::new();
+        let a_scale = self.a.norm();
+        // Each input direction normalized: the controllable subspace is that of B·S for
+        // any invertible diagonal S, so B's own size must not decide its rank.
         let mut block = self.b.clone();
+        for mut col in block.column_iter_mut() {
+            let nrm = col.norm();
+            if nrm > 0.0 && nrm.is_finite() {
+                col.unscale_mut(nrm);
+            }
+        }
+        let mut basis: Vec<nalgebra::DVector<f64>> = Vec::new();
+        let mut first = true;
         for _ in 0..=n {
             // Orthogonalize twice against the basis (classical Gram–Schmidt, repeated).
             for _ in 0..2 {
@@ -136,9 +157,12 @@ impl StateSpace {
             }
             let svd = block.clone().svd(true, false);
             let u = svd.u.expect("svd u");
+            // The first block has unit columns; later ones are A times orthonormal columns.
+            let reference = if first { 1.0 } else { a_scale };
+            first = false;
             let mut added = Vec::new();
             for (k, s) in svd.singular_values.iter().enumerate() {
-                if *s > tol * scale && basis.len() + added.len() < n {
+                if *s > tol * reference && basis.len() + added.len() < n {
                     added.push(u.column(k).into_owned());
                 }
             }

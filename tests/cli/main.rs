@@ -18,6 +18,7 @@ mod closed_loop_cli;
 mod configs_every;
 mod figures_glance;
 mod fuzz_inputs;
+mod hardening_iii;
 mod kill_safety;
 mod output_modes;
 mod output_policy;

@@ -27,6 +27,7 @@ fn input<'a>(omega: &'a [f64], r_min: &'a [f64], margin: f64) -> CertInput<'a> {
         r_min,
         a1: None,
         a1_data: None,
+        a1_dips: &[],
         margin,
         floor: 1e-12,
         per_decade: 100,

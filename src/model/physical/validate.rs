@@ -11,6 +11,11 @@ pub const OMEGA_N_RANGE: std::ops::RangeInclusive<f64> = 1e-8..=1e10;
 /// Largest damping ratio accepted.
 pub const MAX_ZETA: f64 = 1e4;
 
+/// Smallest damping ratio accepted: below it the mode's real part `ζω_n` is lost in the
+/// rounding of `s² + 2ζω_n s + ω_n²` near `ω_n` (relative `ε ≈ 1e-16`), so the factors and
+/// the A1 limit at the resonance are noise (`ζ = 5e-324` was accepted).
+pub const MIN_ZETA: f64 = 1e-12;
+
 impl PhysicalModel {
     /// Checks every parameter; the message names the table and the key.
     pub fn validate(&self) -> Result<(), String> {
@@ -68,6 +73,12 @@ impl PhysicalModel {
             if !(md.zeta.is_finite() && md.zeta > 0.0) {
                 return Err(format!(
                     "{at}: zeta = {} must be positive (an undamped mode has no stable factorization)",
+                    md.zeta
+                ));
+            }
+            if md.zeta < MIN_ZETA {
+                return Err(format!(
+                    "{at}: zeta = {:e} is below {MIN_ZETA:e}: the mode's damping is lost in double-precision rounding; a damping ratio is of order 1e-4…10",
                     md.zeta
                 ));
             }
