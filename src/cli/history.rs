@@ -70,7 +70,7 @@ pub fn run(a: &HistoryArgs) -> Result<i32> {
             data: a.data.clone(),
             noise_radius: a.noise_radius,
         };
-        let (rep, _, _) = run_compare(&input, ch)?;
+        let (rep, _, _) = run_compare(&input, ch, None)?;
         revs.push(Revision {
             config: c.display().to_string(),
             data: rep.data,
