@@ -272,7 +272,9 @@ impl Ranged for LogAxis {
     }
 
     fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
-        if hint.weight().allow_light_points() {
+        if hint.max_num_points() == 0 {
+            Vec::new()
+        } else if hint.weight().allow_light_points() {
             self.light(hint.max_num_points())
         } else {
             self.ticks(hint.max_num_points())
@@ -349,7 +351,9 @@ impl Ranged for LinAxis {
     }
 
     fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
-        if hint.weight().allow_light_points() {
+        if hint.max_num_points() == 0 {
+            Vec::new()
+        } else if hint.weight().allow_light_points() {
             self.ticks((2 * hint.bold_points()).max(2))
         } else {
             self.ticks(hint.max_num_points())

@@ -132,7 +132,7 @@ fn notes(p: &mut LogLogPlot, lines: &[String]) -> Result<()> {
     let root = area.strip_coord_spec();
     let width = lines
         .iter()
-        .map(|l| text_width(l, LEGEND))
+        .map(|l| l.chars().count() as f64 * 0.6 * LEGEND as f64)
         .fold(0.0, f64::max) as i32
         + 16;
     let h = lines.len() as i32 * 18 + 10;
