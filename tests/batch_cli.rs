@@ -57,7 +57,7 @@ fn rows(out: &Path) -> Vec<Vec<String>> {
     let mut l = s.lines();
     assert_eq!(
         l.next().unwrap(),
-        "index,name,status,n_data,max_r_min,consistent,n_failing,data,error"
+        "index,name,status,n_data,max_r_min,consistent,verdict,n_failing,data,error"
     );
     l.map(|r| r.split(',').map(str::to_string).collect())
         .collect()
