@@ -60,12 +60,9 @@ fn mistyped_option_is_suggested() {
     let e = stderr(&o);
     assert!(e.contains("did you mean --out?"), "{e}");
     assert!(!e.contains("-- --ouput"), "{e}");
+    // Where clap has its own suggestion it stays.
     let o = rshape(&["synthesize", "configs/robot.toml", "--metod", "hinf"]);
-    assert!(
-        stderr(&o).contains("did you mean --method?"),
-        "{}",
-        stderr(&o)
-    );
+    assert!(stderr(&o).contains("'--method'"), "{}", stderr(&o));
 }
 
 #[test]

@@ -71,7 +71,9 @@ pub fn omega_range(omega: &[f64]) -> (f64, f64) {
 /// (the configuration's name) loses whole words from its middle, replaced by `…`; then,
 /// if still too wide, the title is cut at a word boundary.
 pub fn fit_title(title: &str, width: f64, font: u32) -> String {
-    let fits = |t: &str| text_width(t, font) <= width;
+    // The SVG backend writes the size as font/1.24 px; 0.55 em a character is wider than the
+    // digits and lower-case letters of common sans fonts.
+    let fits = |t: &str| t.chars().count() as f64 * 0.55 * font as f64 / 1.24 <= width;
     if fits(title) {
         return title.to_string();
     }
