@@ -151,15 +151,6 @@ impl LogAxis {
         (self.lo, self.hi)
     }
 
-    /// Clamps `v` into the axis (NaN to the bottom).
-    pub fn clamp(&self, v: f64) -> f64 {
-        if v.is_nan() {
-            self.lo
-        } else {
-            v.clamp(self.lo, self.hi)
-        }
-    }
-
     /// True when `v` lies on the axis.
     pub fn contains(&self, v: f64) -> bool {
         v >= self.lo * (1.0 - 1e-12) && v <= self.hi * (1.0 + 1e-12)
@@ -299,11 +290,6 @@ impl LinAxis {
     pub fn new(lo: f64, hi: f64) -> Self {
         let (lo, hi) = lin_bounds(lo, hi);
         Self { lo, hi }
-    }
-
-    /// The (guarded) ends.
-    pub fn ends(&self) -> (f64, f64) {
-        (self.lo, self.hi)
     }
 
     /// Ticks at multiples of a 1-2-5 step, at most `n`.
@@ -475,8 +461,7 @@ pub fn log_label(v: &f64) -> String {
     if (0.01..1e5).contains(&v.abs()) {
         format!("{v}")
     } else {
-        let s = format!("{v:e}");
-        s.replace("e-", "e-")
+        format!("{v:e}")
     }
 }
 

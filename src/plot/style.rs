@@ -230,41 +230,6 @@ impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
 /// Width of the y tick labels and axis description left of a plot.
 pub const Y_LABEL_AREA: u32 = 78;
 
-/// Formats a tick label of a log axis: plain numbers from 0.01 to 9999 (`0.05`, `200`),
-/// else `1e-3`, `2e5`.  Only ticks with mantissa 1, 2 or 5 are labelled (the others stay as
-/// grid lines), so labels never crowd.
-pub fn log_tick(v: &f64) -> String {
-    // Round off the last bits of the axis arithmetic (0.009999999999 → 0.01).
-    let v: f64 = format!("{:.10e}", *v).parse().unwrap_or(*v);
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let mantissa = v.abs() / 10f64.powf(v.abs().log10().floor());
-    if ![1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .any(|m| (mantissa - m).abs() < 1e-6 * m)
-    {
-        return String::new();
-    }
-    if (0.01..1e4).contains(&v.abs()) {
-        let s = format!(
-            "{:.*}",
-            (2 - v.abs().log10().floor() as i32).max(0) as usize,
-            v
-        );
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    } else {
-        let s = format!("{v:.2e}");
-        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = m.trim_end_matches('0').trim_end_matches('.');
-        format!("{m}e{x}")
-    }
-}
-
 /// A short human form of a transfer function, e.g. `(1e-8 s + 0.3)/(s + 1)`, or
 /// `order-n unit` when that would be too long for a legend.
 pub fn tf_label(tf: &crate::system::TransferFunction) -> String {
@@ -588,7 +553,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{fmt_tick, log_axis_ticks, log_tick, text_width};
+    use super::{fmt_tick, log_axis_ticks, text_width};
 
     /// The chosen ticks never crowd: on narrow and wide bands, neighbouring labels keep
     /// 8 px apart (the old figures printed `800.900.01000.0`).
@@ -614,18 +579,5 @@ mod tests {
         assert_eq!(fmt_tick(800.0), "800");
         assert_eq!(fmt_tick(1200.0000000001), "1200");
         assert_eq!(fmt_tick(2.5), "2.5");
-    }
-
-    #[test]
-    fn ticks() {
-        assert_eq!(log_tick(&300.0), "");
-        assert_eq!(log_tick(&200.0), "200");
-        assert_eq!(log_tick(&0.05), "0.05");
-        assert_eq!(log_tick(&1.0), "1");
-        assert_eq!(log_tick(&1e-3), "1e-3");
-        assert_eq!(log_tick(&2e5), "2e5");
-        assert_eq!(log_tick(&1000.0), "1000");
-        assert_eq!(log_tick(&0.5), "0.5");
-        assert_eq!(log_tick(&0.009999999999999), "0.01");
     }
 }
