@@ -178,7 +178,7 @@ impl LogAxis {
             t
         };
         // Wide: every k-th decade.
-        let step = decades.div_ceil(n - 1).max(1) as i32;
+        let step = decades.div_ceil(n).max(1) as i32;
         let mut wide = Vec::new();
         let mut d = d0 + (d0.rem_euclid(step) != 0) as i32 * (step - d0.rem_euclid(step));
         while d <= d1 && wide.len() < n {
