@@ -53,7 +53,7 @@ pub const FREQ_LABEL: &str = "frequency f = ω/2π (Hz)";
 /// per decade (a step of 0.23 %), so a mode with ζ ≈ 1e-3 (half-power width 0.2 %) shows its
 /// peak between data.
 ///
-/// The band goes through the figures' axis guard ([`crate::plot::axis::log_bounds`]) and the
+/// The band goes through the figures' axis guard (`plot::axis::log_bounds`) and the
 /// grid holds at most 20 000 points, so extreme frequencies (5e-324, 1e300) cannot make it
 /// endless.
 pub fn dense_grid(omega: &[f64]) -> Vec<f64> {
