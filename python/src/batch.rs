@@ -7,13 +7,15 @@ use crate::data::Config;
 use crate::errors::{guarded, input, OrRaise};
 use pyo3::prelude::*;
 use rshape::batch::{self, BatchSettings, Dataset, DatasetResult, SummaryRow};
+use rshape::consistency::Verdict;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 /// `(index, name, path, noise_radius)` of a dataset.
 type DatasetTuple = (usize, String, PathBuf, Option<f64>);
-/// A `summary.csv` row: index, name, ok, n_data, max_r_min, consistent, n_failing, data, error.
+/// A `summary.csv` row: index, name, ok, n_data, max_r_min, consistent, verdict, n_failing,
+/// data, error.
 type RowTuple = (
     usize,
     String,
@@ -21,6 +23,7 @@ type RowTuple = (
     usize,
     Option<f64>,
     Option<bool>,
+    Option<String>,
     usize,
     String,
     String,
@@ -74,6 +77,7 @@ fn row_tuple(r: &SummaryRow) -> RowTuple {
         r.n_data,
         r.max_r_min,
         r.consistent,
+        r.verdict.map(|v| v.as_str().to_string()),
         r.n_failing,
         r.data.clone(),
         r.error.clone(),
@@ -119,22 +123,36 @@ pub fn _run_dataset(
     })
 }
 
+/// The verdict named as `report.json` names it (`Verdict::as_str`).
+fn verdict_of(name: &str) -> Option<Verdict> {
+    [
+        Verdict::Consistent,
+        Verdict::Inconsistent,
+        Verdict::NotAdmissible,
+    ]
+    .into_iter()
+    .find(|v| v.as_str() == name)
+}
+
 /// `summary.csv` of rows (in the order given).
 #[pyfunction]
 pub fn _summary_csv(rows: Vec<RowTuple>) -> String {
     let rows: Vec<SummaryRow> = rows
         .into_iter()
         .map(
-            |(index, name, ok, n_data, max_r_min, consistent, n_failing, data, error)| SummaryRow {
-                index,
-                name,
-                ok,
-                n_data,
-                max_r_min,
-                consistent,
-                n_failing,
-                data,
-                error,
+            |(index, name, ok, n_data, max_r_min, consistent, verdict, n_failing, data, error)| {
+                SummaryRow {
+                    index,
+                    name,
+                    ok,
+                    n_data,
+                    max_r_min,
+                    consistent,
+                    verdict: verdict.as_deref().and_then(verdict_of),
+                    n_failing,
+                    data,
+                    error,
+                }
             },
         )
         .collect();

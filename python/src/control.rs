@@ -177,7 +177,7 @@ pub fn _synthesize(
         let report =
             serde_json::to_string(&out.stability.report).map_err(|e| input(e.to_string()))?;
         let k = &out.gm.k;
-        let toml = syn::controller_toml(k, &out.gm, out.hinf.is_some());
+        let toml = syn::controller_toml(k, &syn::method_label(&out));
         Ok((
             synthesis,
             report,

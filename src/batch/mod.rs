@@ -132,6 +132,7 @@ fn figure(
     r_configured: Option<&TransferFunction>,
     r_fitted: Option<&TransferFunction>,
     closed_loop: bool,
+    factorization: Option<&crate::model::Factorization>,
 ) -> Result<String> {
     let name = config
         .file_name()
@@ -148,7 +149,18 @@ fn figure(
         .iter()
         .map(|e| (e.omega.as_slice(), e.r_min.as_slice()))
         .collect();
-    let grid = crate::pipeline::outputs::dense_grid(&combined.omega);
+    // The figure spans every dataset's frequencies, not only the combined envelope's.
+    let mut all: Vec<f64> = combined
+        .omega
+        .iter()
+        .chain(datasets.iter().flat_map(|e| e.omega.iter()))
+        .copied()
+        .filter(|w| w.is_finite() && *w > 0.0)
+        .collect();
+    all.sort_by(f64::total_cmp);
+    all.dedup();
+    let grid = crate::pipeline::outputs::dense_grid(&all);
+    let a1: Option<Vec<f64>> = factorization.map(|f| grid.iter().map(|w| f.a1_limit(*w)).collect());
     crate::plot::batch_svg(
         &crate::plot::BatchFigureInput {
             title: &title,
@@ -157,6 +169,7 @@ fn figure(
             r_configured,
             r_fitted,
             grid: &grid,
+            a1_on_grid: a1.as_deref(),
         },
         &crate::plot::Symbols::of(closed_loop),
     )
@@ -235,6 +248,7 @@ pub fn finish(
             inp.r_configured,
             fitted,
             inp.closed_loop,
+            inp.factorization,
         )?;
         write_atomic(&out.join("batch.svg"), svg.as_bytes())?;
     }

@@ -3,7 +3,8 @@
 //! Columns: `index` (0-based position in the full list), `name`, `status` (`ok` or
 //! `failed`), `n_data`, `max_r_min` (`inf` when some datum has no admissible `r`),
 //! `consistent` (`true`/`false` for the configured `r`, empty without one or on failure),
-//! `n_failing` (data the configured `r` does not explain), `data` (the file), `error` (one
+//! `verdict` (why: `consistent`, `inconsistent` or `not_admissible` when A1 fails, so a
+//! `consistent=false, n_failing=0` row says its reason), `n_failing` (data the configured `r` does not explain), `data` (the file), `error` (one
 //! line, empty on success).
 
 use super::runner::DatasetResult;
@@ -13,7 +14,8 @@ use crate::report::csv::num;
 use std::fmt::Write;
 
 /// The header line.
-pub const HEADER: &str = "index,name,status,n_data,max_r_min,consistent,n_failing,data,error";
+pub const HEADER: &str =
+    "index,name,status,n_data,max_r_min,consistent,verdict,n_failing,data,error";
 
 /// One row of `summary.csv`.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +32,8 @@ pub struct SummaryRow {
     pub max_r_min: Option<f64>,
     /// Verdict for the configured `r`.
     pub consistent: Option<bool>,
+    /// Why (`not_admissible` when A1 fails at some datum).
+    pub verdict: Option<crate::consistency::Verdict>,
     /// Number of data not explained by the configured `r`.
     pub n_failing: usize,
     /// The data file.
@@ -47,6 +51,7 @@ impl From<&DatasetResult> for SummaryRow {
             n_data: r.n_data,
             max_r_min: r.max_r_min,
             consistent: r.consistent,
+            verdict: r.verdict,
             n_failing: r.failing_omegas.len(),
             data: r.path.display().to_string(),
             error: r.error.clone().unwrap_or_default(),
@@ -69,13 +74,14 @@ pub fn render(rows: &[SummaryRow]) -> String {
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{}",
             r.index,
             quote(&r.name),
             if r.ok { "ok" } else { "failed" },
             r.n_data,
             r.max_r_min.map_or(String::new(), num),
             r.consistent.map_or(String::new(), |c| c.to_string()),
+            r.verdict.map_or("", |v| v.as_str()),
             r.n_failing,
             quote(&r.data),
             quote(&r.error)
@@ -129,9 +135,15 @@ pub fn parse(text: &str, what: &str) -> Result<Vec<SummaryRow>> {
                 "false" => Some(false),
                 _ => None,
             },
-            n_failing: int(&f[6])?,
-            data: f[7].clone(),
-            error: f[8].clone(),
+            verdict: match f[6].as_str() {
+                "consistent" => Some(crate::consistency::Verdict::Consistent),
+                "inconsistent" => Some(crate::consistency::Verdict::Inconsistent),
+                "not_admissible" => Some(crate::consistency::Verdict::NotAdmissible),
+                _ => None,
+            },
+            n_failing: int(&f[7])?,
+            data: f[8].clone(),
+            error: f[9].clone(),
         });
     }
     Ok(rows)
@@ -143,17 +155,30 @@ mod tests {
 
     #[test]
     fn round_trip() {
-        let rows = vec![SummaryRow {
+        let mut rows = vec![SummaryRow {
             index: 3,
             name: "a,b".into(),
             ok: false,
             n_data: 0,
             max_r_min: None,
             consistent: None,
+            verdict: None,
             n_failing: 0,
             data: "x.csv".into(),
             error: "x.csv:3: bad \"number\"".into(),
         }];
+        rows.push(SummaryRow {
+            index: 4,
+            name: "b".into(),
+            ok: true,
+            n_data: 3,
+            max_r_min: Some(0.5),
+            consistent: Some(false),
+            verdict: Some(crate::consistency::Verdict::NotAdmissible),
+            n_failing: 0,
+            data: "y.csv".into(),
+            error: String::new(),
+        });
         assert_eq!(parse(&render(&rows), "s").unwrap(), rows);
     }
 }

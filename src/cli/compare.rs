@@ -26,6 +26,10 @@ pub struct CompareArgs {
     /// config's rules (a `<stem>_std.csv` beside it, a noise_radius column, --noise-radius).
     #[arg(long)]
     pub against: Option<PathBuf>,
+    /// Compare (and plot) only the lines with FMIN ≤ f ≤ FMAX (Hz), e.g. `--band 20:120`,
+    /// as `diagnose --band`.
+    #[arg(long, value_parser = super::diagnose::parse_band, value_name = "FMIN:FMAX", allow_hyphen_values = true)]
+    pub band: Option<(f64, f64)>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -44,6 +48,7 @@ pub fn channel_arg(c: &Option<Vec<usize>>) -> Result<Option<(usize, usize)>> {
 pub fn run_compare(
     input: &InputArgs,
     channel: Option<(usize, usize)>,
+    band: Option<(f64, f64)>,
 ) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
     let inputs = input.load()?;
     // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
@@ -54,7 +59,28 @@ pub fn run_compare(
         input.noise_radius,
     )?;
     let noise = inputs.noise_radius;
-    let siso = prepare(&inputs.config, &inputs.data, channel, noise)?;
+    let mut siso = prepare(&inputs.config, &inputs.data, channel, noise)?;
+    if let Some((lo, hi)) = band {
+        // As `diagnose --band`: the lines with FMIN ≤ f ≤ FMAX (Hz), at least two.
+        let tau = std::f64::consts::TAU;
+        let keep: Vec<usize> = (0..siso.omega.len())
+            .filter(|k| {
+                let f = siso.omega[*k] / tau;
+                f >= lo * (1.0 - 1e-12) && f <= hi * (1.0 + 1e-12)
+            })
+            .collect();
+        if keep.len() < 2 {
+            return Err(anyhow!(
+                "--band {lo}:{hi}: {} of the data's lines lie in it (the data span {} … {} Hz); at least 2 are needed",
+                keep.len(),
+                fmt_g(siso.omega.first().copied().unwrap_or(0.0) / tau),
+                fmt_g(siso.omega.last().copied().unwrap_or(0.0) / tau)
+            ));
+        }
+        siso.omega = keep.iter().map(|k| siso.omega[*k]).collect();
+        siso.g = keep.iter().map(|k| siso.g[*k]).collect();
+        siso.radius = siso.radius.map(|r| keep.iter().map(|k| r[*k]).collect());
+    }
     let model = PlantModel::from_config(&inputs.config);
     let rep = compare(&inputs.config, &model, &siso)?;
     Ok((rep, siso, model))
@@ -117,7 +143,7 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         }
         super::common::check_out_file("--svg", svg, &inputs)?;
     }
-    let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?)?;
+    let (mut rep, siso, model) = run_compare(&a.input, channel_arg(&a.channel)?, a.band)?;
     // Everything is read and checked before the figure is written (no figure left behind
     // by a refusal such as a missing --against file).
     let agreement = match &a.against {

@@ -62,7 +62,7 @@ fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
         .ok_or_else(|| format!("`{s}`: give a candidate rank (1, 2, …) or `chosen`"))
 }
 
-fn parse_band(s: &str) -> std::result::Result<(f64, f64), String> {
+pub(super) fn parse_band(s: &str) -> std::result::Result<(f64, f64), String> {
     let bad = || format!("`{s}`: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX (e.g. 20:1200)");
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
     let (a, b): (f64, f64) = (

@@ -30,15 +30,16 @@ pub mod synthesize;
 
 use clap::{Parser, Subcommand};
 
-/// rshape: consistency of frequency-response data with coprime-factor models, and the
-/// smallest uncertainty bound r(s) that explains them.
+/// rshape: consistency of frequency-response data with coprime-factor models, the smallest
+/// uncertainty bound r(s) that explains them, robust-stability proofs and controller
+/// synthesis (Glover–McFarlane, H∞), and discovery of missing effects.
 #[derive(Debug, Parser)]
 #[command(
     name = "rshape",
     version,
-    about,
+    about = "Consistency of frequency-response data with coprime-factor models, the smallest uncertainty bound r(s) that explains them, robust-stability proofs, controller synthesis (Glover–McFarlane, H∞) and discovery of missing effects",
     long_about = None,
-    after_help = "Exit codes: 0 success; 1 a negative verdict (check: inconsistent or not admissible; stability: not robustly stable); 2 error (bad input, usage); 3 some datasets failed (batch, merge).  `rshape help SUBCOMMAND` gives each subcommand's."
+    after_help = "Exit codes: 0 success; 1 a negative verdict (check: inconsistent or not admissible; stability: not robustly stable; synthesize: not proven robust); 2 error (bad input, usage); 3 some datasets failed (batch, merge).  `rshape help SUBCOMMAND` gives each subcommand's."
 )]
 pub struct Cli {
     /// The subcommand.
@@ -95,7 +96,10 @@ pub enum Command {
         after_help = "Exit codes: 0 robustly stable for every bound given, 1 not (including a controller that does not stabilize the nominal plant), 2 error (bad input, usage)."
     )]
     Stability(stability::StabilityArgs),
-    /// Synthesize the Glover–McFarlane controller and prove it with Theorem 1.
+    /// Synthesize a controller (Glover–McFarlane, or H∞ with r as weight) and prove it with Theorem 1.
+    #[command(
+        after_help = "Exit codes: 0 proven robust for every bound given (and stabilizing), 1 not proven robust for some bound (the controller and reports are still written), 2 error (bad input, usage; nothing is written)."
+    )]
     Synthesize(synthesize::SynthesizeArgs),
 }
 
@@ -106,7 +110,18 @@ pub fn main() -> i32 {
         Err(e) if e.use_stderr() => {
             // One line, like every other error: clap's message with the missing or wrong
             // arguments named inline, then the usage.
-            let text = e.render().to_string();
+            let mut text = e.render().to_string();
+            if let Some(better) = suggestion(&e) {
+                // clap's "to pass '--ouput' as a value, use '-- --ouput'" misleads: a
+                // mistyped option is far likelier.
+                text = match text.find("tip:") {
+                    Some(k) => {
+                        let end = text[k..].find('\n').map_or(text.len(), |n| k + n);
+                        format!("{}tip: did you mean {better}?{}", &text[..k], &text[end..])
+                    }
+                    None => format!("{text}\ntip: did you mean {better}?"),
+                };
+            }
             let lines: Vec<&str> = (text.lines())
                 .map(|l| l.trim().trim_start_matches("error: "))
                 .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
@@ -155,6 +170,52 @@ pub fn main() -> i32 {
 }
 
 pub use crate::report::fmt::one_line;
+
+/// For an unknown `--option`: the subcommand's long option nearest to it (edit distance at
+/// most 2, or a prefix either way), when clap offered none.
+fn suggestion(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue, ErrorKind};
+    if e.kind() != ErrorKind::UnknownArgument {
+        return None;
+    }
+    if let Some(ContextValue::Strings(s)) = e.get(ContextKind::SuggestedArg) {
+        if !s.is_empty() {
+            return None;
+        }
+    }
+    if let Some(ContextValue::String(_)) = e.get(ContextKind::SuggestedArg) {
+        return None;
+    }
+    let Some(ContextValue::String(bad)) = e.get(ContextKind::InvalidArg) else {
+        return None;
+    };
+    let bad = bad.strip_prefix("--")?.split('=').next()?.to_string();
+    let sub = std::env::args().skip(1).find(|a| !a.starts_with('-'))?;
+    let cmd = <Cli as clap::CommandFactory>::command();
+    let sub = cmd.find_subcommand(&sub)?;
+    sub.get_arguments()
+        .filter_map(|a| a.get_long())
+        .map(|l| (edit_distance(&bad, l), l))
+        .filter(|(d, l)| *d <= 2 || (bad.len() >= 3 && (l.starts_with(&bad) || bad.starts_with(l))))
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, l)| format!("--{l}"))
+}
+
+/// Levenshtein distance (characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.iter().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
 
 /// Longest error message printed, in characters: the start (what and where) and the end
 /// (what to do) are kept, a middle that quotes input at length is cut.

@@ -93,8 +93,12 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         if rep.noisy { "noisy" } else { "noise-free" }
     );
     outln!(
-        "  envelope  {:?}, max {wmin} = {}",
-        rep.method,
+        "  envelope  {}, max {wmin} = {}",
+        // The name report.json and the docs use (`theorem4_mu`), not the Rust one.
+        serde_json::to_value(rep.method)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_else(|| format!("{:?}", rep.method)),
         rep.max_r_min.map_or("-".into(), fmt_g)
     );
     if !rep.beyond_a1.is_empty() {

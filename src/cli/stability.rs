@@ -68,7 +68,7 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
                 .file_name()
                 .map_or(String::new(), |n| n.to_string_lossy().into_owned());
             let title = stability::figure_title(&config, &format!("K = {k}"));
-            stability::write_outputs(out, &outcome, &title)?
+            stability::write_outputs(out, &outcome, &title, &[])?
         }
         None => Vec::new(),
     };

@@ -9,6 +9,8 @@
 //! the plots where it hides no data.
 
 use crate::error::Result;
+use crate::plot::axis::{LinAxis, LogAxis};
+use crate::plot::fine::{Look, Overlay, PixelMap};
 use crate::plot::style::{
     draw_x_labels, fmt_tick, log_axis_ticks, plot_err, Legend, C_GREY, C_RED, FONT, PALETTE, TICKS,
     Y_LABEL_AREA,
@@ -42,21 +44,27 @@ pub struct ModelCurve {
     pub g: Vec<Complex64>,
 }
 
-/// The x-axis label: why Hz here while `run` plots rad/s.
-pub const FREQ_LABEL: &str =
-    "frequency f = ω/2π (Hz, the unit modes are quoted in; the text report gives rad/s and Hz)";
+/// The x-axis label (Hz here, the unit modes are quoted in, while `run` plots rad/s; the
+/// text report gives both).
+pub const FREQ_LABEL: &str = "frequency f = ω/2π (Hz)";
 
 /// A dense logarithmic grid (rad/s) over the plotted band (the data's range widened by 10 %
 /// on each side), merged with the data frequencies themselves: at least 2000 points and 1000
 /// per decade (a step of 0.23 %), so a mode with ζ ≈ 1e-3 (half-power width 0.2 %) shows its
 /// peak between data.
+///
+/// The band goes through the figures' axis guard (`plot::axis::log_bounds`) and the
+/// grid holds at most 20 000 points, so extreme frequencies (5e-324, 1e300) cannot make it
+/// endless.
 pub fn dense_grid(omega: &[f64]) -> Vec<f64> {
     let (lo, hi) = match (omega.first(), omega.last()) {
-        (Some(&a), Some(&b)) if a > 0.0 && b >= a => (a / 1.1, b * 1.1),
+        (Some(&a), Some(&b)) if a > 0.0 && b >= a => {
+            crate::plot::axis::log_bounds(a / 1.1, b * 1.1)
+        }
         _ => return omega.to_vec(),
     };
     let decades = (hi / lo).log10();
-    let n = ((1000.0 * decades).ceil() as usize).max(2000);
+    let n = ((1000.0 * decades).ceil() as usize).clamp(2000, 20_000);
     let mut g: Vec<f64> = (0..=n)
         .map(|k| lo * (hi / lo).powf(k as f64 / n as f64))
         .chain(omega.iter().copied())
@@ -66,20 +74,7 @@ pub fn dense_grid(omega: &[f64]) -> Vec<f64> {
     g
 }
 
-/// Phase in degrees, unwrapped along the sequence (no jump larger than 180° between
-/// neighbours), starting in (−180°, 180°].
-pub fn unwrap_deg(g: &[Complex64]) -> Vec<f64> {
-    let mut out: Vec<f64> = Vec::with_capacity(g.len());
-    for z in g {
-        let p = z.arg().to_degrees();
-        let v = match out.iter().rev().find(|v| v.is_finite()) {
-            Some(prev) if p.is_finite() => p + 360.0 * ((prev - p) / 360.0).round(),
-            _ => p,
-        };
-        out.push(v);
-    }
-    out
-}
+pub use crate::plot::axis::unwrap_deg;
 
 /// The phase of each datum (degrees): on the branch nearest `reference` (the model's
 /// unwrapped phase at the same frequency) where the datum lies within 90° of it, else on the
@@ -188,7 +183,12 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
                     .map(|(_, v)| *v)
             })),
     );
-    let (p0, p1) = (p0.min(p1 - 90.0), p1.max(p0 + 90.0));
+    // Guarded axes: the phase spans multiples of 90° and is ticked (labels and grid lines
+    // alike) at multiples of 90°.
+    let phase_axis = crate::plot::axis::PhaseAxis::covering([p0, p1]);
+    let (p0, p1) = phase_axis.ends();
+    let (m0, m1) = crate::plot::axis::lin_bounds(m0, m1);
+    let (f0, f1) = crate::plot::axis::log_bounds(f0, f1);
     // Noise band: the magnitude and phase covered by each disk |G − G_data| ≤ r.
     let band = data.radius.map(|r| {
         let mut upper_db = Vec::new();
@@ -220,12 +220,13 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
     let x_area = 56;
     let height = caption_h + PANEL.0 + PANEL.1 + x_area + legend_h;
     let mut svg = String::new();
+    let overlay = Overlay::default();
     {
         let root = SVGBackend::with_string(&mut svg, (WIDTH, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
         let (head, rest) = root.split_vertically(caption_h);
         head.draw(&Text::new(
-            title.to_string(),
+            crate::plot::style::fit_title(title, WIDTH as f64 - 28.0, 20),
             (WIDTH as i32 / 2, 12),
             TextStyle::from((FONT, 20).into_font()).pos(plotters::style::text_anchor::Pos::new(
                 plotters::style::text_anchor::HPos::Center,
@@ -236,14 +237,14 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
         let (top, rest) = rest.split_vertically(PANEL.0);
         let (bottom, below) = rest.split_vertically(PANEL.1 + x_area);
         let mut legend: Legend<'_, SVGBackend<'_>> = Legend::default();
-        let xs = (f0..f1).log_scale();
+        let xs = LogAxis::new(f0, f1);
         let mut mag = ChartBuilder::on(&top)
             .margin_left(14)
             .margin_right(24)
             .margin_top(4)
             .x_label_area_size(6)
             .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(xs.clone(), m0..m1)
+            .build_cartesian_2d(xs.clone(), LinAxis::new(m0, m1))
             .map_err(plot_err)?;
         let mut ph = ChartBuilder::on(&bottom)
             .margin_left(14)
@@ -251,49 +252,43 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
             .margin_top(10)
             .x_label_area_size(x_area)
             .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(xs, p0..p1)
+            .build_cartesian_2d(xs, phase_axis.clone())
             .map_err(plot_err)?;
         let plot_w = mag.plotting_area().get_pixel_range().0;
         let ticks = log_axis_ticks(f0, f1, (plot_w.end - plot_w.start) as f64, TICKS);
         let grid = RGBColor(225, 225, 225);
-        for (chart_mesh, desc) in [(&mut mag, "|G| (dB)"), (&mut ph, "phase (deg, unwrapped)")] {
-            chart_mesh
-                .configure_mesh()
-                .disable_x_mesh()
-                .x_labels(0)
-                .x_label_formatter(&|_| String::new())
-                .y_labels(8)
-                .y_label_formatter(&|v| fmt_tick(*v))
-                .max_light_lines(1)
-                .y_desc(desc)
-                .axis_desc_style((FONT, 17))
-                .label_style((FONT, TICKS))
-                .light_line_style(RGBColor(240, 240, 240))
-                .bold_line_style(grid)
-                .draw()
-                .map_err(plot_err)?;
-        }
+        mag.configure_mesh()
+            .disable_x_mesh()
+            .x_labels(0)
+            .x_label_formatter(&|_| String::new())
+            .y_labels(8)
+            .y_label_formatter(&|v| fmt_tick(*v))
+            .max_light_lines(1)
+            .y_desc("|G| (dB)")
+            .axis_desc_style((FONT, 17))
+            .label_style((FONT, TICKS))
+            .light_line_style(RGBColor(240, 240, 240))
+            .bold_line_style(grid)
+            .draw()
+            .map_err(plot_err)?;
+        // The phase grid lines are the mesh's own, at the labelled multiples of 90°.
+        ph.configure_mesh()
+            .disable_x_mesh()
+            .x_labels(0)
+            .x_label_formatter(&|_| String::new())
+            .y_label_formatter(&crate::plot::axis::phase_tick)
+            .max_light_lines(0)
+            .y_desc("phase (degrees, unwrapped)")
+            .axis_desc_style((FONT, 17))
+            .label_style((FONT, TICKS))
+            .bold_line_style(RGBColor(200, 200, 200))
+            .draw()
+            .map_err(plot_err)?;
         for t in &ticks {
             mag.draw_series(LineSeries::new(vec![(*t, m0), (*t, m1)], grid))
                 .map_err(plot_err)?;
             ph.draw_series(LineSeries::new(vec![(*t, p0), (*t, p1)], grid))
                 .map_err(plot_err)?;
-        }
-        let phase_step = if p1 - p0 > 1440.0 {
-            360.0
-        } else if p1 - p0 > 360.0 {
-            180.0
-        } else {
-            90.0
-        };
-        let mut k = (p0 / phase_step).ceil();
-        while k * phase_step <= p1 {
-            ph.draw_series(LineSeries::new(
-                vec![(f0, k * phase_step), (f1, k * phase_step)],
-                RGBColor(200, 200, 200),
-            ))
-            .map_err(plot_err)?;
-            k += 1.0;
         }
         if let Some((udb, ldb, uph, lph)) = &band {
             let f: Vec<f64> = data.omega.iter().map(|w| hz(*w)).collect();
@@ -314,35 +309,34 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
             });
         }
         for (k, (m, p)) in models.iter().zip(&model_phase).enumerate() {
-            let c = PALETTE[k % PALETTE.len()];
-            let s = c.stroke_width(2);
+            let look = Look::solid(PALETTE[k % PALETTE.len()], 2.0);
+            let (map_m, map_p) = (PixelMap::of(&mag), PixelMap::of(&ph));
             for run in runs(m.omega.iter().zip(&m.g).map(|(w, z)| (hz(*w), db(z)))) {
-                mag.draw_series(LineSeries::new(run, s)).map_err(plot_err)?;
+                overlay.curve(&map_m, run, look);
             }
             for run in runs(m.omega.iter().zip(p).map(|(w, v)| (hz(*w), *v))) {
-                ph.draw_series(LineSeries::new(run, s)).map_err(plot_err)?;
+                overlay.curve(&map_p, run, look);
             }
-            legend.add(
+            legend.add_line(
                 format!("{} (line: evaluated between the data)", m.name),
-                move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
+                look,
+                &overlay,
             );
         }
         let dot = |bad: bool| if bad { C_RED.filled() } else { BLACK.filled() };
-        for (chart, ys) in [
-            (&mut mag, data.g.iter().map(db).collect::<Vec<_>>()),
-            (&mut ph, dph.clone()),
-        ] {
-            chart
-                .draw_series(
-                    data.omega
-                        .iter()
-                        .zip(&ys)
-                        .zip(data.invalid)
-                        .filter(|((_, y), _)| y.is_finite())
-                        .map(|((w, y), bad)| Circle::new((hz(*w), *y), 2, dot(*bad))),
-                )
-                .map_err(plot_err)?;
-        }
+        let dots = |ys: &[f64]| -> Vec<Circle<(f64, f64), i32>> {
+            data.omega
+                .iter()
+                .zip(ys)
+                .zip(data.invalid)
+                .filter(|((_, y), _)| y.is_finite())
+                .map(|((w, y), bad)| Circle::new((hz(*w), *y), 2, dot(*bad)))
+                .collect()
+        };
+        let mdb: Vec<f64> = data.g.iter().map(|z| db(z).clamp(m0, m1)).collect();
+        mag.draw_series(dots(&mdb)).map_err(plot_err)?;
+        let pdeg: Vec<f64> = dph.iter().map(|p| phase_axis.clamp(*p)).collect();
+        ph.draw_series(dots(&pdeg)).map_err(plot_err)?;
         legend.add("data explained by the noise", move |(x, y)| {
             Circle::new((x + 12, y), 3, BLACK.filled())
         });
@@ -371,6 +365,7 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
         legend.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
+    overlay.inject(&mut svg);
     Ok(svg)
 }
 

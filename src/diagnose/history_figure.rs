@@ -189,7 +189,7 @@ pub fn history_svg(
             .margin_top(4)
             .x_label_area_size(6)
             .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(xr.clone(), (lo..hi).log_scale())
+            .build_cartesian_2d(xr.clone(), crate::plot::axis::LogAxis::new(lo, hi))
             .map_err(plot_err)?;
         a.configure_mesh()
             .disable_x_mesh()
@@ -198,7 +198,7 @@ pub fn history_svg(
             .y_desc("misfit_rms (log)")
             .axis_desc_style((FONT, 17))
             .label_style((FONT, TICKS))
-            .y_label_formatter(&crate::plot::style::log_tick)
+            .y_label_formatter(&crate::plot::axis::log_label)
             .draw()
             .map_err(plot_err)?;
         let mut b = ChartBuilder::on(&bottom)

@@ -146,7 +146,26 @@ pub const FIGURE_TITLE_CHARS: usize = 92;
 /// never dropped: a long model name is shortened first, in the middle (`…`), keeping at least
 /// 16 of its characters; only then is the controller's name shortened in the middle too.
 pub fn figure_title(config: &Config, controller: &str) -> String {
-    use crate::report::fmt::ellipsize_middle;
+    // Whole words out of the middle (`f…998` was unreadable); a single long word is cut in
+    // its middle as before.
+    fn ellipsize_words(s: &str, n: usize) -> String {
+        if s.chars().count() <= n {
+            return s.to_string();
+        }
+        let words: Vec<&str> = s.split(' ').collect();
+        for keep in (2..words.len()).rev() {
+            let front = keep.div_ceil(2);
+            let t = format!(
+                "{} … {}",
+                words[..front].join(" "),
+                words[words.len() - (keep - front)..].join(" ")
+            );
+            if t.chars().count() <= n {
+                return t;
+            }
+        }
+        crate::report::fmt::ellipsize_middle(s, n)
+    }
     let name = config
         .raw
         .name
@@ -157,14 +176,38 @@ pub fn figure_title(config: &Config, controller: &str) -> String {
     let room = FIGURE_TITLE_CHARS.saturating_sub(fixed);
     let controller_chars = controller.chars().count();
     let name_room = room.saturating_sub(controller_chars).max(16);
-    let name = ellipsize_middle(&name, name_room);
-    let controller = ellipsize_middle(controller, room.saturating_sub(name.chars().count()));
+    let name = ellipsize_words(&name, name_room);
+    let controller = ellipsize_words(controller, room.saturating_sub(name.chars().count()));
     format!("{prefix}{name}, {controller}")
 }
 
-/// Writes `stability.svg` (titled `title`, see [`figure_title`]) and `stability.json` into
-/// `out` (atomically) and returns them.
-pub fn write_outputs(out: &Path, o: &StabilityOutcome, title: &str) -> Result<Vec<PathBuf>> {
+/// The lines `stability.svg` carries in its corner: `head` (e.g. the synthesis method and its
+/// γ), then per bound `α*`, where it binds and the verdict.
+pub fn figure_notes(o: &StabilityOutcome, head: &[String]) -> Vec<String> {
+    let mut lines = head.to_vec();
+    if !o.report.internally_stable {
+        lines.push("NOT internally stable: Theorem 1 condition 1 fails".to_string());
+    }
+    for m in &o.report.margins {
+        let verdict = match m.verdict {
+            Verdict::Robust => "PROVEN robust (α* ≥ 1)",
+            Verdict::NotRobust => "NOT proven robust (α* < 1)",
+            Verdict::Withheld => "verdict withheld (cross-checks disagree)",
+        };
+        lines.push(format!("{} r: α* = {}: {verdict}", m.label, fmt_g(m.alpha)));
+    }
+    lines
+}
+
+/// Writes `stability.svg` (titled `title`, see [`figure_title`]; `head` lines on the figure
+/// before the margins, see [`figure_notes`]) and `stability.json` into `out` (atomically)
+/// and returns them.
+pub fn write_outputs(
+    out: &Path,
+    o: &StabilityOutcome,
+    title: &str,
+    head: &[String],
+) -> Result<Vec<PathBuf>> {
     let labelled: Vec<(String, Vec<f64>)> = o
         .labels
         .iter()
@@ -176,6 +219,8 @@ pub fn write_outputs(out: &Path, o: &StabilityOutcome, title: &str) -> Result<Ve
         omega: &o.curve.omega,
         inv_t: &o.curve.inv_t,
         r: &labelled,
+        binding: &o.report.margins.iter().map(|m| m.omega).collect::<Vec<_>>(),
+        notes: &figure_notes(o, head),
     })?;
     let svg_path = out.join("stability.svg");
     crate::util::write_atomic(&svg_path, svg.as_bytes())?;
@@ -299,14 +344,18 @@ pub fn text(o: &StabilityOutcome) -> String {
                 );
             }
         }
+        // Only a proven gain is a gain: before a "NOT proven robust" the line would read as
+        // one (a 1e6 % "gain" of an H∞ controller designed for the fitted r).
         if let [c, f, ..] = rep.margins.as_slice() {
-            let _ = writeln!(
-                s,
-                "what the tighter r buys: margin {} -> {} ({:+.1}%)",
-                fmt_g(c.alpha),
-                fmt_g(f.alpha),
-                (f.alpha / c.alpha - 1.0) * 100.0
-            );
+            if f.verdict == Verdict::Robust {
+                let _ = writeln!(
+                    s,
+                    "what the tighter r buys: margin {} -> {} ({:+.1}%)",
+                    fmt_g(c.alpha),
+                    fmt_g(f.alpha),
+                    (f.alpha / c.alpha - 1.0) * 100.0
+                );
+            }
         }
     }
     s

@@ -322,15 +322,33 @@ fn toml_matrix(m: &DMatrix<f64>) -> String {
     format!("[{}]", r.join(",\n     "))
 }
 
+/// The method of the controller as the outputs name it, and its `γ` line: `H∞ (the fitted r
+/// as weight)` with the H∞ `γ` and `γ_opt`, or `Glover–McFarlane` with its `γ`, `γ_min` and
+/// `b_opt`.
+pub fn method_label(o: &SynthesisOutcome) -> (String, String) {
+    match &o.hinf {
+        Some((label, h)) => (
+            format!("H∞ (the {label} r as weight)"),
+            format!(
+                "gamma = {:?} (gamma_opt = {:?}, ||r*T||_inf = {:?})",
+                h.gamma, h.gamma_opt, h.gamma_achieved
+            ),
+        ),
+        None => (
+            "Glover–McFarlane".to_string(),
+            format!(
+                "b_opt = {:?}, gamma = {:?} (gamma_min = {:?})",
+                o.gm.b_opt, o.gm.gamma, o.gm.gamma_min
+            ),
+        ),
+    }
+}
+
 /// `controller.toml`: the `[controller]` table (`u = −K·y`) that `stability --controller`
-/// reads.
-pub fn controller_toml(k: &StateSpace, gm: &GmController, hinf: bool) -> String {
+/// reads, headed by the method and its `γ` ([`method_label`]).
+pub fn controller_toml(k: &StateSpace, (method, gamma): &(String, String)) -> String {
     format!(
-        "# {} central controller from rshape synthesize:\n# b_opt = {:?}, gamma = {:?} (gamma_min = {:?}); loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
-        if hinf { "H∞ (r as weight)" } else { "Glover–McFarlane" },
-        gm.b_opt,
-        gm.gamma,
-        gm.gamma_min,
+        "# {method} central controller from rshape synthesize:\n# {gamma}; loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
         toml_matrix(&k.a),
         toml_matrix(&k.b),
         toml_matrix(&k.c),
@@ -369,10 +387,17 @@ fn literal(m: &DMatrix<f64>, python: bool) -> String {
     }
 }
 
-fn script(k: &StateSpace, comment: &str, preamble: &str, call: &str, python: bool) -> String {
+fn script(
+    k: &StateSpace,
+    (method, gamma): &(String, String),
+    comment: &str,
+    preamble: &str,
+    call: &str,
+    python: bool,
+) -> String {
     let end = if python || comment == "#" { "" } else { ";" };
     format!(
-        "{comment} Glover–McFarlane controller from rshape synthesize; loop u = -K y\n{preamble}A = {}{end}\nB = {}{end}\nC = {}{end}\nD = {}{end}\nK = {call}{end}\n",
+        "{comment} {method} controller from rshape synthesize; loop u = -K y\n{comment} {gamma}\n{preamble}A = {}{end}\nB = {}{end}\nC = {}{end}\nD = {}{end}\nK = {call}{end}\n",
         literal(&k.a, python),
         literal(&k.b, python),
         literal(&k.c, python),
@@ -387,21 +412,23 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         "A": rows(&k.a), "B": rows(&k.b), "C": rows(&k.c), "D": rows(&k.d),
         "feedback": "negative",
     });
+    let label = method_label(o);
     let synthesis = synthesis_json(o);
     let json = |v: &serde_json::Value| {
         serde_json::to_string_pretty(v).map_err(|e| Error::Invalid(format!("json: {e}")))
     };
     let files = [
-        (
-            "controller.toml",
-            controller_toml(k, &o.gm, o.hinf.is_some()),
-        ),
+        ("controller.toml", controller_toml(k, &label)),
         ("controller.json", json(&state_space)?),
-        ("controller.m", script(k, "%", "", "ss(A, B, C, D)", false)),
+        (
+            "controller.m",
+            script(k, &label, "%", "", "ss(A, B, C, D)", false),
+        ),
         (
             "controller.py",
             script(
                 k,
+                &label,
                 "#",
                 "import numpy as np\nimport control as ct\n\n",
                 "ct.ss(A, B, C, D)",
@@ -410,7 +437,14 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         ),
         (
             "controller.jl",
-            script(k, "#", "using ControlSystems\n\n", "ss(A, B, C, D)", false),
+            script(
+                k,
+                &label,
+                "#",
+                "using ControlSystems\n\n",
+                "ss(A, B, C, D)",
+                false,
+            ),
         ),
         ("synthesis.json", json(&synthesis)?),
     ];
@@ -420,11 +454,25 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
         crate::util::write_atomic(&p, text.as_bytes())?;
         written.push(p);
     }
-    written.extend(stab::write_outputs(
-        out,
-        &o.stability,
-        "Theorem 1: 1/σ_max(T) vs |r| — the synthesized controller",
-    )?);
+    let head = match &o.hinf {
+        Some((_, h)) => format!(
+            "{} controller: γ = {} (γ_opt = {})",
+            label.0,
+            fmt_g(h.gamma),
+            fmt_g(h.gamma_opt)
+        ),
+        None => format!(
+            "Glover–McFarlane controller: γ = {} (γ_min = {}), b_opt = {}",
+            fmt_g(o.gm.gamma),
+            fmt_g(o.gm.gamma_min),
+            fmt_g(o.gm.b_opt)
+        ),
+    };
+    let title = match &o.hinf {
+        Some(_) => "Theorem 1: 1/σ_max(T) vs |r| — the synthesized H∞ controller",
+        None => "Theorem 1: 1/σ_max(T) vs |r| — the synthesized Glover–McFarlane controller",
+    };
+    written.extend(stab::write_outputs(out, &o.stability, title, &[head])?);
     Ok(written)
 }
 
@@ -433,12 +481,22 @@ pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
 pub fn synthesis_json(o: &SynthesisOutcome) -> serde_json::Value {
     let k = &o.gm.k;
     let rep = &o.stability.report;
+    let label = method_label(o);
+    // `gamma` is the controller's: the H∞ γ (with `gamma_opt`) or Glover–McFarlane's (with
+    // `gamma_min`); Glover–McFarlane's numbers stay under `glover_mcfarlane` either way.
+    let (gamma, gamma_opt, gamma_min) = match &o.hinf {
+        Some((_, h)) => (h.gamma, Some(h.gamma_opt), None),
+        None => (o.gm.gamma, None, Some(o.gm.gamma_min)),
+    };
     serde_json::json!({
         "method": if o.hinf.is_some() { "hinf_weighted" } else { "glover_mcfarlane" },
+        "method_label": label.0,
         "hinf": o.hinf.as_ref().map(|(label, h)| serde_json::json!({"r": label, "synthesis": h})),
+        "glover_mcfarlane": {"b_opt": o.gm.b_opt, "gamma_min": o.gm.gamma_min, "gamma": o.gm.gamma},
         "b_opt": o.gm.b_opt,
-        "gamma_min": o.gm.gamma_min,
-        "gamma": o.gm.gamma,
+        "gamma": gamma,
+        "gamma_opt": gamma_opt,
+        "gamma_min": gamma_min,
         "gamma_factor": o.gm.gamma / o.gm.gamma_min,
         "rho_xz": o.gm.rho,
         "riccati_residuals": o.gm.riccati_residuals,
@@ -457,14 +515,25 @@ pub fn synthesis_json(o: &SynthesisOutcome) -> serde_json::Value {
 /// The summary the CLI prints: the optimum, the controller, then the proof.
 pub fn text(o: &SynthesisOutcome) -> String {
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "Glover–McFarlane: b_opt = {} (gamma_min = {}), central controller at gamma = {} ({} states)",
-        fmt_g(o.gm.b_opt),
-        fmt_g(o.gm.gamma_min),
-        fmt_g(o.gm.gamma),
-        o.gm.k.states()
-    );
+    if o.hinf.is_some() {
+        // The controller is the H∞ one (next line): Glover–McFarlane gives the reference
+        // b_opt only.
+        let _ = writeln!(
+            s,
+            "Glover–McFarlane (reference, not the controller): b_opt = {} (gamma_min = {})",
+            fmt_g(o.gm.b_opt),
+            fmt_g(o.gm.gamma_min),
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "Glover–McFarlane: b_opt = {} (gamma_min = {}), central controller at gamma = {} ({} states)",
+            fmt_g(o.gm.b_opt),
+            fmt_g(o.gm.gamma_min),
+            fmt_g(o.gm.gamma),
+            o.gm.k.states()
+        );
+    }
     if let Some((label, h)) = &o.hinf {
         let _ = writeln!(
             s,
@@ -513,8 +582,11 @@ pub fn text(o: &SynthesisOutcome) -> String {
     }
     let _ = writeln!(
         s,
-        "closed loop: bandwidth (sigma_max(S) = -3 dB) {} rad/s, peak sensitivity Ms = {}",
-        o.merit.bandwidth.map_or("-".to_string(), fmt_g),
+        "closed loop: bandwidth (sigma_max(S) = -3 dB) {}, peak sensitivity Ms = {}",
+        o.merit.bandwidth.map_or(
+            "none (sigma_max(S) never crosses -3 dB on the grid)".to_string(),
+            |b| format!("{} rad/s", fmt_g(b))
+        ),
         fmt_g(o.merit.peak_sensitivity)
     );
     let _ = writeln!(s, "proof (Theorem 1 on the synthesized controller):");

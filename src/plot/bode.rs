@@ -1,6 +1,8 @@
 //! `bode.svg`: magnitude and phase of the data, with the noise disk of eq. (5) drawn as
 //! error bars, against the nominal model `G = C·M̃⁻¹·Ñ·J` (as in the paper's Fig. 7).
 
+use super::axis::{log_label, phase_tick, unwrap_deg, LogAxis, PhaseAxis};
+use super::fine::{Look, Overlay, PixelMap};
 use super::style::*;
 use crate::error::Result;
 use nalgebra::DMatrix;
@@ -29,57 +31,47 @@ fn phase_deg(z: Complex64) -> f64 {
     z.arg().to_degrees()
 }
 
-/// An angle in degrees wrapped into `(-180, 180]`.
-fn wrap180(a: f64) -> f64 {
-    let r = a.rem_euclid(360.0);
-    if r > 180.0 {
-        r - 360.0
-    } else {
-        r
-    }
+/// The model's phase of channel `ch` on the grid, unwrapped along it (NaN where the model is
+/// unknown or zero): the convention of `compare`'s overlay.
+fn model_phase(inp: &BodeInput, ch: (usize, usize)) -> Vec<f64> {
+    let g: Vec<Complex64> = inp
+        .model
+        .iter()
+        .map(|g| match g {
+            Some(g) if g[ch].norm() > 0.0 && g[ch].norm().is_finite() => g[ch],
+            _ => Complex64::new(f64::NAN, f64::NAN),
+        })
+        .collect();
+    unwrap_deg(&g)
 }
 
-/// The model's (wrapped) phase of channel `ch` at the grid point nearest to `w`.
-fn model_phase_near(inp: &BodeInput, w: f64, ch: (usize, usize)) -> Option<f64> {
-    let k = inp.grid.partition_point(|g| *g < w);
-    let cand = [k.saturating_sub(1), k.min(inp.grid.len().saturating_sub(1))];
-    let best = cand
-        .into_iter()
-        .filter(|&c| c < inp.grid.len())
-        .min_by(|&a, &b| {
-            (inp.grid[a] / w)
-                .ln()
-                .abs()
-                .total_cmp(&(inp.grid[b] / w).ln().abs())
-        })?;
-    let g = inp.model.get(best)?.as_ref()?[ch];
-    (g.norm() > 0.0).then(|| phase_deg(g))
-}
-
-/// Phase (degrees) of datum `k`, channel `ch`, on the branch of the model's phase nearby, so
-/// that data and model do not sit on opposite sides of the ±180° wrap.
-fn data_phase(inp: &BodeInput, k: usize, ch: (usize, usize)) -> f64 {
-    let z = inp.data[k][ch];
-    match model_phase_near(inp, inp.omega[k], ch) {
-        Some(pm) => pm + wrap180(phase_deg(z) - pm),
-        None => phase_deg(z),
+/// Phase (degrees) of each datum of channel `ch`, on the branch of the model's unwrapped
+/// phase at the nearest grid point (data and model never sit 360° apart); unwrapped along the
+/// data where the model is unknown.
+fn data_phases(inp: &BodeInput, ch: (usize, usize), model: &[f64]) -> Vec<f64> {
+    let near = |p: f64, to: f64| p + 360.0 * ((to - p) / 360.0).round();
+    let mut out: Vec<f64> = Vec::with_capacity(inp.omega.len());
+    for (k, w) in inp.omega.iter().enumerate() {
+        let p = phase_deg(inp.data[k][ch]);
+        let j = inp.grid.partition_point(|g| *g < *w);
+        let reference = [j.saturating_sub(1), j]
+            .into_iter()
+            .filter(|&c| c < inp.grid.len() && model[c].is_finite())
+            .min_by(|&a, &b| {
+                (inp.grid[a] / w)
+                    .ln()
+                    .abs()
+                    .total_cmp(&(inp.grid[b] / w).ln().abs())
+            })
+            .map(|c| model[c]);
+        let prev = out.last().copied().filter(|v: &f64| v.is_finite());
+        out.push(match (reference, prev) {
+            (Some(m), _) if p.is_finite() => near(p, m),
+            (None, Some(q)) if p.is_finite() => near(p, q),
+            _ => p,
+        });
     }
-}
-
-/// Splits a wrapped phase curve where it jumps by more than 180°, so no vertical line is
-/// drawn across the ±180° wrap.
-fn wrap_segments(points: Vec<(f64, f64)>) -> Vec<Vec<(f64, f64)>> {
-    let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for p in points {
-        let cur = out.last_mut().expect("non-empty");
-        if let Some(last) = cur.last() {
-            if (p.1 - last.1).abs() > 180.0 {
-                out.push(Vec::new());
-            }
-        }
-        out.last_mut().expect("non-empty").push(p);
-    }
-    out.into_iter().filter(|s| s.len() > 1).collect()
+    out
 }
 
 /// Pixel size of one channel's panel (magnitude over phase) in a MIMO grid, and of the
@@ -102,25 +94,28 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
     let width = (pw * m as u32).max(SIZE.0);
     let height = 44 + ph * p as u32 + legend_height(rows);
     let mut svg = String::new();
+    let overlay = Overlay::default();
     {
         let root = SVGBackend::with_string(&mut svg, (width, height)).into_drawing_area();
         root.fill(&WHITE).map_err(plot_err)?;
-        let root = root.titled(inp.title, (FONT, CAPTION)).map_err(plot_err)?;
+        let title = fit_title(inp.title, width as f64 - 28.0, CAPTION);
+        let root = root.titled(&title, (FONT, CAPTION)).map_err(plot_err)?;
         let (grid, below) = root.split_vertically(ph * p as u32);
         let panels = grid.split_evenly((p, m));
         for (k, area) in panels.iter().enumerate() {
             let ch = (k / m, k % m);
-            panel(area, inp, ch, p * m == 1)?;
+            panel(area, inp, ch, p * m == 1, &overlay)?;
         }
         let mut leg = Legend::default();
         let col = C_BLUE;
-        let s = ShapeStyle::from(&C_ORANGE).stroke_width(2);
         let sym = inp.symbol;
-        leg.add(format!("nominal model {sym}(jω) (line)"), move |(x, y)| {
-            PathElement::new(vec![(x, y), (x + 24, y)], s)
-        });
+        leg.add_line(
+            format!("nominal model {sym}(jω) (line; phase unwrapped along ω)"),
+            MODEL,
+            &overlay,
+        );
         leg.add("measured data (markers)", move |(x, y)| {
-            Circle::new((x + 12, y), 4, col.filled())
+            Circle::new((x + 12, y), 3, col.mix(0.7).filled())
         });
         if noisy {
             let s = C_BLUE.mix(0.6).stroke_width(1);
@@ -132,15 +127,20 @@ pub fn bode_svg(inp: &BodeInput) -> Result<String> {
         leg.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
+    overlay.inject(&mut svg);
     Ok(svg)
 }
 
-/// Draws channel `ch` (magnitude over phase) in `area`.
+/// The model's line: solid orange.
+const MODEL: Look = Look::solid(C_ORANGE, 2.0);
+
+/// Draws channel `ch` (magnitude over phase) in `area`; the model's lines go to `overlay`.
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     inp: &BodeInput,
     (i, j): (usize, usize),
     siso: bool,
+    overlay: &Overlay,
 ) -> Result<()> {
     let radius = |k: usize| inp.noise_radius.map_or(0.0, |r| r[k]);
     let (xlo, xhi) = omega_range(inp.omega);
@@ -176,31 +176,23 @@ fn panel<DB: DrawingBackend>(
         );
     }
     let mut mag = builder
-        .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
+        .build_cartesian_2d(LogAxis::new(xlo, xhi), LogAxis::new(ylo, yhi))
         .map_err(plot_err)?;
+    let (ylo, yhi) = mag.as_coord_spec().y_spec().ends();
     mag.configure_mesh()
         .y_desc(format!("|{name}(jω)|"))
         .axis_desc_style((FONT, if siso { AXIS } else { TICKS }))
         .label_style((FONT, font))
-        .x_label_formatter(&log_tick)
-        .y_label_formatter(&log_tick)
+        .x_label_formatter(&log_label)
+        .y_label_formatter(&log_label)
         .light_line_style(RGBColor(235, 235, 235))
-        .max_light_lines(4)
+        .max_light_lines(9)
         .x_labels(if siso { 12 } else { 6 })
+        .y_labels(if siso { 10 } else { 6 })
         .draw()
         .map_err(plot_err)?;
     let col = C_BLUE;
-    let s = ShapeStyle::from(&C_ORANGE).stroke_width(2);
-    let line: Vec<(f64, f64)> = inp
-        .grid
-        .iter()
-        .zip(inp.model)
-        .filter_map(|(w, g)| g.as_ref().map(|g| (*w, g[(i, j)].norm())))
-        .filter(|(_, y)| *y > 0.0 && y.is_finite())
-        .map(|(w, y)| (w, clamp(y, ylo, yhi)))
-        .collect();
-    mag.draw_series(LineSeries::new(line, s))
-        .map_err(plot_err)?;
+    let dot = col.mix(0.7).filled();
     for (k, (w, d)) in inp.omega.iter().zip(inp.data).enumerate() {
         let a = d[(i, j)].norm();
         let r = radius(k);
@@ -214,57 +206,64 @@ fn panel<DB: DrawingBackend>(
             )))
             .map_err(plot_err)?;
         }
-        if a > 0.0 {
+        if a > 0.0 && a.is_finite() {
             mag.draw_series(std::iter::once(Circle::new(
                 (*w, clamp(a, ylo, yhi)),
                 3,
-                col.filled(),
+                dot,
             )))
             .map_err(plot_err)?;
         }
     }
+    let line: Vec<(f64, f64)> = inp
+        .grid
+        .iter()
+        .zip(inp.model)
+        .map(|(w, g)| match g {
+            Some(g) if g[(i, j)].norm() > 0.0 => (*w, clamp(g[(i, j)].norm(), ylo, yhi)),
+            _ => (*w, f64::NAN),
+        })
+        .collect();
+    overlay.curve(&PixelMap::of(&mag), line, MODEL);
 
-    // Phase: ±180° plus whatever the data on the model's branch need (at most ±360°).
-    let (mut plo, mut phi) = (-180.0f64, 180.0f64);
-    for k in 0..inp.omega.len() {
-        let a = data_phase(inp, k, (i, j));
-        plo = plo.min(a);
-        phi = phi.max(a);
-    }
-    let (plo, phi) = (plo.max(-360.0) - 22.5, phi.min(360.0) + 22.5);
+    // Phase: unwrapped along the grid (as compare's overlay), the data on the model's
+    // branch; the axis spans multiples of 90° just around them, ticked every 90°.
+    let model = model_phase(inp, (i, j));
+    let data = data_phases(inp, (i, j), &model);
+    let in_band = |w: &f64| *w >= xlo && *w <= xhi;
+    let axis = PhaseAxis::covering(
+        data.iter().copied().chain(
+            inp.grid
+                .iter()
+                .zip(&model)
+                .filter(|(w, _)| in_band(w))
+                .map(|(_, p)| *p),
+        ),
+    );
     let mut ph = ChartBuilder::on(&bottom)
         .margin(10)
         .x_label_area_size(if siso { 52 } else { 40 })
         .y_label_area_size(yl)
-        .build_cartesian_2d((xlo..xhi).log_scale(), plo..phi)
+        .build_cartesian_2d(LogAxis::new(xlo, xhi), axis.clone())
         .map_err(plot_err)?;
     ph.configure_mesh()
         .x_desc("frequency ω (rad/s)")
         .y_desc(format!("∠{name}(jω) (degrees)"))
         .axis_desc_style((FONT, if siso { AXIS } else { TICKS }))
         .label_style((FONT, font))
-        .x_label_formatter(&log_tick)
-        .y_labels(if siso { 9 } else { 5 })
-        .y_label_formatter(&|v| format!("{v:.0}°"))
+        .x_label_formatter(&log_label)
+        .y_label_formatter(&phase_tick)
         .light_line_style(RGBColor(235, 235, 235))
-        .max_light_lines(4)
+        .max_light_lines(9)
         .x_labels(if siso { 12 } else { 6 })
         .draw()
         .map_err(plot_err)?;
-    let line: Vec<(f64, f64)> = inp
-        .grid
-        .iter()
-        .zip(inp.model)
-        .filter_map(|(w, g)| g.as_ref().map(|g| (*w, g[(i, j)])))
-        .filter(|(_, z)| z.norm() > 0.0)
-        .map(|(w, z)| (w, phase_deg(z)))
-        .collect();
-    for seg in wrap_segments(line) {
-        ph.draw_series(LineSeries::new(seg, s)).map_err(plot_err)?;
-    }
     for (k, (w, d)) in inp.omega.iter().zip(inp.data).enumerate() {
         let z = d[(i, j)];
-        let ang = data_phase(inp, k, (i, j));
+        let ang = data[k];
+        if !ang.is_finite() {
+            continue;
+        }
         let r = radius(k);
         if r > 0.0 {
             // The disk of radius r around z subtends ±asin(r/|z|) (all angles if it holds 0).
@@ -273,38 +272,59 @@ fn panel<DB: DrawingBackend>(
             } else {
                 (r / z.norm()).asin().to_degrees()
             };
-            let (lo, hi) = (clamp(ang - half, plo, phi), clamp(ang + half, plo, phi));
+            let (lo, hi) = (axis.clamp(ang - half), axis.clamp(ang + half));
             ph.draw_series(std::iter::once(PathElement::new(
                 vec![(*w, lo), (*w, hi)],
                 col.mix(0.6).stroke_width(1),
             )))
             .map_err(plot_err)?;
         }
-        ph.draw_series(std::iter::once(Circle::new((*w, ang), 3, col.filled())))
+        ph.draw_series(std::iter::once(Circle::new((*w, axis.clamp(ang)), 3, dot)))
             .map_err(plot_err)?;
     }
+    overlay.curve(
+        &PixelMap::of(&ph),
+        inp.grid.iter().copied().zip(model.iter().copied()),
+        MODEL,
+    );
     Ok(())
 }
 
 #[cfg(test)]
 mod tests {
-    use super::wrap_segments;
+    use super::*;
 
+    /// The model's phase is continuous (no jump at ±180°) and each datum sits on its branch.
     #[test]
-    fn wrap_splits_at_jumps() {
-        let s = wrap_segments(vec![
-            (1.0, 170.0),
-            (2.0, 179.0),
-            (3.0, -179.0),
-            (4.0, -170.0),
-        ]);
-        assert_eq!(s.len(), 2);
-    }
-
-    #[test]
-    fn wrap() {
-        assert_eq!(super::wrap180(190.0), -170.0);
-        assert_eq!(super::wrap180(-190.0), 170.0);
-        assert_eq!(super::wrap180(180.0), 180.0);
+    fn phase_is_unwrapped_along_the_model() {
+        let grid: Vec<f64> = (0..200).map(|k| 0.1 * 1.05f64.powi(k)).collect();
+        // G = 1/(s+1)^3: the phase runs from 0 to −270°.
+        let g = |w: f64| Complex64::new(1.0, w).powi(3).inv();
+        let model: Vec<Option<DMatrix<Complex64>>> = grid
+            .iter()
+            .map(|w| Some(DMatrix::from_element(1, 1, g(*w))))
+            .collect();
+        let omega = [0.5, 3.0, 20.0];
+        let data: Vec<DMatrix<Complex64>> = omega
+            .iter()
+            .map(|w| DMatrix::from_element(1, 1, g(*w)))
+            .collect();
+        let inp = BodeInput {
+            title: "t",
+            omega: &omega,
+            data: &data,
+            noise_radius: None,
+            grid: &grid,
+            model: &model,
+            symbol: "G",
+        };
+        let m = model_phase(&inp, (0, 0));
+        assert!(m.windows(2).all(|w| (w[1] - w[0]).abs() < 20.0));
+        assert!(m.last().unwrap() < &-200.0);
+        let d = data_phases(&inp, (0, 0), &m);
+        let exact = |w: f64| -3.0 * w.atan().to_degrees();
+        for (p, w) in d.iter().zip(omega) {
+            assert!((p - exact(w)).abs() < 1e-6, "{p} vs {}", exact(w));
+        }
     }
 }

@@ -12,8 +12,10 @@
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
+pub(crate) mod axis;
 pub(crate) mod batch;
 pub(crate) mod bode;
+pub(crate) mod fine;
 pub(crate) mod mu;
 pub(crate) mod r_vs_delta;
 pub(crate) mod stability;
@@ -24,4 +26,5 @@ pub use batch::{batch_svg, BatchFigureInput};
 pub use bode::{bode_svg, BodeInput};
 pub use mu::{mu_svg, mu_svg_with, MuInput};
 pub use r_vs_delta::{r_vs_delta_svg, r_vs_delta_svg_with, RVsDeltaInput};
+pub use stability::{stability_svg, StabilityInput};
 pub use symbols::Symbols;

@@ -45,18 +45,11 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
             + usize::from(inp.mu.iter().any(|m| *m <= 1.0));
     let y_desc = format!("{mu_name} (dimensionless)");
     loglog_figure(inp.title, (xlo, xhi), (ylo, yhi), &y_desc, rows, |p| {
-        let s = C_GREY.stroke_width(2);
-        p.chart
-            .draw_series(DashedLineSeries::new(
-                vec![(xlo, 1.0), (xhi, 1.0)],
-                10,
-                6,
-                s,
-            ))
-            .map_err(plot_err)?;
-        p.legend.add(
+        let (xlo, xhi) = p.x_axis().ends();
+        p.line_with_legend(
+            [(xlo, 1.0), (xhi, 1.0)],
+            super::fine::Look::dashed(C_GREY, 2.0, 10.0, 6.0),
             "μ = 1: consistent above, inconsistent at or below",
-            move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
         );
         let a1_fails = |i: usize| inp.a1_failing.get(i).copied().unwrap_or(false);
         // (ω, μ clamped, μ > 1, A1 holds)
@@ -68,12 +61,10 @@ pub fn mu_svg_with(inp: &MuInput, sym: &Symbols) -> Result<String> {
             })
             .collect();
         // A thin line through the data guides the eye; the markers carry the verdict.
-        p.chart
-            .draw_series(LineSeries::new(
-                pts.iter().map(|p| (p.0, p.1)),
-                C_BLUE.mix(0.35).stroke_width(1),
-            ))
-            .map_err(plot_err)?;
+        p.line(
+            pts.iter().map(|p| (p.0, p.1)),
+            super::fine::Look::solid(C_BLUE, 1.0).alpha(0.35),
+        );
         if pts.iter().any(|p| p.2 && p.3) {
             p.chart
                 .draw_series(

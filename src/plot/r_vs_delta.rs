@@ -152,25 +152,26 @@ impl Figure<'_, '_> {
         let Some(a1) = self.inp.a1_on_grid else {
             return Ok(());
         };
-        let s = ShapeStyle::from(&C_PURPLE).stroke_width(2);
-        p.chart
-            .draw_series(DashedLineSeries::new(self.curve(a1), 8, 5, s))
-            .map_err(plot_err)?;
-        p.legend.add(
+        p.line_with_legend(
+            self.curve(a1),
+            LIMIT,
             "A1 limit σ_min(M̃(jω)): |r| must stay below",
-            move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], s),
         );
         Ok(())
     }
 
-    /// Green dots: the data the configured weight explains.
+    /// Green dots, small and translucent (the curves are drawn over them, so none hides the
+    /// fitted weight): the data the configured weight explains.
     fn explained(&self, p: &mut LogLogPlot) -> Result<()> {
         let ok = self.points(Class::Explained);
         if ok.is_empty() {
             return Ok(());
         }
         p.chart
-            .draw_series(ok.iter().map(|p| Circle::new(*p, 5, C_GREEN.filled())))
+            .draw_series(
+                ok.iter()
+                    .map(|p| Circle::new(*p, 4, C_GREEN.mix(0.55).filled())),
+            )
             .map_err(plot_err)?;
         let label = if self.inp.r_configured.is_some() {
             let w = self.sym.weight;
@@ -179,7 +180,7 @@ impl Figure<'_, '_> {
             self.inp.r_min_label.to_string()
         };
         p.legend.add(label, |(x, y)| {
-            Circle::new((x + 12, y), 5, C_GREEN.filled())
+            Circle::new((x + 12, y), 4, C_GREEN.mix(0.55).filled())
         });
         Ok(())
     }
@@ -222,7 +223,7 @@ impl Figure<'_, '_> {
         p.chart
             .draw_series(bad.iter().map(|p| {
                 EmptyElement::at(*p)
-                    + Circle::new((0, 0), 8, C_RED.stroke_width(3))
+                    + Circle::new((0, 0), 6, C_RED.stroke_width(2))
                     + Cross::new((0, 0), 5, C_RED.stroke_width(2))
             }))
             .map_err(plot_err)?;
@@ -234,7 +235,7 @@ impl Figure<'_, '_> {
             ),
             |(x, y)| {
                 EmptyElement::at((x + 12, y))
-                    + Circle::new((0, 0), 7, C_RED.stroke_width(3))
+                    + Circle::new((0, 0), 6, C_RED.stroke_width(2))
                     + Cross::new((0, 0), 4, C_RED.stroke_width(2))
             },
         );

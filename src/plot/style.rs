@@ -1,5 +1,7 @@
 //! Shared look of the figures: size, fonts, palette, legend placement, axis ranges.
 
+use super::axis::LogAxis;
+use super::fine::{Look, Overlay, PixelMap};
 use crate::error::{Error, Result};
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
@@ -54,30 +56,67 @@ pub fn plot_err<E: std::fmt::Debug>(e: E) -> Error {
 }
 
 /// A log-axis range covering the positive finite values, padded by a factor (at least one
-/// decade in total); `None` when there is no positive finite value.
+/// decade in total), finite and at most [`super::axis::MAX_DECADES`] wide (the guard of
+/// [`super::axis::log_bounds`]); `None` when there is no positive finite value.
 pub fn log_range<'a, I: IntoIterator<Item = &'a f64>>(values: I, pad: f64) -> Option<(f64, f64)> {
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
-    for &v in values {
-        if v.is_finite() && v > 0.0 {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    if hi == 0.0 {
-        return None;
-    }
-    let (mut lo, mut hi) = (lo / pad, hi * pad);
-    if hi / lo < 10.0 {
-        let mid = (lo * hi).sqrt();
-        lo = mid / 10f64.sqrt();
-        hi = mid * 10f64.sqrt();
-    }
-    Some((lo, hi))
+    super::axis::log_data_range(values, pad)
 }
 
 /// The frequency axis: the data range extended by a quarter decade on each side.
 pub fn omega_range(omega: &[f64]) -> (f64, f64) {
     log_range(omega, 10f64.powf(0.25)).unwrap_or((0.1, 10.0))
+}
+
+/// Shortens `title` to fit `width` pixels in font `font`: the part after the last ` — `
+/// (the configuration's name) loses whole words from its middle, replaced by `…`; then,
+/// if still too wide, the title is cut at a word boundary.
+pub fn fit_title(title: &str, width: f64, font: u32) -> String {
+    // The SVG backend writes the size as font/1.24 px; 0.55 em a character is wider than the
+    // digits and lower-case letters of common sans fonts.
+    let fits = |t: &str| t.chars().count() as f64 * 0.55 * font as f64 / 1.24 <= width;
+    if fits(title) {
+        return title.to_string();
+    }
+    let (head, name) = match title.rsplit_once(" — ") {
+        Some((h, n)) => (format!("{h} — "), n.to_string()),
+        None => (String::new(), title.to_string()),
+    };
+    let words: Vec<&str> = name.split(' ').collect();
+    // Drop words from the middle of the name, keeping its first and last words.
+    for drop in 1..words.len().saturating_sub(1) {
+        let keep = words.len() - drop;
+        let front = keep.div_ceil(2);
+        let back = keep - front;
+        let t = format!(
+            "{head}{} … {}",
+            words[..front].join(" "),
+            words[words.len() - back..].join(" ")
+        );
+        if back > 0 && fits(&t) {
+            return t;
+        }
+    }
+    // Cut at a word boundary.
+    let mut out = String::new();
+    for w in title.split(' ') {
+        let next = if out.is_empty() {
+            w.to_string()
+        } else {
+            format!("{out} {w}")
+        };
+        if !fits(&format!("{next} …")) {
+            break;
+        }
+        out = next;
+    }
+    if out.is_empty() {
+        title
+            .chars()
+            .take((width / (0.5 * font as f64)) as usize)
+            .collect()
+    } else {
+        format!("{out} …")
+    }
 }
 
 /// Clamps `v` into `[lo, hi]` (for drawing values that sit outside the axis).
@@ -122,12 +161,16 @@ type Entry<'a, DB> = Box<dyn FnOnce(&mut LegendChart<'a, DB>) -> Result<()> + 'a
 /// plot, where it hides no data and costs no axis range.
 pub struct Legend<'a, DB: DrawingBackend> {
     entries: Vec<Entry<'a, DB>>,
+    // Pixel origin of the legend's area in the document: plotters hands the samples
+    // coordinates relative to it, the overlay needs absolute ones.
+    origin: std::rc::Rc<std::cell::Cell<(i32, i32)>>,
 }
 
 impl<'a, DB: DrawingBackend + 'a> Default for Legend<'a, DB> {
     fn default() -> Self {
         Self {
             entries: Vec::new(),
+            origin: Default::default(),
         }
     }
 }
@@ -152,6 +195,19 @@ impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
             }));
     }
 
+    /// Adds an entry whose sample is a line in `look`, drawn (dashes and all) by `overlay`
+    /// exactly as the curve it stands for.
+    pub fn add_line(&mut self, label: impl Into<String>, look: Look, overlay: &Overlay) {
+        let overlay = overlay.clone();
+        let origin = self.origin.clone();
+        self.add(label, move |(x, y)| {
+            let (ox, oy) = origin.get();
+            let (ax, ay) = ((x + ox) as f64, (y + oy) as f64);
+            overlay.pixels(&[(ax, ay), (ax + 24.0, ay)], look, "legend");
+            EmptyElement::at((x, y))
+        });
+    }
+
     /// Draws the legend in `area` (the strip below the plot), aligned with the plot's left
     /// edge.
     pub fn draw(self, area: &'a DrawingArea<DB, plotters::coord::Shift>) -> Result<()> {
@@ -163,6 +219,7 @@ impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
             .margin_right(14)
             .build_cartesian_2d(0f64..1f64, 0f64..1f64)
             .map_err(plot_err)?;
+        self.origin.set(chart.plotting_area().get_base_pixel());
         for entry in self.entries {
             entry(&mut chart)?;
         }
@@ -172,41 +229,6 @@ impl<'a, DB: DrawingBackend + 'a> Legend<'a, DB> {
 
 /// Width of the y tick labels and axis description left of a plot.
 pub const Y_LABEL_AREA: u32 = 78;
-
-/// Formats a tick label of a log axis: plain numbers from 0.01 to 9999 (`0.05`, `200`),
-/// else `1e-3`, `2e5`.  Only ticks with mantissa 1, 2 or 5 are labelled (the others stay as
-/// grid lines), so labels never crowd.
-pub fn log_tick(v: &f64) -> String {
-    // Round off the last bits of the axis arithmetic (0.009999999999 → 0.01).
-    let v: f64 = format!("{:.10e}", *v).parse().unwrap_or(*v);
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let mantissa = v.abs() / 10f64.powf(v.abs().log10().floor());
-    if ![1.0, 2.0, 5.0, 10.0]
-        .iter()
-        .any(|m| (mantissa - m).abs() < 1e-6 * m)
-    {
-        return String::new();
-    }
-    if (0.01..1e4).contains(&v.abs()) {
-        let s = format!(
-            "{:.*}",
-            (2 - v.abs().log10().floor() as i32).max(0) as usize,
-            v
-        );
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    } else {
-        let s = format!("{v:.2e}");
-        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = m.trim_end_matches('0').trim_end_matches('.');
-        format!("{m}e{x}")
-    }
-}
 
 /// A short human form of a transfer function, e.g. `(1e-8 s + 0.3)/(s + 1)`, or
 /// `order-n unit` when that would be too long for a legend.
@@ -363,9 +385,11 @@ pub fn draw_x_labels<DB: DrawingBackend>(
     Ok(())
 }
 
-/// A chart with logarithmic axes on both sides.
-pub type LogLogChart<'a, 'b> =
-    ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+/// A chart with logarithmic axes on both sides (rshape's guarded [`LogAxis`]).
+pub type LogLogChart<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogAxis, LogAxis>>;
+
+/// Width available to a caption on the standard canvas.
+pub const TITLE_WIDTH: f64 = SIZE.0 as f64 - 28.0;
 
 /// A log-frequency × log-magnitude chart on `root` with the caption, margins and mesh that
 /// `r_vs_delta.svg` and `mu.svg` share.
@@ -377,25 +401,56 @@ pub fn loglog_chart<'a, 'b>(
     y_desc: &str,
 ) -> Result<LogLogChart<'a, 'b>> {
     let mut chart = ChartBuilder::on(root)
-        .caption(title, (FONT, CAPTION))
+        .caption(fit_title(title, TITLE_WIDTH, CAPTION), (FONT, CAPTION))
         .margin(14)
         .x_label_area_size(52)
         .y_label_area_size(Y_LABEL_AREA)
-        .build_cartesian_2d((xlo..xhi).log_scale(), (ylo..yhi).log_scale())
+        .build_cartesian_2d(LogAxis::new(xlo, xhi), LogAxis::new(ylo, yhi))
         .map_err(plot_err)?;
     loglog_mesh(&mut chart, y_desc)?;
     Ok(chart)
 }
 
-/// A log-log plot being drawn: the chart to put the series on and the legend that collects
-/// their entries (drawn below the plot when the figure is finished).
+/// A log-log plot being drawn: the chart to put the series on, the overlay of its curves and
+/// the legend that collects their entries (drawn below the plot when the figure is finished).
 pub struct LogLogPlot<'a, 'b> {
     /// The chart (caption, axes and mesh of [`loglog_chart`]).
     pub chart: LogLogChart<'a, 'b>,
     /// The legend strip below the plot.
     pub legend: Legend<'a, SVGBackend<'b>>,
+    /// The sub-pixel curves.
+    pub overlay: Overlay,
     // The chart borrows the drawing area of a backend that lives longer ('b: 'a).
     _area: std::marker::PhantomData<&'a SVGBackend<'b>>,
+}
+
+impl LogLogPlot<'_, '_> {
+    /// Draws a curve through `points` in `look` (sub-pixel, clamped into the y axis).
+    pub fn line<I: IntoIterator<Item = (f64, f64)>>(&self, points: I, look: Look) {
+        let map = PixelMap::of(&self.chart);
+        self.overlay.curve(&map, points, look);
+    }
+
+    /// Draws a curve and adds its legend entry with the same look.
+    pub fn line_with_legend<I: IntoIterator<Item = (f64, f64)>>(
+        &mut self,
+        points: I,
+        look: Look,
+        label: impl Into<String>,
+    ) {
+        self.line(points, look);
+        self.legend.add_line(label, look, &self.overlay);
+    }
+
+    /// The x axis (guarded range).
+    pub fn x_axis(&self) -> &LogAxis {
+        self.chart.as_coord_spec().x_spec()
+    }
+
+    /// The y axis (guarded range).
+    pub fn y_axis(&self) -> &LogAxis {
+        self.chart.as_coord_spec().y_spec()
+    }
 }
 
 /// A log-log figure with its legend strip below, as an SVG document: the caption, axes and
@@ -413,6 +468,7 @@ where
     F: for<'a, 'b> FnOnce(&mut LogLogPlot<'a, 'b>) -> Result<()>,
 {
     let mut svg = String::new();
+    let overlay = Overlay::default();
     {
         let root =
             SVGBackend::with_string(&mut svg, size_with_legend(legend_rows)).into_drawing_area();
@@ -421,12 +477,14 @@ where
         let mut p = LogLogPlot {
             chart: loglog_chart(&plot, title, x, y, y_desc)?,
             legend: Legend::default(),
+            overlay: overlay.clone(),
             _area: std::marker::PhantomData,
         };
         draw(&mut p)?;
         p.legend.draw(&below)?;
         root.present().map_err(plot_err)?;
     }
+    overlay.inject(&mut svg);
     Ok(svg)
 }
 
@@ -440,6 +498,19 @@ pub enum WeightCurve {
     Fitted,
 }
 
+impl WeightCurve {
+    /// The look of the curve: solid blue, or dashed orange.
+    pub const fn look(self) -> Look {
+        match self {
+            WeightCurve::Configured => Look::solid(C_BLUE, 3.0),
+            WeightCurve::Fitted => Look::dashed(C_ORANGE, 3.0, 12.0, 5.0),
+        }
+    }
+}
+
+/// The look of a limit curve (A1, Theorem 1): dashed purple.
+pub const LIMIT: Look = Look::dashed(C_PURPLE, 2.5, 8.0, 5.0);
+
 impl LogLogPlot<'_, '_> {
     /// Draws `|w(jω)|` at `points` in the look of `kind` and adds its legend entry `label`.
     pub fn weight(
@@ -448,20 +519,7 @@ impl LogLogPlot<'_, '_> {
         kind: WeightCurve,
         label: String,
     ) -> Result<()> {
-        let s = match kind {
-            WeightCurve::Configured => ShapeStyle::from(&C_BLUE).stroke_width(3),
-            WeightCurve::Fitted => ShapeStyle::from(&C_ORANGE).stroke_width(3),
-        };
-        match kind {
-            WeightCurve::Configured => self.chart.draw_series(LineSeries::new(points, s)),
-            WeightCurve::Fitted => self
-                .chart
-                .draw_series(DashedLineSeries::new(points, 12, 4, s)),
-        }
-        .map_err(plot_err)?;
-        self.legend.add(label, move |(x, y)| {
-            PathElement::new(vec![(x, y), (x + 24, y)], s)
-        });
+        self.line_with_legend(points, kind.look(), label);
         Ok(())
     }
 }
@@ -482,11 +540,12 @@ where
         .y_desc(y_desc)
         .axis_desc_style((FONT, AXIS))
         .label_style((FONT, TICKS))
-        .x_label_formatter(&log_tick)
-        .y_label_formatter(&log_tick)
+        .x_label_formatter(&super::axis::log_label)
+        .y_label_formatter(&super::axis::log_label)
         .light_line_style(RGBColor(235, 235, 235))
-        .max_light_lines(4)
+        .max_light_lines(9)
         .x_labels(12)
+        .y_labels(10)
         .draw()
         .map_err(plot_err)?;
     Ok(())
@@ -494,7 +553,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{fmt_tick, log_axis_ticks, log_tick, text_width};
+    use super::{fmt_tick, log_axis_ticks, text_width};
 
     /// The chosen ticks never crowd: on narrow and wide bands, neighbouring labels keep
     /// 8 px apart (the old figures printed `800.900.01000.0`).
@@ -520,18 +579,5 @@ mod tests {
         assert_eq!(fmt_tick(800.0), "800");
         assert_eq!(fmt_tick(1200.0000000001), "1200");
         assert_eq!(fmt_tick(2.5), "2.5");
-    }
-
-    #[test]
-    fn ticks() {
-        assert_eq!(log_tick(&300.0), "");
-        assert_eq!(log_tick(&200.0), "200");
-        assert_eq!(log_tick(&0.05), "0.05");
-        assert_eq!(log_tick(&1.0), "1");
-        assert_eq!(log_tick(&1e-3), "1e-3");
-        assert_eq!(log_tick(&2e5), "2e5");
-        assert_eq!(log_tick(&1000.0), "1000");
-        assert_eq!(log_tick(&0.5), "0.5");
-        assert_eq!(log_tick(&0.009999999999999), "0.01");
     }
 }

@@ -57,7 +57,7 @@ fn rows(out: &Path) -> Vec<Vec<String>> {
     let mut l = s.lines();
     assert_eq!(
         l.next().unwrap(),
-        "index,name,status,n_data,max_r_min,consistent,n_failing,data,error"
+        "index,name,status,n_data,max_r_min,consistent,verdict,n_failing,data,error"
     );
     l.map(|r| r.split(',').map(str::to_string).collect())
         .collect()
@@ -97,12 +97,13 @@ fn corrupt_dataset_exit_3_others_complete() {
     assert_eq!(names, ["exp1", "exp2", "exp2b", "exp3"]);
     let bad = &r[2];
     assert_eq!(bad[2], "failed");
-    assert!(bad[8..].join(",").contains("exp2b.csv"), "{bad:?}");
+    assert!(bad[9..].join(",").contains("exp2b.csv"), "{bad:?}");
     for good in [&r[0], &r[1], &r[3]] {
         assert_eq!(good[2], "ok");
         assert_eq!(good[3], "5");
         assert_eq!(good[5], "false");
-        assert_eq!(good[6], "2");
+        assert_eq!(good[6], "inconsistent");
+        assert_eq!(good[7], "2");
         assert!((good[4].parse::<f64>().unwrap() - 0.2515853887657883).abs() < 1e-9);
         let dir = out.path().join("datasets").join(&good[1]);
         assert!(dir.join("envelope.csv").is_file() && dir.join("result.json").is_file());

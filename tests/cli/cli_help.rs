@@ -28,6 +28,10 @@ fn every_subcommand_help_states_its_exit_codes() {
         ("history", &["0", "2 error"]),
         ("fit", &["0", "2 error"]),
         ("stability", &["0 robustly stable", "1 not", "2 error"]),
+        (
+            "synthesize",
+            &["0 proven robust", "1 not proven robust", "2 error"],
+        ),
     ];
     for (sub, needles) in subs {
         let o = rshape(&[sub, "--help"]);
@@ -46,6 +50,19 @@ fn every_subcommand_help_states_its_exit_codes() {
         t.contains("Exit codes:") && t.contains("3 some datasets failed"),
         "{t}"
     );
+}
+
+/// A mistyped option gets "did you mean --out", not clap's "use -- --ouput".
+#[test]
+fn mistyped_option_is_suggested() {
+    let o = rshape(&["run", "configs/robot.toml", "--ouput", "x"]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("did you mean --out?"), "{e}");
+    assert!(!e.contains("-- --ouput"), "{e}");
+    // Where clap has its own suggestion it stays.
+    let o = rshape(&["synthesize", "configs/robot.toml", "--metod", "hinf"]);
+    assert!(stderr(&o).contains("'--method'"), "{}", stderr(&o));
 }
 
 #[test]

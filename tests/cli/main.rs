@@ -16,6 +16,7 @@ mod batch_vocabulary;
 mod cli_help;
 mod closed_loop_cli;
 mod configs_every;
+mod figures_extreme;
 mod figures_glance;
 mod fuzz_inputs;
 mod hardening_iii;

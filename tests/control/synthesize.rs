@@ -484,3 +484,102 @@ fn fit_then_synthesize_proves_both_bounds() {
     );
     assert!(syn["merit"]["peak_sensitivity"].as_f64().unwrap() >= 1.0);
 }
+
+/// Every output names the method that made the controller and carries that method's γ
+/// (issue 35): with `--method hinf` the text, `controller.toml`'s header, the `.m`/`.py`/`.jl`
+/// exports, `synthesis.json` and `stability.svg` say H∞ with the H∞ γ and γ_opt (not
+/// Glover–McFarlane's 1.94/1.76); with `gm` they say Glover–McFarlane with its γ and γ_min.
+#[test]
+fn outputs_carry_the_method_and_its_gamma() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = common::repo("configs/plant_first.toml");
+    let gm_out = dir.path().join("gm");
+    let (_, gm_text, gm) = synthesize_verdict(&cfg, &["--fit", "--method", "gm"], &gm_out);
+    let r_json = gm_out.join("r.json");
+    let h_out = dir.path().join("hinf");
+    let (_, h_text, h) = synthesize_verdict(
+        &cfg,
+        &["--r-json", r_json.to_str().unwrap(), "--method", "hinf"],
+        &h_out,
+    );
+    let read = |d: &Path, f: &str| std::fs::read_to_string(d.join(f)).unwrap();
+
+    // Glover–McFarlane.
+    let g = &gm["glover_mcfarlane"];
+    assert_eq!(gm["method"], "glover_mcfarlane");
+    assert_eq!(gm["gamma"], g["gamma"]);
+    assert_eq!(gm["gamma_min"], g["gamma_min"]);
+    assert!(gm["gamma_opt"].is_null());
+    let toml = read(&gm_out, "controller.toml");
+    let head: Vec<&str> = toml.lines().take(2).collect();
+    assert!(head[0].contains("Glover–McFarlane"), "{toml}");
+    assert!(
+        head[1].contains(&format!("gamma = {:?}", g["gamma"].as_f64().unwrap()))
+            && head[1].contains(&format!(
+                "gamma_min = {:?}",
+                g["gamma_min"].as_f64().unwrap()
+            )),
+        "{toml}"
+    );
+    for f in ["controller.m", "controller.py", "controller.jl"] {
+        let t = read(&gm_out, f);
+        assert!(
+            t.lines()
+                .next()
+                .unwrap()
+                .contains("Glover–McFarlane controller"),
+            "{f}: {t}"
+        );
+    }
+    let svg = read(&gm_out, "stability.svg");
+    assert!(svg.contains("Glover–McFarlane controller: γ = ") && svg.contains("γ_min = "));
+    assert!(svg.contains("α* = ") && !svg.contains("H∞"), "GM figure");
+    assert!(
+        gm_text.contains("central controller at gamma = "),
+        "{gm_text}"
+    );
+
+    // H∞.
+    let hs = &h["hinf"]["synthesis"];
+    assert_eq!(h["method"], "hinf_weighted");
+    assert_eq!(h["gamma"], hs["gamma"]);
+    assert_eq!(h["gamma_opt"], hs["gamma_opt"]);
+    assert!(h["gamma_min"].is_null());
+    assert_ne!(h["gamma"], h["glover_mcfarlane"]["gamma"]);
+    let toml = read(&h_out, "controller.toml");
+    let head: Vec<&str> = toml.lines().take(2).collect();
+    assert!(
+        head[0].contains("H∞") && !head[0].contains("Glover"),
+        "{toml}"
+    );
+    assert!(
+        head[1].contains(&format!("gamma = {:?}", hs["gamma"].as_f64().unwrap()))
+            && head[1].contains(&format!(
+                "gamma_opt = {:?}",
+                hs["gamma_opt"].as_f64().unwrap()
+            ))
+            && !head[1].contains("gamma_min"),
+        "{toml}"
+    );
+    for f in ["controller.m", "controller.py", "controller.jl"] {
+        let t = read(&h_out, f);
+        let first = t.lines().next().unwrap();
+        assert!(
+            first.contains("H∞") && !first.contains("Glover"),
+            "{f}: {t}"
+        );
+    }
+    let svg = read(&h_out, "stability.svg");
+    assert!(svg.contains("H∞") && svg.contains("γ_opt = ") && svg.contains("α* = "));
+    assert!(
+        !svg.contains("Glover–McFarlane controller"),
+        "H∞ figure says GM"
+    );
+    // The text: GM is the reference only (no controller order under its name).
+    assert!(
+        h_text.contains("Glover–McFarlane (reference, not the controller)")
+            && !h_text.contains("central controller at gamma = 1."),
+        "{h_text}"
+    );
+    assert!(!h_text.contains("- rad/s"), "{h_text}");
+}
