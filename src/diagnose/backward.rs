@@ -50,10 +50,13 @@ pub fn eliminate(
         };
         dropped.push(node.effects[j].0.label());
         node.effects.remove(j);
+        // Steps and effects are parallel: remove this one's step, not every step of its label.
+        if j < node.steps.len() {
+            node.steps.remove(j);
+        }
         node.measures = Problem::new(&model, data)?.measures(&Default::default());
         node.model = model;
         node.v_fit = v;
-        node.steps.retain(|st| !dropped.contains(&st.effect));
     }
     Ok(dropped)
 }

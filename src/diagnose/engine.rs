@@ -150,6 +150,8 @@ pub fn diagnose_channels(
         super::backward::eliminate(base, &mut node, &res.nodes, data)
     })?;
     phases.time("final refit", || final_refit(&mut node, base, data))?;
+    // What the written model has and the input did not: the modes read by an assignment.
+    node.model = super::assign::align(base, &node.model, &node.effects);
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
     let ties = phases.time("ties", || {
@@ -201,6 +203,7 @@ pub fn diagnose_channels(
         eliminated,
         final_effects: final_effects(
             &node.model,
+            base,
             &node.effects.iter().map(|e| e.0).collect::<Vec<_>>(),
             data,
             true,
@@ -248,7 +251,13 @@ fn drop_failing_holdout(
     node.measures = measures(&model, data)?;
     node.v_fit = node.measures.v;
     node.model = model;
-    node.steps.retain(|st| !dropped.contains(&st.effect));
+    // Steps and effects are parallel (one effect per step): drop the failing ones by
+    // position, not by label (a dropped mode is not every mode).
+    let mut k = 0;
+    node.steps.retain(|_| {
+        k += 1;
+        !failing.contains(&(k - 1))
+    });
     node.effects = keep;
     Ok((holdout, dropped))
 }

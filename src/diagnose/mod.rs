@@ -27,6 +27,7 @@ pub(crate) mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
 pub(crate) mod agreement;
+pub(crate) mod assign;
 pub(crate) mod backward;
 pub(crate) mod candidates;
 pub(crate) mod changes;

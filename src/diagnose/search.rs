@@ -227,7 +227,7 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     let r = retune(base, data, None, true);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
     let v_fit = r.v_after;
-    let (model, measures) = settle(r.model, base, data)?;
+    let (model, measures) = settle(super::assign::align(base, &r.model, &[]), base, data)?;
     Ok([
         Node {
             effects: vec![],
@@ -351,12 +351,16 @@ pub fn search(
                     if d_bic > MIN_DELTA_BIC && improves(&m, &node.measures) && !at_edge {
                         let mut effects = node.effects.clone();
                         effects.push((sc.cand, sc.mods.theta.clone()));
+                        // The configured modes first, matched by frequency and shape, then
+                        // the added ones in the order chosen (never read by slot).
+                        let model = super::assign::align(&anchor, &model, &effects);
                         let mut steps = node.steps.clone();
                         steps.push(Step {
                             step: depth,
                             effect: sc.cand.label(),
                             params: final_effects(
                                 &model,
+                                &anchor,
                                 &effects.iter().map(|e| e.0).collect::<Vec<_>>(),
                                 data,
                                 false,
