@@ -89,6 +89,7 @@ fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
     let s = SearchSettings {
         max_effects: 1,
         beam: 3,
+        ..Default::default()
     };
     // Step 1 from the mass line: the 900 Hz mode (the largest peak).
     let d1 = diagnose_channels(&mass_line(), &data, &s).unwrap();
@@ -164,6 +165,7 @@ fn walk(data: &Channels, max_steps: usize) -> Vec<Diagnosis> {
         let s = SearchSettings {
             max_effects: 1,
             beam: 3,
+            ..Default::default()
         };
         let d = diagnose_channels(&m, data, &s).unwrap();
         let modes: Vec<String> = d
@@ -387,6 +389,7 @@ fn step_1_raises_the_invalid_fraction_only_against_the_configured_model() {
     let s = SearchSettings {
         max_effects: 1,
         beam: 3,
+        ..Default::default()
     };
     let d1 = diagnose_channels(&accelerance_mass_line(), &data, &s).unwrap();
     let m1 = &d1.final_model.mode[0];

@@ -26,6 +26,7 @@ pub(crate) mod compare;
 pub(crate) mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
+pub mod admissible;
 pub(crate) mod agreement;
 pub(crate) mod assign;
 pub(crate) mod backward;
@@ -75,7 +76,7 @@ pub use problem::Measures as ErrorMeasures;
 pub use rank::candidate_list;
 pub use report::{
     CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Peak, PeakFate,
-    PeakProbe, PhaseTime, Phases, Retuned, SearchStats, Step, Tie,
+    PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
 };
 pub use retune::cost;
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
