@@ -598,3 +598,7 @@ fn not_identified(c: &Child<'_>, data: &Channels) -> Option<String> {
     }
     None
 }
+
+#[cfg(test)]
+#[path = "admissible_tests.rs"]
+mod tests;
