@@ -89,7 +89,8 @@ impl Rule {
 pub struct Refusal {
     /// The effect (`mode`, `delay (input 2)`, …).
     pub effect: String,
-    /// Its frequency (Hz) when it is a mode.
+    /// Its frequency (Hz) when it is a mode (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub frequency_hz: Option<f64>,
     /// The rule.
     pub rule: Rule,

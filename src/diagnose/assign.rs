@@ -120,15 +120,24 @@ fn mode_cost(b: &ModeSpec, f: &ModeSpec, p: usize, n_in: usize) -> f64 {
 
 /// For every configured mode of `base`, the index of its mode in `m` (see the module docs);
 /// `None` when `m` has fewer modes than `base`.
-pub fn configured_modes(base: &PhysicalModel, m: &PhysicalModel) -> Option<Vec<usize>> {
-    if m.mode.len() < base.mode.len() {
+/// For every configured mode, the index of its mode in `m` (see the module docs), with the cost summed over several readings of the configured
+/// modes (`refs`, each with `base`'s modes in the same order: as configured, and where the
+/// retune put them): from a rough start a configured mode may lie nearer an added one than
+/// the mode it became, and the retune alone may have moved a configured slot onto a missing
+/// mode; the sum decides by both.
+pub fn configured_modes_from(refs: &[&PhysicalModel], m: &PhysicalModel) -> Option<Vec<usize>> {
+    let base = refs.first()?;
+    if m.mode.len() < base.mode.len() || refs.iter().any(|r| r.mode.len() != base.mode.len()) {
         return None;
     }
     let (p, n_in) = (m.n_outputs(), m.n_inputs());
-    let cost: Vec<Vec<f64>> = base
-        .mode
-        .iter()
-        .map(|b| m.mode.iter().map(|f| mode_cost(b, f, p, n_in)).collect())
+    let cost: Vec<Vec<f64>> = (0..base.mode.len())
+        .map(|b| {
+            m.mode
+                .iter()
+                .map(|f| refs.iter().map(|r| mode_cost(&r.mode[b], f, p, n_in)).sum())
+                .collect()
+        })
         .collect();
     Some(min_cost_assignment(&cost))
 }
@@ -143,7 +152,18 @@ pub fn align(
     m: &PhysicalModel,
     effects: &[(Cand, Vec<f64>)],
 ) -> PhysicalModel {
-    let Some(matched) = configured_modes(base, m) else {
+    align_from(&[base], m, effects)
+}
+
+/// As [`align`], the configured modes read in every model of `refs` (the first gives the
+/// names; see [`configured_modes_from`]).
+pub fn align_from(
+    refs: &[&PhysicalModel],
+    m: &PhysicalModel,
+    effects: &[(Cand, Vec<f64>)],
+) -> PhysicalModel {
+    let base = refs[0];
+    let Some(matched) = configured_modes_from(refs, m) else {
         return m.clone();
     };
     let mut unmatched: Vec<usize> = (0..m.mode.len()).filter(|j| !matched.contains(j)).collect();

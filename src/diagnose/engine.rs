@@ -153,7 +153,7 @@ pub fn diagnose_channels(
     })?;
     phases.time("final refit", || final_refit(&mut node, base, data))?;
     // What the written model has and the input did not: the modes read by an assignment.
-    node.model = super::assign::align(base, &node.model, &node.effects);
+    node.model = super::assign::align_from(&[base, &root_model], &node.model, &node.effects);
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
     let ties = phases.time("ties", || {

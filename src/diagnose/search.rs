@@ -376,7 +376,11 @@ pub fn search(
                     effects.push((sc.cand, sc.mods.theta.clone()));
                     // The configured modes first, matched by frequency and shape, then the
                     // added ones in the order chosen (never read by slot).
-                    let model = super::assign::align(&anchor, &model, &effects);
+                    // Matched against the retuned root (the configured modes where the retune
+                    // put them): from a rough start a configured mode may lie nearer the
+                    // added one than where it belongs.
+                    let model =
+                        super::assign::align_from(&[&anchor, &nodes[1].model], &model, &effects);
                     let likely =
                         d_bic > s.min_delta_bic && improves(&m, &node.measures) && !at_edge;
                     // Physical admissibility of the joint refit, against the node (or, for
