@@ -118,9 +118,8 @@ fn mode_cost(b: &ModeSpec, f: &ModeSpec, p: usize, n_in: usize) -> f64 {
         + SHAPE_WEIGHT * (1.0 - mac(&shape(b, p, n_in), &shape(f, p, n_in)))
 }
 
-/// For every configured mode of `base`, the index of its mode in `m` (see the module docs);
-/// `None` when `m` has fewer modes than `base`.
-/// For every configured mode, the index of its mode in `m` (see the module docs), with the cost summed over several readings of the configured
+/// For every configured mode, the index of its mode in `m` (see the module docs; `None` when
+/// `m` has fewer modes), with the cost summed over several readings of the configured
 /// modes (`refs`, each with `base`'s modes in the same order: as configured, and where the
 /// retune put them): from a rough start a configured mode may lie nearer an added one than
 /// the mode it became, and the retune alone may have moved a configured slot onto a missing
