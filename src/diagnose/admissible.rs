@@ -17,7 +17,7 @@
 //!   exceeds the data's largest magnitude 10× (it fits only by cancelling another term);
 //! * **negligible** — a delay whose phase `ω_max τ` at the band top (a lag's, an NMP zero's,
 //!   a hold's phase there) is below the noise's phase resolution there (`asin(r/|G|)`,
-//!   median over the top lines), a friction pole whose
+//!   median over the top n lines (5 % of them, at most 20), divided by √n), a friction pole whose
 //!   relative effect at the band bottom `p/ω_min` is below the noise's relative resolution
 //!   there (`r/|G|`), or any effect whose removal changes `misfit_rms` by less than 1 %
 //!   (unless it is what makes the model consistent), whatever its ΔBIC;
@@ -400,9 +400,11 @@ fn term_over_data(c: &Child<'_>, data: &Channels) -> Option<String> {
 fn negligible(c: &Child<'_>, data: &Channels) -> Option<String> {
     let om = &data.omega;
     let (w_lo, w_hi) = (om[0], *om.last()?);
-    // The noise's relative resolution `r/|G|` over the `n` lines at one end of the band.
+    // The noise's relative resolution `r/|G|` over the `n` lines at one end of the band, as
+    // resolved by all `n` together (÷√n: an effect acts coherently on every line there).
     let rel = |top: bool| -> f64 {
         let n = (om.len() / 20).clamp(1, 20);
+        let coherent = (n as f64).sqrt();
         let idx: Vec<usize> = if top {
             (om.len() - n..om.len()).collect()
         } else {
@@ -415,7 +417,7 @@ fn negligible(c: &Child<'_>, data: &Channels) -> Option<String> {
                         .map(move |ch| (data.radius[ch][i] / data.g[ch][i].norm()).min(1.0))
                 })
                 .collect(),
-        )
+        ) / coherent
     };
     match c.cand {
         Cand::Delay(_) => {
