@@ -559,7 +559,7 @@ fn not_identified(c: &Child<'_>, data: &Channels) -> Option<String> {
             Nl::Delay(i) => sigma[nlin + j] / m.effect[*i].tau_s.unwrap_or(0.0).abs(),
             _ => sigma[nlin + j],
         };
-        if !(rel <= MAX_REL_SIGMA) {
+        if rel.is_nan() || rel > MAX_REL_SIGMA {
             return Some(format!(
                 "{} has a relative σ of {} (> 1/3): the data do not determine it",
                 slot_name(m, s),
