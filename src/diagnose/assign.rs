@@ -141,6 +141,47 @@ pub fn configured_modes_from(refs: &[&PhysicalModel], m: &PhysicalModel) -> Opti
     Some(min_cost_assignment(&cost))
 }
 
+/// The configured modes and the added ones read in `m` by one assignment, when `m` has
+/// exactly one mode for each (`None` otherwise): rows are the configured modes (cost summed
+/// over the readings of `refs`, as in [`configured_modes_from`]) and the added modes (cost
+/// `|ln(ω_f/ω_added)|` to the frequency each was fitted at, weighted like one reading per
+/// ref). Assigning both at once keeps a configured mode from taking the peak an added mode
+/// was fitted to when the configured mode itself moved far in the joint refit (a shifted
+/// mode plus a new one: read configured-first, the shifted mode took the new peak and the
+/// new mode was reported where the shifted one went).
+fn joint_assignment(
+    refs: &[&PhysicalModel],
+    m: &PhysicalModel,
+    added_w: &[f64],
+) -> Option<(Vec<usize>, Vec<usize>)> {
+    let base = refs.first()?;
+    let n_conf = base.mode.len();
+    if added_w.is_empty()
+        || n_conf + added_w.len() != m.mode.len()
+        || refs.iter().any(|r| r.mode.len() != n_conf)
+    {
+        return None;
+    }
+    let (p, n_in) = (m.n_outputs(), m.n_inputs());
+    let weight = refs.len() as f64;
+    let cost: Vec<Vec<f64>> = (0..n_conf)
+        .map(|b| {
+            m.mode
+                .iter()
+                .map(|f| refs.iter().map(|r| mode_cost(&r.mode[b], f, p, n_in)).sum())
+                .collect()
+        })
+        .chain(added_w.iter().map(|w| {
+            m.mode
+                .iter()
+                .map(|f| weight * (f.omega_n / w).ln().abs())
+                .collect()
+        }))
+        .collect();
+    let a = min_cost_assignment(&cost);
+    Some((a[..n_conf].to_vec(), a[n_conf..].to_vec()))
+}
+
 /// `m` with its modes reordered (see the module docs): the modes matched to `base`'s first,
 /// in `base`'s order and with its names; then the added ones in the order of the `Mode`
 /// effects of `effects` (matched by the frequency each was fitted at when added, `θ[0] =
@@ -162,28 +203,21 @@ pub fn align_from(
     effects: &[(Cand, Vec<f64>)],
 ) -> PhysicalModel {
     let base = refs[0];
-    let Some(matched) = configured_modes_from(refs, m) else {
-        return m.clone();
-    };
-    let mut unmatched: Vec<usize> = (0..m.mode.len()).filter(|j| !matched.contains(j)).collect();
     let added_w: Vec<f64> = effects
         .iter()
         .filter(|(c, th)| *c == Cand::Mode && !th.is_empty())
         .map(|(_, th)| th[0].exp())
         .collect();
-    if added_w.len() == unmatched.len() && !unmatched.is_empty() {
-        let cost: Vec<Vec<f64>> = added_w
-            .iter()
-            .map(|w| {
-                unmatched
-                    .iter()
-                    .map(|&j| (m.mode[j].omega_n / w).ln().abs())
-                    .collect()
-            })
-            .collect();
-        let order = min_cost_assignment(&cost);
-        unmatched = order.iter().map(|&k| unmatched[k]).collect();
-    }
+    let (matched, unmatched) = match joint_assignment(refs, m, &added_w) {
+        Some(a) => a,
+        None => {
+            let Some(matched) = configured_modes_from(refs, m) else {
+                return m.clone();
+            };
+            let unmatched = (0..m.mode.len()).filter(|j| !matched.contains(j)).collect();
+            (matched, unmatched)
+        }
+    };
     let mut out = m.clone();
     out.mode = matched
         .iter()
