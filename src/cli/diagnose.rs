@@ -43,6 +43,10 @@ pub struct DiagnoseArgs {
     /// Diagnose only the lines with FMIN ≤ f ≤ FMAX (Hz), e.g. `--band 20:1200`.
     #[arg(long, value_parser = parse_band, value_name = "FMIN:FMAX", allow_hyphen_values = true)]
     pub band: Option<(f64, f64)>,
+    /// Write modes at 50/60 Hz or a harmonic (refused by default as probable electrical
+    /// interference).
+    #[arg(long)]
+    pub allow_mains: bool,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -145,6 +149,8 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     let settings = SearchSettings {
         max_effects: a.max_effects.max(1),
         beam: a.beam.max(1),
+        allow_mains: a.allow_mains,
+        ..Default::default()
     };
     let d = diagnose_channels(&base, &data, &settings)?;
     if let (Some(what), Some(out)) = (a.apply, &a.write) {
@@ -202,6 +208,7 @@ fn print_text(config: &crate::model::Config, data: &Channels, d: &Diagnosis, hin
         );
     }
     print_dropped(d);
+    print_refused(d);
     print_alternatives(d);
     print_peaks(d);
     let given_up = match d.search.refits_given_up {
@@ -353,6 +360,29 @@ fn print_dropped(d: &Diagnosis) {
     }
     if !d.dropped.is_empty() {
         println!("dropped by the holdout: {}", d.dropped.join(", "));
+    }
+}
+
+/// The effects the likelihood wanted but physical admissibility refused, with the rule and
+/// the reason.
+fn print_refused(d: &Diagnosis) {
+    if d.refused.is_empty() {
+        return;
+    }
+    println!("refused on their joint refit (ΔBIC passed, not physical):");
+    for r in &d.refused {
+        let at = r
+            .refusal
+            .frequency_hz
+            .map(|f| format!(" {} Hz", sig(f)))
+            .unwrap_or_default();
+        println!(
+            "  step {}: {}{at}: {}: {}",
+            r.step,
+            r.refusal.effect,
+            r.refusal.rule.word(),
+            r.refusal.reason
+        );
     }
 }
 

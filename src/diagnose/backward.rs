@@ -1,6 +1,6 @@
 //! Backward elimination after the forward search: an effect of the chosen set that the data
 //! do not need — removing it (and refitting the rest jointly) costs no more than the
-//! acceptance threshold, `ΔBIC = 2(V_without − V) − n_e·ln(2F) ≤ 10` — is dropped, the
+//! acceptance threshold, `ΔBIC = 2(V_without − V) − n_e·ln(2F) ≤ min_delta_bic` (10) — is dropped, the
 //! weakest first, until every remaining effect is needed.  This removes vacuous effects the
 //! forward search kept, such as a lag whose corner refit far above the band (it contributes
 //! nothing there once other effects were added).
@@ -8,7 +8,6 @@
 use super::channels::Channels;
 use super::holdout::{model_of, without};
 use super::problem::Problem;
-use super::rank::MIN_DELTA_BIC;
 use super::retune::retune_within;
 use super::search::Node;
 use crate::error::Result;
@@ -23,6 +22,7 @@ pub fn eliminate(
     node: &mut Node,
     nodes: &[Node],
     data: &Channels,
+    min_delta_bic: f64,
 ) -> Result<Vec<String>> {
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut dropped = Vec::new();
@@ -41,7 +41,7 @@ pub fn eliminate(
         for (j, r) in refits.into_iter().enumerate() {
             let n_e = node.effects[j].0.n_params(data.n_ch());
             let d_bic = 2.0 * (r.v_after - node.v_fit) - n_e as f64 * ln2f;
-            if d_bic <= MIN_DELTA_BIC && worst.as_ref().is_none_or(|w| d_bic < w.1) {
+            if d_bic <= min_delta_bic && worst.as_ref().is_none_or(|w| d_bic < w.1) {
                 worst = Some((j, d_bic, r.model, r.v_after));
             }
         }
@@ -50,10 +50,13 @@ pub fn eliminate(
         };
         dropped.push(node.effects[j].0.label());
         node.effects.remove(j);
+        // Steps and effects are parallel: remove this one's step, not every step of its label.
+        if j < node.steps.len() {
+            node.steps.remove(j);
+        }
         node.measures = Problem::new(&model, data)?.measures(&Default::default());
         node.model = model;
         node.v_fit = v;
-        node.steps.retain(|st| !dropped.contains(&st.effect));
     }
     Ok(dropped)
 }

@@ -261,12 +261,24 @@ fn residual(m: &PhysicalModel, data: &Channels, out: &mut Vec<f64>) {
 /// `cov = (2JᵀJ)⁻¹`, by an SVD of the column-scaled Jacobian; a coordinate with a
 /// noticeable share in a direction the data do not determine gets `∞`.
 pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
+    slot_covariance(m, lin, nl, data).0
+}
+
+/// Standard deviations of every slot coordinate (as [`slot_sigmas`]) and, when the Jacobian
+/// has full rank, the correlation matrix of the slots (`lin` then `nl`) from the same
+/// covariance `(2JᵀJ)⁻¹`.
+pub(super) fn slot_covariance(
+    m: &PhysicalModel,
+    lin: &[Lin],
+    nl: &[Nl],
+    data: &Channels,
+) -> (Vec<f64>, Option<DMatrix<f64>>) {
     let n = lin.len() + nl.len();
     let mut r0 = Vec::new();
     residual(m, data, &mut r0);
     let rows = r0.len();
     if n == 0 || rows == 0 {
-        return vec![f64::INFINITY; n];
+        return (vec![f64::INFINITY; n], None);
     }
     let w_max = data.omega.last().copied().unwrap_or(1.0);
     let mut jac = DMatrix::<f64>::zeros(rows, n);
@@ -297,7 +309,7 @@ pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Chan
     }
     let scale: Vec<f64> = (0..n).map(|j| jac.column(j).norm()).collect();
     if scale.iter().any(|s| !s.is_finite()) {
-        return vec![f64::INFINITY; n];
+        return (vec![f64::INFINITY; n], None);
     }
     for (j, s) in scale.iter().enumerate() {
         if *s > 0.0 {
@@ -306,7 +318,7 @@ pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Chan
     }
     let svd = jac.svd(false, true);
     let Some(vt) = svd.v_t else {
-        return vec![f64::INFINITY; n];
+        return (vec![f64::INFINITY; n], None);
     };
     let smax = svd.singular_values.max();
     let mut var = vec![0.0; n];
@@ -322,7 +334,7 @@ pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Chan
             *v += (vt[(k, j)] / sk).powi(2);
         }
     }
-    (0..n)
+    let sigma = (0..n)
         .map(|j| {
             if undetermined[j] || scale[j] == 0.0 {
                 f64::INFINITY
@@ -330,7 +342,21 @@ pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Chan
                 (var[j] / 2.0).sqrt() / scale[j]
             }
         })
-        .collect()
+        .collect();
+    // Correlations in the scaled coordinates (the scale cancels): V Σ⁻² Vᵀ normalized.
+    let full_rank = svd.singular_values.iter().all(|sk| *sk > 1e-10 * smax);
+    let corr = full_rank.then(|| {
+        let k = svd.singular_values.len();
+        let mut w = vt.transpose();
+        for c in 0..k {
+            let sk = svd.singular_values[c];
+            w.column_mut(c).scale_mut(1.0 / sk);
+        }
+        let cov = &w * w.transpose();
+        let d: Vec<f64> = (0..n).map(|j| cov[(j, j)].max(1e-300).sqrt()).collect();
+        DMatrix::from_fn(n, n, |a, b| cov[(a, b)] / (d[a] * d[b]))
+    });
+    (sigma, corr)
 }
 
 /// The configured parameters of `base` that the refit model `refit` (configured terms first,

@@ -100,6 +100,7 @@ pub fn diagnose_channels(
             eliminated: vec![],
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
+            refused: vec![],
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
@@ -130,6 +131,7 @@ pub fn diagnose_channels(
         model: &root_model,
         retuned,
         v_ret,
+        min_delta_bic: s.min_delta_bic,
     };
     let mut candidates = phases.time("first level", || ranked_candidates(&root, &res, data))?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
@@ -147,9 +149,11 @@ pub fn diagnose_channels(
     // Runner-ups and ties are then relative to the set kept.
     res.chosen = replaced_by.unwrap_or(res.chosen);
     let eliminated = phases.time("backward elimination", || {
-        super::backward::eliminate(base, &mut node, &res.nodes, data)
+        super::backward::eliminate(base, &mut node, &res.nodes, data, s.min_delta_bic)
     })?;
     phases.time("final refit", || final_refit(&mut node, base, data))?;
+    // What the written model has and the input did not: the modes read by an assignment.
+    node.model = super::assign::align_from(&[base, &root_model], &node.model, &node.effects);
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
     let ties = phases.time("ties", || {
@@ -178,8 +182,11 @@ pub fn diagnose_channels(
     } else {
         DiagnoseVerdict::NoEffectFound
     };
-    let message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
+    let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
         + &unreached_modes(&peaks);
+    if verdict == DiagnoseVerdict::NoEffectFound {
+        message += &stop_explanation(&res.refused, after.v, n as f64 - node.n_params as f64 / 2.0);
+    }
     Ok(Diagnosis {
         verdict,
         message,
@@ -201,11 +208,20 @@ pub fn diagnose_channels(
         eliminated,
         final_effects: final_effects(
             &node.model,
+            base,
             &node.effects.iter().map(|e| e.0).collect::<Vec<_>>(),
             data,
             true,
         ),
         retuned_in_chosen: changes(base, &node.model, data),
+        refused: res
+            .refused
+            .iter()
+            .map(|(step, r)| super::report::RefusedEffect {
+                step: *step,
+                refusal: r.clone(),
+            })
+            .collect(),
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
@@ -248,7 +264,13 @@ fn drop_failing_holdout(
     node.measures = measures(&model, data)?;
     node.v_fit = node.measures.v;
     node.model = model;
-    node.steps.retain(|st| !dropped.contains(&st.effect));
+    // Steps and effects are parallel (one effect per step): drop the failing ones by
+    // position, not by label (a dropped mode is not every mode).
+    let mut k = 0;
+    node.steps.retain(|_| {
+        k += 1;
+        !failing.contains(&(k - 1))
+    });
     node.effects = keep;
     Ok((holdout, dropped))
 }
@@ -313,6 +335,43 @@ fn unreached_modes(peaks: &[super::report::Peak]) -> String {
         "; one mode fitted at a peak of the residual would pass the screen at {} Hz, where the search proposed none (see the peaks)",
         f.iter().map(|x| sig(*x)).collect::<Vec<_>>().join(", ")
     )
+}
+
+/// Why nothing was added, for a stop: the effects the likelihood wanted but admissibility
+/// refused (with their rules), and the size of the remaining misfit against the stated
+/// noise (`V / E V`; above 1 either dynamics are missing or the data's own scatter exceeds
+/// the stated σ, and `std_factor × √(V/E V)` is the radius that would cover it).
+fn stop_explanation(refused: &[(usize, super::admissible::Refusal)], v: f64, ev: f64) -> String {
+    let mut out = String::new();
+    if !refused.is_empty() {
+        let names: Vec<String> = refused
+            .iter()
+            .map(|(_, r)| match r.frequency_hz {
+                Some(f) => format!("{} {} Hz ({})", r.effect, sig(f), r.rule.word()),
+                None => format!("{} ({})", r.effect, r.rule.word()),
+            })
+            .collect();
+        out += &format!(
+            "; passed ΔBIC but refused as not physical: {}",
+            names.join(", ")
+        );
+    }
+    if ev > 0.0 && v.is_finite() {
+        let ratio = v / ev;
+        if ratio > 1.5 {
+            out += &format!(
+                "; the residual is {}× the stated noise (V/E[V]): if no dynamics are missing, the data scatter more than the stated σ and std_factor × {} would cover it",
+                sig(ratio),
+                sig(ratio.sqrt())
+            );
+        } else {
+            out += &format!(
+                "; the residual is at the stated noise (V/E[V] = {}): nothing more to find",
+                sig(ratio)
+            );
+        }
+    }
+    out
 }
 
 /// The one-paragraph summary of a verdict, from the measures of the configured, the retuned

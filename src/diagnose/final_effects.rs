@@ -2,8 +2,11 @@
 //! effect, in the order added, with its refit parameters and their standard deviations
 //! (`cov = (2JᵀJ)⁻¹` over every refit parameter, [`super::changes`]).
 //!
-//! Each added term or path effect carries the note `added by rshape diagnose: LABEL`; the
-//! k-th chosen effect with a label is the k-th term with that note.  Effects that change a
+//! Added terms and path effects follow the configured ones in every list (the modes put there
+//! by [`super::assign::align`], matched to the configured modes by frequency and shape, never
+//! by slot); the k-th chosen effect with a label is the k-th **added** term with that note.  A
+//! term the input already had is never reported as added, whatever its note says (a revision
+//! written by `diagnose` keeps the notes of its earlier steps).  Effects that change a
 //! configured term (mode shift, damping, friction) are read from that term; a feedthrough
 //! from `D`.  A gain or sign effect has no refit parameter of its own (a gain error is
 //! absorbed in the residues), so no σ.  MIMO residues `ρ_oi = c_o b_i / m` get the σ of
@@ -44,9 +47,11 @@ fn note_is(note: &Option<String>, label: &str) -> bool {
 }
 
 /// The chosen `effects` (in the order added) with their parameters in the final model `m`
-/// (SI, rad/s), and with `with_sigma` their standard deviations on `data`.
+/// (SI, rad/s), and with `with_sigma` their standard deviations on `data`; `base` is the
+/// configured model (its terms and effects are not the added ones).
 pub fn final_effects(
     m: &PhysicalModel,
+    base: &PhysicalModel,
     effects: &[Cand],
     data: &Channels,
     with_sigma: bool,
@@ -105,6 +110,7 @@ pub fn final_effects(
                     .mode
                     .iter()
                     .enumerate()
+                    .skip(base.mode.len())
                     .filter(|(_, x)| note_is(&x.name, &label));
                 if let Some((i, _)) = idx.clone().nth(nth) {
                     mode_params(i, &mut put);
@@ -127,14 +133,15 @@ pub fn final_effects(
                 }
             }
             Cand::Integrator(order) => {
-                let (list, term): (&[_], fn(usize) -> Term) = if *order == 2 {
-                    (&m.rigid_body, Term::Rigid)
+                let (list, term, n_base): (&[_], fn(usize) -> Term, _) = if *order == 2 {
+                    (&m.rigid_body, Term::Rigid, base.rigid_body.len())
                 } else {
-                    (&m.integrator, Term::Int)
+                    (&m.integrator, Term::Int, base.integrator.len())
                 };
                 let found = list
                     .iter()
                     .enumerate()
+                    .skip(n_base)
                     .filter(|(_, r)| note_is(&r.name, &label))
                     .nth(nth);
                 if let Some((i, _)) = found {
@@ -170,6 +177,7 @@ pub fn final_effects(
                     .effect
                     .iter()
                     .enumerate()
+                    .skip(base.effect.len())
                     .filter(|(_, e)| note_is(&e.note, &label))
                     .nth(nth);
                 if let Some((i, e)) = found {

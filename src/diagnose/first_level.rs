@@ -6,7 +6,7 @@ use super::candidates::{explain, sig};
 use super::channels::Channels;
 use super::compare::{bands, Band};
 use super::problem::{Measures, Problem};
-use super::rank::{improves, prior, si_map, MIN_DELTA_BIC, TIE_BIC};
+use super::rank::{improves, prior, si_map, TIE_BIC};
 use super::report::CandidateReport;
 use super::search::{add_effect, SearchResult};
 use crate::error::Result;
@@ -26,6 +26,8 @@ pub(super) struct Root<'a> {
     pub retuned: Measures,
     /// The retune's least-squares cost (the BIC's; the polish may raise `retuned.v`).
     pub v_ret: f64,
+    /// The ΔBIC a candidate must exceed.
+    pub min_delta_bic: f64,
 }
 
 /// The ranked first-level candidates: usable fits by ΔBIC (near-ties by fewer parameters,
@@ -37,6 +39,7 @@ pub(super) fn ranked_candidates(
 ) -> Result<Vec<CandidateReport>> {
     let (base, before, root_model, retuned, v_ret) =
         (root.base, root.before, root.model, root.retuned, root.v_ret);
+    let min_delta_bic = root.min_delta_bic;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let (_, flags0) = Problem::new(base, data)?.invalid_flags(&Default::default());
     let explained = |m: &PhysicalModel| -> Vec<Band> {
@@ -62,10 +65,11 @@ pub(super) fn ranked_candidates(
     delta_bic_vs_retune: 0.0,
     n_params: 0,
     joint_refit: true,
-    passes: 2.0 * (before.v - v_ret) > MIN_DELTA_BIC,
+    passes: 2.0 * (before.v - v_ret) > min_delta_bic,
     tie_with_best: false,
     flags: vec![],
     no_fit: None,
+    min_delta_bic,
     explanation: format!(
         "refit of the configured model's own parameters (residues and gains over four decades, every ω_n, ζ, pole and delay; modes placed by a grid from a rough start): misfit_rms {} → {}",
         sig(before.misfit_rms),
@@ -75,7 +79,7 @@ pub(super) fn ranked_candidates(
     cand: None,
     model: root_model.clone(),
 }];
-    for (sc, child) in &res.first_level {
+    for (sc, child, refusal) in &res.first_level {
         let nn = sc.cand.n_params(data.n_ch());
         let th = &sc.mods.theta;
         let (model, m, v, joint) = match child {
@@ -123,11 +127,23 @@ pub(super) fn ranked_candidates(
             joint_refit: joint,
             passes: sc.no_fit.is_none()
                 && sc.flags.is_empty()
-                && d_root > MIN_DELTA_BIC
+                && refusal.is_none()
+                && d_root > min_delta_bic
                 && improves(&m, &retuned),
             tie_with_best: false,
-            flags: sc.flags.clone(),
+            // A refusal of the joint refit (physical admissibility) is named like a flag.
+            flags: sc
+                .flags
+                .iter()
+                .cloned()
+                .chain(
+                    refusal
+                        .iter()
+                        .map(|r| format!("{}: {}", r.rule.word(), r.reason)),
+                )
+                .collect(),
             no_fit: sc.no_fit.clone(),
+            min_delta_bic,
             explanation: match &sc.no_fit {
                 Some(why) => format!("no fit: {why}"),
                 None => explain(&sc.cand, th, &data.entries, root_model, &data.omega),

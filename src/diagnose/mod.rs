@@ -26,7 +26,9 @@ pub(crate) mod compare;
 pub(crate) mod figures;
 
 pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
+pub mod admissible;
 pub(crate) mod agreement;
+pub(crate) mod assign;
 pub(crate) mod backward;
 pub(crate) mod candidates;
 pub(crate) mod changes;
@@ -74,7 +76,7 @@ pub use problem::Measures as ErrorMeasures;
 pub use rank::candidate_list;
 pub use report::{
     CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Peak, PeakFate,
-    PeakProbe, PhaseTime, Phases, Retuned, SearchStats, Step, Tie,
+    PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
 };
 pub use retune::cost;
 pub use retune::{refit_nominal, retune, retune_within, NominalRefit};

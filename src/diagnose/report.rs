@@ -62,6 +62,9 @@ pub struct CandidateReport {
     /// The candidate (`None` for the retune).
     #[serde(skip)]
     pub cand: Option<Cand>,
+    /// The ΔBIC it had to exceed (the search settings').
+    #[serde(skip)]
+    pub min_delta_bic: f64,
     /// The revised model (candidate added, jointly refit when `joint_refit`).
     #[serde(skip)]
     pub model: PhysicalModel,
@@ -82,14 +85,12 @@ impl CandidateReport {
         } else if self.cand.is_none() {
             format!(
                 "the refit lowers the cost too little (ΔBIC {:.3} ≤ {})",
-                self.delta_bic,
-                super::rank::MIN_DELTA_BIC
+                self.delta_bic, self.min_delta_bic
             )
-        } else if self.delta_bic_vs_retune <= super::rank::MIN_DELTA_BIC {
+        } else if self.delta_bic_vs_retune <= self.min_delta_bic {
             format!(
                 "ΔBIC {:.3} against the retune alone (needs > {})",
-                self.delta_bic_vs_retune,
-                super::rank::MIN_DELTA_BIC
+                self.delta_bic_vs_retune, self.min_delta_bic
             )
         } else {
             format!(
@@ -98,6 +99,16 @@ impl CandidateReport {
             )
         })
     }
+}
+
+/// An effect refused by physical admissibility, at the search level (`step`) it was met.
+#[derive(Debug, Clone, Serialize)]
+pub struct RefusedEffect {
+    /// Search level (1 = on the configured or retuned model).
+    pub step: usize,
+    /// The refusal.
+    #[serde(flatten)]
+    pub refusal: super::admissible::Refusal,
 }
 
 /// A tie between two effects or two effect sets.
@@ -398,6 +409,9 @@ pub struct Diagnosis {
     pub final_effects: Vec<FinalEffect>,
     /// The configured parameters the final joint refit (of the chosen set) moved.
     pub retuned_in_chosen: Changes,
+    /// Effects the likelihood wanted but physical admissibility refused (on their joint
+    /// refit), each with its rule and reason ([`super::admissible`]).
+    pub refused: Vec<RefusedEffect>,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
     /// Every peak of the residual that stands out of the noise, with its fate (at most

@@ -66,7 +66,7 @@ pub fn write_revision(r: &Revise<'_>, out: &Path) -> Result<Revision> {
         force,
     } = *r;
     // What is written: the label, its parameters, the explanation and the error before.
-    let (revised, label, params, explanation, flag) = match what {
+    let (revised, label, params, explanation, flag, moved) = match what {
         Apply::Rank(k) => {
             // The candidate (already refit jointly when the search got to it), refit once more.
             let applied = apply_candidate(base, d, k, force)?;
@@ -77,6 +77,7 @@ pub fn write_revision(r: &Revise<'_>, out: &Path) -> Result<Revision> {
                 params_text(&c.params),
                 c.explanation.clone(),
                 format!("{k}{}", if force { " --force" } else { "" }),
+                None,
             )
         }
         Apply::Chosen => {
@@ -86,17 +87,29 @@ pub fn write_revision(r: &Revise<'_>, out: &Path) -> Result<Revision> {
             } else {
                 d.chosen.join(" + ")
             };
+            // Only the added effects go in the parenthesis (what `history` labels the
+            // revision by); the configured parameters the joint refit moved get their own
+            // line, matched to their originals by frequency and shape.
             let params = d
                 .final_effects
                 .iter()
                 .map(|e| format!("{}: {}", e.effect, params_text(&e.params)))
-                .chain(
-                    (!d.retuned_in_chosen.changes.is_empty())
-                        .then(|| format!("retuned: {}", d.retuned_in_chosen.summary())),
-                )
                 .collect::<Vec<_>>()
                 .join("; ");
-            (m, label, params, d.message.clone(), "chosen".to_string())
+            let moved = (!d.retuned_in_chosen.changes.is_empty()).then(|| {
+                format!(
+                    "# Moved by the joint refit (configured parameters): {}\n",
+                    d.retuned_in_chosen.summary().replace('\n', " ")
+                )
+            });
+            (
+                m,
+                label,
+                params,
+                d.message.clone(),
+                "chosen".to_string(),
+                moved,
+            )
         }
     };
     let (rms_refit, inv_refit) = misfit_channels(&revised, data);
@@ -149,7 +162,7 @@ pub fn write_revision(r: &Revise<'_>, out: &Path) -> Result<Revision> {
         fmt_pct(d.before.invalid_fraction),
         fmt_pct(inv_refit),
     );
-    let full = format!("{header}{text}");
+    let full = format!("{header}{}{text}", moved.unwrap_or_default());
     // The written file must load back.
     crate::model::Config::parse(&full, out)
         .map_err(|e| Error::Invalid(format!("internal: the revised config does not parse: {e}")))?;

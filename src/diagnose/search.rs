@@ -23,6 +23,7 @@
 //!   moved inside its own 95 % confidence region towards the disks.  The BIC stays that of
 //!   the least-squares fit.
 
+use super::admissible::{check, Child, Refusal};
 use super::candidates::Cand;
 use super::channels::Channels;
 use super::final_effects::final_effects;
@@ -103,7 +104,7 @@ fn expand(
         .iter()
         .map(|sc| {
             let promising =
-                sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > MIN_DELTA_BIC;
+                sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > s.min_delta_bic;
             let go = promising && tried <= s.beam;
             tried += usize::from(go);
             go
@@ -138,6 +139,11 @@ pub struct SearchSettings {
     pub max_effects: usize,
     /// Nodes kept per level.
     pub beam: usize,
+    /// ΔBIC an effect must exceed to be added (`2(V_ref − V) − n ln(2F)`; default
+    /// [`MIN_DELTA_BIC`] = 10, "very strong" evidence on Kass & Raftery's scale).
+    pub min_delta_bic: f64,
+    /// Write modes at mains frequencies ([`super::admissible`]); refused by default.
+    pub allow_mains: bool,
 }
 
 impl SearchSettings {
@@ -146,6 +152,7 @@ impl SearchSettings {
         crate::settings::Checker::new("SearchSettings")
             .at_least("max_effects", self.max_effects, 1, "must be at least 1")
             .at_least("beam", self.beam, 1, "must be at least 1")
+            .non_negative("min_delta_bic", self.min_delta_bic)
             .finish()
     }
 }
@@ -155,6 +162,8 @@ impl Default for SearchSettings {
         Self {
             max_effects: 3,
             beam: 3,
+            min_delta_bic: MIN_DELTA_BIC,
+            allow_mains: false,
         }
     }
 }
@@ -195,7 +204,10 @@ pub struct SearchResult {
     /// Index of the chosen node.
     pub chosen: usize,
     /// The root's screened candidates (first level) and the children made of them.
-    pub first_level: Vec<(Screened, Option<Node>)>,
+    pub first_level: Vec<(Screened, Option<Node>, Option<Refusal>)>,
+    /// Effects whose joint refit passed the likelihood but not physical admissibility
+    /// ([`super::admissible`]), one per (effect, rule, frequency), in the order met.
+    pub refused: Vec<(usize, Refusal)>,
     /// Nodes expanded.
     pub expanded: usize,
     /// Joint refits.
@@ -207,8 +219,18 @@ pub struct SearchResult {
 }
 
 /// Writes effect `c` with parameters `th` into `m`.
+/// An effect on a term `m` lacks (friction on a rigid body that an effect left out of a
+/// holdout or elimination set had added) is not written: it has nothing to act on.
 pub fn add_effect(m: &PhysicalModel, c: &Cand, th: &[f64], data: &Channels) -> PhysicalModel {
     let mut next = m.clone();
+    let missing = match c {
+        Cand::Friction(i) => *i >= m.rigid_body.len(),
+        Cand::ModeShift(i) | Cand::Damping(i) => *i >= m.mode.len(),
+        _ => false,
+    };
+    if missing {
+        return next;
+    }
     c.apply_to(
         th,
         &data.entries,
@@ -227,7 +249,7 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     let r = retune(base, data, None, true);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
     let v_fit = r.v_after;
-    let (model, measures) = settle(r.model, base, data)?;
+    let (model, measures) = settle(super::assign::align(base, &r.model, &[]), base, data)?;
     Ok([
         Node {
             effects: vec![],
@@ -268,6 +290,7 @@ pub fn search(
     let anchor = roots[0].model.clone();
     let mut nodes = roots;
     let mut first_level = Vec::new();
+    let mut refused: Vec<(usize, Refusal)> = Vec::new();
     let (mut expanded, mut joint_refits, mut gave_up) = (0, 0, 0);
     let mut phases = Phases::default();
     for depth in 1..=s.max_effects {
@@ -332,12 +355,13 @@ pub fn search(
             let ref_v = e.ref_v;
             for (sc, go) in e.screened.iter().zip(&e.refit) {
                 let mut child_node = None;
+                let mut first_refusal = None;
                 if let Some(refit) = go.then(|| done.next()).flatten() {
                     joint_refits += 1;
                     let Some((model, m, v_fit, n_refit)) = refit? else {
                         gave_up += 1;
                         if depth == 1 && ni == 0 {
-                            first_level.push((sc.clone(), None));
+                            first_level.push((sc.clone(), None, None));
                         }
                         continue;
                     };
@@ -348,15 +372,60 @@ pub fn search(
                     let (w_lo, w_hi) = (data.omega[0], *data.omega.last().expect("data"));
                     let at_edge = modes_at_band_edge(&model, w_lo, w_hi)
                         > modes_at_band_edge(&node.model, w_lo, w_hi);
-                    if d_bic > MIN_DELTA_BIC && improves(&m, &node.measures) && !at_edge {
-                        let mut effects = node.effects.clone();
-                        effects.push((sc.cand, sc.mods.theta.clone()));
+                    let mut effects = node.effects.clone();
+                    effects.push((sc.cand, sc.mods.theta.clone()));
+                    // The configured modes first, matched by frequency and shape, then the
+                    // added ones in the order chosen (never read by slot).
+                    // Matched against the retuned root (the configured modes where the retune
+                    // put them): from a rough start a configured mode may lie nearer the
+                    // added one than where it belongs.
+                    let model =
+                        super::assign::align_from(&[&anchor, &nodes[1].model], &model, &effects);
+                    let likely =
+                        d_bic > s.min_delta_bic && improves(&m, &node.measures) && !at_edge;
+                    // Physical admissibility of the joint refit, against the node (or, for
+                    // the configured model, the better of it and its retune).
+                    let refusal = likely
+                        .then(|| {
+                            let reference = if node.configured && nodes[1].v_fit < node.v_fit {
+                                &nodes[1].measures
+                            } else {
+                                &node.measures
+                            };
+                            check(
+                                &Child {
+                                    cand: sc.cand,
+                                    model: &model,
+                                    measures: &m,
+                                    reference,
+                                    allow_mains: s.allow_mains,
+                                },
+                                data,
+                            )
+                        })
+                        .flatten();
+                    if let Some(r) = &refusal {
+                        let seen = refused.iter().any(|(_, x): &(usize, Refusal)| {
+                            x.effect == r.effect
+                                && x.rule == r.rule
+                                && match (x.frequency_hz, r.frequency_hz) {
+                                    (Some(a), Some(b)) => (a - b).abs() <= 1e-3 * a,
+                                    (a, b) => a.is_none() && b.is_none(),
+                                }
+                        });
+                        if !seen {
+                            refused.push((depth, r.clone()));
+                        }
+                    }
+                    first_refusal.clone_from(&refusal);
+                    if likely && refusal.is_none() {
                         let mut steps = node.steps.clone();
                         steps.push(Step {
                             step: depth,
                             effect: sc.cand.label(),
                             params: final_effects(
                                 &model,
+                                &anchor,
                                 &effects.iter().map(|e| e.0).collect::<Vec<_>>(),
                                 data,
                                 false,
@@ -395,7 +464,7 @@ pub fn search(
                     }
                 }
                 if depth == 1 && ni == 0 {
-                    first_level.push((sc.clone(), child_node));
+                    first_level.push((sc.clone(), child_node, first_refusal));
                 }
             }
         }
@@ -461,6 +530,7 @@ pub fn search(
         nodes,
         chosen,
         first_level,
+        refused,
         expanded,
         joint_refits,
         gave_up,

@@ -115,7 +115,7 @@ fn paper_mimo_report_and_figures() {
         "G21: output 2, input 1 (model ≡ 0)",
         "|G12(jω)|",
         "∠G22(jω) (degrees)",
-        "nominal model G(jω) (line)",
+        "nominal model G(jω) (line; phase unwrapped along ω)",
         "measured data (markers)",
     ] {
         assert!(t.contains(label), "bode.svg lacks `{label}`");

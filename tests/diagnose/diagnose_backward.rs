@@ -47,13 +47,15 @@ fn a_vacuous_lag_is_eliminated_and_the_needed_mode_kept() {
         let mode = (Cand::Mode, vec![900f64.ln(), 0.02f64.ln(), rho]);
         let lag = (Cand::Lag(Sel::All), vec![(100.0 * w_max).ln()]);
         let mut node = node_with(vec![mode.clone(), lag], &ch);
-        let dropped = eliminate(&base, &mut node, &[], &ch).unwrap();
+        let dropped = eliminate(&base, &mut node, &[], &ch, 10.0).unwrap();
         assert_eq!(dropped, ["lag"], "seed {seed}");
         assert_eq!(node.labels(), ["mode"]);
         assert_eq!(node.model.effect.len(), 0);
         // The needed mode alone: nothing is dropped.
         let mut node = node_with(vec![mode], &ch);
-        assert!(eliminate(&base, &mut node, &[], &ch).unwrap().is_empty());
+        assert!(eliminate(&base, &mut node, &[], &ch, 10.0)
+            .unwrap()
+            .is_empty());
         assert_eq!(node.model.mode.len(), 3);
     }
 }

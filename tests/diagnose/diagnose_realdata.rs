@@ -32,6 +32,7 @@ fn ballscrew_from_a_rough_rigid_body_finds_the_axial_mode_in_band() {
     let s = SearchSettings {
         max_effects: 1,
         beam: 2,
+        ..Default::default()
     };
     let d = diagnose_channels(c.physical.as_ref().unwrap(), &data, &s).unwrap();
     println!("{}", d.message);
