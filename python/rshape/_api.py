@@ -316,8 +316,10 @@ class Diagnosis(Record):
 def diagnose(config: Union[Config, PathLike], frf: Optional[Frf] = None,
              channel: Optional[Tuple[int, int]] = None, noise_radius: Optional[float] = None,
              max_effects: int = 3, beam: int = 3,
-             band: Optional[Tuple[float, float]] = None) -> Diagnosis:
+             band: Optional[Tuple[float, float]] = None,
+             allow_mains: bool = False) -> Diagnosis:
     """Which physical effects the model misses (the search of ``rshape diagnose``);
-    ``band=(fmin, fmax)`` in Hz restricts the data."""
+    ``band=(fmin, fmax)`` in Hz restricts the data; ``allow_mains=True`` lets a mode at
+    50/60 Hz or a harmonic pass (``--allow-mains``)."""
     return Diagnosis(_core._diagnose(_config(config), frf, channel, noise_radius,
-                                     max_effects, beam, band))
+                                     max_effects, beam, band, allow_mains))

@@ -128,7 +128,7 @@ impl DiagnosisHandle {
 
 /// `rshape diagnose --json`: candidates, chosen set, changes, peaks.
 #[pyfunction]
-#[pyo3(signature = (config, frf=None, channel=None, noise_radius=None, max_effects=3, beam=3, band=None))]
+#[pyo3(signature = (config, frf=None, channel=None, noise_radius=None, max_effects=3, beam=3, band=None, allow_mains=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn _diagnose(
     py: Python<'_>,
@@ -139,9 +139,17 @@ pub fn _diagnose(
     max_effects: usize,
     beam: usize,
     band: Option<(f64, f64)>,
+    allow_mains: bool,
 ) -> PyResult<DiagnosisHandle> {
     let cfg = config.inner.clone();
     guarded(py, move || {
+        for (flag, v) in [("max_effects", max_effects), ("beam", beam)] {
+            if v == 0 {
+                return Err(input(format!(
+                    "{flag} 0: must be at least 1 (the default is 3)"
+                )));
+            }
+        }
         noise_arg(noise_radius)?;
         let chan = channel_arg(channel)?;
         let data = config_data(&cfg, frf)?;
@@ -174,8 +182,10 @@ pub fn _diagnose(
             channels = channels.band(lo, hi).py()?;
         }
         let settings = SearchSettings {
-            max_effects: max_effects.max(1),
-            beam: beam.max(1),
+            max_effects,
+            beam,
+            allow_mains,
+            ..Default::default()
         };
         let diagnosis = diagnose_channels(&base, &channels, &settings).py()?;
         let json = serde_json::to_string(&diagnosis).map_err(|e| input(e.to_string()))?;
