@@ -1,5 +1,6 @@
 //! One constructed case per admissibility rule: the truth is one mode at 100 rad/s
 //! (ζ 0.01) measured on dense lines; a child adds a term that breaks exactly one rule.
+#![cfg(test)]
 
 use super::*;
 use crate::model::physical::{EffectKind, EffectSpec, Gains, ModeSpec};

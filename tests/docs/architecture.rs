@@ -34,7 +34,10 @@ fn offending_lines(with_cli: bool, code_only: bool, matches: impl Fn(&str) -> bo
         }
         let text = std::fs::read_to_string(&f).expect("source is UTF-8");
         for (i, line) in text.lines().enumerate() {
-            if code_only && line.trim_start().starts_with("#[cfg(test)]") {
+            // Test code: a `#[cfg(test)]` module at the end of a file, or a whole file that
+            // declares itself test-only (`#![cfg(test)]`, a `#[path]` test module).
+            let t = line.trim_start();
+            if code_only && (t.starts_with("#[cfg(test)]") || t.starts_with("#![cfg(test)]")) {
                 break;
             }
             if matches(line.split("//").next().unwrap_or("")) {
