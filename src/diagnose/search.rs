@@ -140,7 +140,7 @@ pub struct SearchSettings {
     /// Nodes kept per level.
     pub beam: usize,
     /// ΔBIC an effect must exceed to be added (`2(V_ref − V) − n ln(2F)`; default
-    /// [`MIN_DELTA_BIC`] = 10, "very strong" evidence on Kass & Raftery's scale).
+    /// 10, "very strong" evidence on Kass & Raftery's scale).
     pub min_delta_bic: f64,
     /// Write modes at mains frequencies ([`super::admissible`]); refused by default.
     pub allow_mains: bool,
