@@ -240,7 +240,9 @@ def stability(config: Union[Config, PathLike], controller: Any, r: Any = None,
 
 class Synthesis(Record):
     """A synthesized controller (``synthesis.json`` of ``rshape synthesize``): ``method``,
-    ``b_opt``, ``gamma_min``, ``gamma``, ``controller_order``, ``controller_poles``,
+    ``b_opt``, ``gamma`` (the controller's: H∞'s with ``gamma_opt``, or Glover–McFarlane's
+    with ``gamma_min``), ``glover_mcfarlane`` (its ``b_opt``, ``gamma_min``, ``gamma``),
+    ``controller_order``, ``controller_poles``,
     ``bounds`` (alpha per bound), ``robust``, ``notes``; the controller ``A``, ``B``, ``C``,
     ``D`` (u = -K y), ``controller_toml``, ``stability`` (the Theorem 1 proof), ``text``."""
 
