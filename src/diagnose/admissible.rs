@@ -26,11 +26,11 @@
 //!   with a parameter of another term.  The `ζ` of a mode narrower than the lines (seen on its
 //!   flanks only) is not judged: the record bounds it, it cannot measure it.
 
-use super::candidates::{sig, Cand};
-use super::changes::slot_covariance;
-use super::channels::Channels;
-use super::problem::Measures;
-use super::slots::{slots, Lin, Nl, Term};
+use crate::diagnose::changes::slot_covariance;
+use crate::diagnose::effects::candidates::{sig, Cand};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::slots::{slots, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
 use serde::Serialize;
 
@@ -238,7 +238,7 @@ pub fn check(c: &Child<'_>, data: &Channels) -> Option<Refusal> {
 /// local maximum above the noise (`> 9`, i.e. 3 radii) at one of the two lines around
 /// `ω_n` (within ±3 lines): the lines see the resonance on its flanks even when none falls
 /// in its half-power band (a lightly damped mode between 1 Hz lines), so `ω_n` and the
-/// residue are identified there and `ζ` is bounded by the record ([`super::slots`]).
+/// residue are identified there and `ζ` is bounded by the record ([`crate::diagnose::lsq::slots`]).
 fn residual_peaks_at(m: &PhysicalModel, k: usize, data: &Channels) -> bool {
     let om = &data.omega;
     let w = m.mode[k].omega_n;

@@ -210,7 +210,7 @@ fn a_delay_below_the_phase_resolution_and_a_tiny_misfit_change_are_negligible() 
     m.effect.push(e);
     assert_eq!(
         rule_of(
-            Cand::Delay(super::super::candidates::Sel::All),
+            Cand::Delay(crate::diagnose::effects::candidates::Sel::All),
             &m,
             &d,
             &AFTER,

@@ -6,7 +6,7 @@
 //! their noise: a model that cannot reach the noise on both experiments is then limited by
 //! the data (nonlinearity, drift, a changed operating point), not by missing dynamics.
 
-use super::compare::{bands, Band, Siso, MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
+use crate::diagnose::compare::{bands, Band, Siso, MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
 use crate::error::{Error, Result};
 use serde::Serialize;
 

@@ -20,8 +20,10 @@
 //! by one common factor `k`, the move is one effect, a gain error: it is reported once as
 //! `gain` (before 1, after `k`) with the parameters it covers in [`CommonGain`].
 
-use super::channels::Channels;
-use super::slots::{gains_of, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl, Term};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::slots::{
+    gains_of, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl, Term,
+};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -212,7 +214,7 @@ fn nl_param(m: &PhysicalModel, s: Nl) -> Param {
 }
 
 /// True when slot `s` of the refit model is a configured parameter of `base` (configured
-/// terms and effects come first in every list; added ones are named [`super::retune::ADDED_NOTE`]).
+/// terms and effects come first in every list; added ones are named [`crate::diagnose::effects::candidates::ADDED_NOTE`]).
 fn configured_lin(base: &PhysicalModel, s: Lin) -> bool {
     match s {
         Lin::Out(t, _) => configured_term(base, t),
@@ -260,14 +262,14 @@ fn residual(m: &PhysicalModel, data: &Channels, out: &mut Vec<f64>) {
 /// Standard deviations of every slot coordinate of `m` (`lin` then `nl`) from
 /// `cov = (2JᵀJ)⁻¹`, by an SVD of the column-scaled Jacobian; a coordinate with a
 /// noticeable share in a direction the data do not determine gets `∞`.
-pub(super) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
+pub(crate) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
     slot_covariance(m, lin, nl, data).0
 }
 
 /// Standard deviations of every slot coordinate (as [`slot_sigmas`]) and, when the Jacobian
 /// has full rank, the correlation matrix of the slots (`lin` then `nl`) from the same
 /// covariance `(2JᵀJ)⁻¹`.
-pub(super) fn slot_covariance(
+pub(crate) fn slot_covariance(
     m: &PhysicalModel,
     lin: &[Lin],
     nl: &[Nl],

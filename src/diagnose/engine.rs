@@ -4,34 +4,40 @@
 //! * Noise: `σ = r/√2` (noise uniform in the disk of radius `r`); the cost is
 //!   `V = Σ|G_d − Ĝ(θ)|²/σ²` over every channel (`E V ≈ F` for a right model), the
 //!   complex-Gaussian `−ln L`.
-//! * [`super::retune`]: the configured parameters, refit with wide bounds (residues by
+//! * [`crate::diagnose::lsq::retune`]: the configured parameters, refit with wide bounds (residues by
 //!   least squares, modes placed by a grid from a rough start): the `retune` candidate.
-//! * [`super::search`]: beam search over effect sequences with a joint refit at every node.
-//! * Final holdout ([`super::holdout`]), per effect of the chosen set: fitted on 3 of every
+//! * [`crate::diagnose::search::beam`]: beam search over effect sequences with a joint refit at every node.
+//! * Final holdout ([`crate::diagnose::search::holdout`]), per effect of the chosen set: fitted on 3 of every
 //!   4 data, the held-out quarter's `V` must be lower with the effect than without it; for a
 //!   multiplicative effect, also fitted below 70 % of the band (log frequency), the top 30 %
 //!   must be predicted better. An effect that fails is dropped and the rest refit. The
 //!   extrapolation test decides only for a set of multiplicative effects (a fit below the
 //!   split cannot place a mode or a feedthrough that acts above it); otherwise it is
 //!   reported.
-//! * Ties ([`super::ties`]): sets within 6 of the chosen set's BIC, with where to measure to
+//! * Ties ([`crate::diagnose::search::ties`]): sets within 6 of the chosen set's BIC, with where to measure to
 //!   tell them apart.
 //! * Consistent: `invalid_fraction ≤ 5 %` and `misfit_rms ≤ 1`, judged on the model's
-//!   consistency polish ([`super::polish`]).
+//!   consistency polish ([`crate::diagnose::search::polish`]).
 
-use super::candidates::sig;
-use super::changes::changes;
-use super::channels::Channels;
-use super::compare::Siso;
-use super::final_effects::final_effects;
-use super::first_level::{ranked_candidates, Root};
-use super::holdout::{holdouts, model_of};
-use super::polish::settle;
-use super::problem::{Measures, Problem};
-use super::report::{DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats};
-use super::retune::retune_within;
-use super::search::{roots, screen_configured, search, Node, SearchResult, SearchSettings};
-use super::ties::{candidate_ties, set_ties};
+use crate::diagnose::changes::changes;
+use crate::diagnose::compare::Siso;
+use crate::diagnose::effects::candidates::sig;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::lsq::retune::retune_within;
+use crate::diagnose::report::{
+    DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
+};
+use crate::diagnose::search::beam::{
+    roots, screen_configured, search, SearchResult, SearchSettings,
+};
+use crate::diagnose::search::final_effects::final_effects;
+use crate::diagnose::search::first_level::{ranked_candidates, Root};
+use crate::diagnose::search::holdout::{holdouts, model_of};
+use crate::diagnose::search::node::Node;
+use crate::diagnose::search::polish::settle;
+use crate::diagnose::search::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
 use crate::report::fmt::fmt_pct;
@@ -136,24 +142,34 @@ pub fn diagnose_channels(
     let mut candidates = phases.time("first level", || ranked_candidates(&root, &res, data))?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
     // When the holdout drops part of the chosen set, the next-best sets are tried.
-    let super::holdout::Passing {
+    let crate::diagnose::search::holdout::Passing {
         mut node,
         holdout,
         dropped,
         replaced_by,
     } = phases.time("holdout", || {
-        super::holdout::first_passing(&res.nodes, res.chosen, |n| {
+        crate::diagnose::search::holdout::first_passing(&res.nodes, res.chosen, |n| {
             drop_failing_holdout(base, n, &res.nodes, data)
         })
     })?;
     // Runner-ups and ties are then relative to the set kept.
     res.chosen = replaced_by.unwrap_or(res.chosen);
     let eliminated = phases.time("backward elimination", || {
-        super::backward::eliminate(base, &mut node, &res.nodes, data, s.min_delta_bic)
+        crate::diagnose::search::backward::eliminate(
+            base,
+            &mut node,
+            &res.nodes,
+            data,
+            s.min_delta_bic,
+        )
     })?;
     phases.time("final refit", || final_refit(&mut node, base, data))?;
     // What the written model has and the input did not: the modes read by an assignment.
-    node.model = super::assign::align_from(&[base, &root_model], &node.model, &node.effects);
+    node.model = crate::diagnose::search::assign::align_from(
+        &[base, &root_model],
+        &node.model,
+        &node.effects,
+    );
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
     let ties = phases.time("ties", || {
@@ -163,8 +179,8 @@ pub fn diagnose_channels(
     });
     let after = node.measures;
     let (peaks, peaks_not_listed) = phases.time("peak account", || {
-        super::peaks::account(
-            &super::peaks::Outcome {
+        crate::diagnose::search::peaks::account(
+            &crate::diagnose::search::peaks::Outcome {
                 retuned: &root_model,
                 final_model: &node.model,
                 chosen: &chosen_labels,
@@ -217,7 +233,7 @@ pub fn diagnose_channels(
         refused: res
             .refused
             .iter()
-            .map(|(step, r)| super::report::RefusedEffect {
+            .map(|(step, r)| crate::diagnose::report::RefusedEffect {
                 step: *step,
                 refusal: r.clone(),
             })
@@ -230,7 +246,7 @@ pub fn diagnose_channels(
     })
 }
 
-/// The final holdout ([`super::holdout`]) of the chosen set; an effect that fails it is
+/// The final holdout ([`crate::diagnose::search::holdout`]) of the chosen set; an effect that fails it is
 /// dropped and the rest refit.  A fit below 70 % of the band cannot place an additive effect
 /// (a mode, a feedthrough) that acts above it, so the extrapolation test decides only for
 /// sets of multiplicative effects; otherwise it is reported.  Returns the holdout rows and
@@ -276,7 +292,7 @@ fn drop_failing_holdout(
 }
 
 /// A last joint refit of the chosen model, kept when it lowers the cost, and its
-/// consistency polish ([`super::polish`]).
+/// consistency polish ([`crate::diagnose::search::polish`]).
 fn final_refit(node: &mut Node, base: &PhysicalModel, data: &Channels) -> Result<()> {
     let refit = retune_within(&node.model, base, data, None, false);
     if refit.v_after < node.v_fit {
@@ -310,13 +326,13 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
     runner_up
 }
 
-/// A note for the verdict when the per-peak account ([`super::peaks`]) found peaks where one
+/// A note for the verdict when the per-peak account ([`crate::diagnose::search::peaks`]) found peaks where one
 /// mode fitted at the peak would pass the screen although no candidate of the run was
 /// fitted there: the modes the search's proposals did not reach (empty when none).
-fn unreached_modes(peaks: &[super::report::Peak]) -> String {
+fn unreached_modes(peaks: &[crate::diagnose::report::Peak]) -> String {
     let mut f: Vec<f64> = Vec::new();
     for p in peaks {
-        if p.fate != super::report::PeakFate::NotProposed {
+        if p.fate != crate::diagnose::report::PeakFate::NotProposed {
             continue;
         }
         if let Some(pr) = &p.probe {
@@ -341,7 +357,11 @@ fn unreached_modes(peaks: &[super::report::Peak]) -> String {
 /// refused (with their rules), and the size of the remaining misfit against the stated
 /// noise (`V / E V`; above 1 either dynamics are missing or the data's own scatter exceeds
 /// the stated σ, and `std_factor × √(V/E V)` is the radius that would cover it).
-fn stop_explanation(refused: &[(usize, super::admissible::Refusal)], v: f64, ev: f64) -> String {
+fn stop_explanation(
+    refused: &[(usize, crate::diagnose::admissible::Refusal)],
+    v: f64,
+    ev: f64,
+) -> String {
     let mut out = String::new();
     if !refused.is_empty() {
         let names: Vec<String> = refused
@@ -379,7 +399,7 @@ fn stop_explanation(refused: &[(usize, super::admissible::Refusal)], v: f64, ev:
 fn verdict_message(
     verdict: DiagnoseVerdict,
     [before, retuned, after]: [&Measures; 3],
-    moved: &super::changes::Changes,
+    moved: &crate::diagnose::changes::Changes,
     chosen_labels: &[String],
 ) -> String {
     let status = if after.consistent() {

@@ -2,83 +2,71 @@
 //! add them, and watch the error fall.  The effects and their signatures are those of the
 //! catalogue `docs/design/effects.md`.
 //!
-//! What is here, in the order of a `diagnose` run:
-//! * `channels`: the data channels, each with its noise radius and model entry;
-//!   `plant_form`, `factor_form`: `[plant]` and factor-form configs converted to
-//!   `[physical]`;
-//! * `compare`: per-frequency misfit normalized by the noise radius, failing bands, error
-//!   measures (`misfit_rms`, `invalid_fraction`, `r_env_max`); `agreement`: two data sets
-//!   against each other;
-//! * `problem`: the least-squares problem (base model, candidate effects, cost `V`);
-//!   `fit`: Levenberg–Marquardt; `slots` (private): the parameters `retune` refits;
-//! * `retune`: the joint refit of the configured model's own parameters;
-//! * `candidates`: the catalogue of effects and how each modifies the model (`explain`,
-//!   private: what each means in the data); `starts`
-//!   (private): their starting points (`lscf`, private: mode proposals from the residual by
-//!   an LSCF stabilization diagram); `rank`: screening and physical plausibility;
-//! * `search`: the beam search over effect sets with joint refits; `polish`: the
-//!   consistency polish; `ties`: sets the data cannot tell apart; `holdout`: the
-//!   final set checked on held-out data; `peaks`: every peak of the residual and its fate;
-//! * `engine`: the whole `diagnose` (entry points [`diagnose`], [`diagnose_channels`],
-//!   [`apply_candidate`]); `report`: what it reports; `figures`: Bode overlay of `compare`;
-//!   `history_figure`: the error after each revision (`history`).
-pub(crate) mod compare;
-pub(crate) mod figures;
-
-pub use compare::{compare, prepare, CompareReport, PlantModel, Siso};
+//! In layers, each using only those below it (checked by `tests/docs/architecture.rs`):
+//! * [`effects`]: the catalogue of effects (`candidates`: what each is and how it modifies
+//!   the model; `explain`: what each means in the data; `lscf`: mode proposals from the
+//!   residual by an LSCF stabilization diagram);
+//! * [`lsq`]: the least squares: `channels` (the data channels, each with its noise radius
+//!   and model entry), `measures` (error measures), `shapes` (a model's path and mode
+//!   shapes), `problem` (base model, candidate effects, cost `V`), `starts` (each candidate's
+//!   starting points), `lm` (Levenberg–Marquardt), `slots` (the parameters `retune` refits),
+//!   `varpro` (variable projection), `retune` (the joint refit of the model's own parameters);
+//! * [`search`]: `rank` (screening and physical plausibility), `node` (an effect set written
+//!   into the model), `beam` (the beam search over effect sets with joint refits),
+//!   `first_level`, `polish` (the consistency polish), `ties` (sets the data cannot tell
+//!   apart), `holdout` (the final set checked on held-out data), `backward` (backward
+//!   elimination), `peaks` (every peak of the residual and its fate), `assign` (added modes
+//!   matched to the refit's), `final_effects`;
+//! * on top: `engine` (the whole `diagnose`: entry points [`diagnose`],
+//!   [`diagnose_channels`], [`apply_candidate`]), `report` (what it reports), `changes` (the
+//!   parameter changes and their σ), [`admissible`] (physical admissibility of a refit),
+//!   `revision` (a revised config); beside them `compare` (per-frequency misfit normalized by
+//!   the noise radius, failing bands, error measures `misfit_rms`, `invalid_fraction`,
+//!   `r_env_max`), `agreement` (two data sets against each other), `plant_form` and
+//!   `factor_form` (`[plant]` and factor-form configs converted to `[physical]`).
+//!
+//! Its figures (the Bode overlay of `compare`, the error after each revision of `history`)
+//! are in [`crate::plot`].
 pub mod admissible;
 pub(crate) mod agreement;
-pub(crate) mod assign;
-pub(crate) mod backward;
-pub(crate) mod candidates;
 pub(crate) mod changes;
-pub(crate) mod channels;
+pub(crate) mod compare;
+pub(crate) mod effects;
 pub(crate) mod engine;
-mod explain;
 pub(crate) mod factor_form;
-pub(crate) mod final_effects;
-mod first_level;
-pub(crate) mod fit;
-pub(crate) mod history_figure;
-pub(crate) mod holdout;
-pub(crate) mod lscf;
-pub(crate) mod peaks;
+pub(crate) mod lsq;
 pub(crate) mod plant_form;
-pub(crate) mod polish;
-pub(crate) mod problem;
-pub(crate) mod rank;
 pub(crate) mod report;
-pub(crate) mod retune;
 pub(crate) mod revision;
 pub(crate) mod search;
-mod slots;
-mod starts;
-pub(crate) mod ties;
-mod varpro;
 
 pub use agreement::{data_vs_data, AgreementVerdict, DataAgreement};
-pub use backward::eliminate;
-pub use candidates::{Cand, Sel, EFFECT_NAMES};
 pub use changes::{changes, Changes, CommonGain, ParamChange};
-pub use channels::{misfit_channels, Channels};
-pub use compare::{misfit, Band, CompareRow, CompareVerdict};
+pub use compare::{
+    compare, misfit, prepare, Band, CompareReport, CompareRow, CompareVerdict, PlantModel, Siso,
+};
+pub use effects::candidates::{Cand, Sel, EFFECT_NAMES};
 pub use engine::{apply_candidate, apply_chosen, diagnose, diagnose_channels};
 pub use factor_form::physical_from_factors;
-pub use figures::{
-    bode_overlay, bode_svg, dense_grid, unwrap_deg, BodeData, ModelCurve, FREQ_LABEL,
-};
-pub use final_effects::final_effects;
-pub use fit::{lm, LmResult};
-pub use history_figure::{error_history, history_svg, model_name, revision_label};
-pub use holdout::{model_of, same_set};
+pub use lsq::channels::{misfit_channels, Channels};
+pub use lsq::lm::{lm, LmResult};
+pub use lsq::measures::Measures as ErrorMeasures;
+pub use lsq::retune::{cost, refit_nominal, retune, retune_within, NominalRefit};
 pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSION_TOL};
-pub use problem::Measures as ErrorMeasures;
-pub use rank::candidate_list;
 pub use report::{
     CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Peak, PeakFate,
     PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
 };
-pub use retune::cost;
-pub use retune::{refit_nominal, retune, retune_within, NominalRefit};
 pub use revision::{params_text, write_revision, Apply, Revise, Revision};
-pub use search::{add_effect, Node, SearchSettings};
+pub use search::backward::eliminate;
+pub use search::beam::SearchSettings;
+pub use search::final_effects::final_effects;
+pub use search::holdout::{model_of, same_set};
+pub use search::node::{add_effect, Node};
+pub use search::rank::candidate_list;
+
+// The figures moved to `crate::plot`; their paths here are kept for the library's users.
+pub use crate::plot::bode_overlay::{
+    bode_overlay, bode_svg, dense_grid, unwrap_deg, BodeData, ModelCurve, FREQ_LABEL,
+};
+pub use crate::plot::history::{error_history, history_svg, model_name, revision_label};

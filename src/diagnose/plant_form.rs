@@ -279,7 +279,7 @@ fn summary(m: &PhysicalModel) -> String {
 
 /// The `[physical]` form of a config that is not `[physical]` and the sentence saying what
 /// was converted: a `[plant]` or `[closed_loop]` transfer function ([`physical_from_tf`]) or
-/// a modal `[model]` factor form ([`super::factor_form::physical_from_factors`]); else why
+/// a modal `[model]` factor form ([`crate::diagnose::factor_form::physical_from_factors`]); else why
 /// not.
 pub fn physical_from_config(c: &Config) -> Result<(PhysicalModel, String), String> {
     match plant_tf(c) {
@@ -293,7 +293,7 @@ pub fn physical_from_config(c: &Config) -> Result<(PhysicalModel, String), Strin
             Ok((m, how))
         }
         None => {
-            let m = super::factor_form::physical_from_factors(&c.factorization)?;
+            let m = crate::diagnose::factor_form::physical_from_factors(&c.factorization)?;
             let how = format!(
                 "the [model] factor form is a modal special factorization: converted to [physical] ({} modes)",
                 m.mode.len()

@@ -2,10 +2,10 @@
 //! effect set with its runner-ups and ties, the path that led to it, the final holdout and
 //! the verdict (the JSON names of the `--json` output).
 
-use super::candidates::Cand;
-use super::changes::Changes;
-use super::compare::Band;
-use super::problem::Measures;
+use crate::diagnose::changes::Changes;
+use crate::diagnose::compare::Band;
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::lsq::measures::Measures;
 use crate::model::physical::PhysicalModel;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -108,7 +108,7 @@ pub struct RefusedEffect {
     pub step: usize,
     /// The refusal.
     #[serde(flatten)]
-    pub refusal: super::admissible::Refusal,
+    pub refusal: crate::diagnose::admissible::Refusal,
 }
 
 /// A tie between two effects or two effect sets.
@@ -410,7 +410,7 @@ pub struct Diagnosis {
     /// The configured parameters the final joint refit (of the chosen set) moved.
     pub retuned_in_chosen: Changes,
     /// Effects the likelihood wanted but physical admissibility refused (on their joint
-    /// refit), each with its rule and reason ([`super::admissible`]).
+    /// refit), each with its rule and reason ([`crate::diagnose::admissible`]).
     pub refused: Vec<RefusedEffect>,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,

@@ -4,12 +4,12 @@
 //! header comment that says what was added, why, and how the error changed.  The written
 //! file is checked to load before it is written (atomically).
 
-use super::candidates::sig;
-use super::channels::Channels;
-use super::engine::{apply_candidate, apply_chosen};
 use super::misfit_channels;
-use super::report::Diagnosis;
-use super::retune::retune_within;
+use crate::diagnose::effects::candidates::sig;
+use crate::diagnose::engine::{apply_candidate, apply_chosen};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::retune::retune_within;
+use crate::diagnose::report::Diagnosis;
 use crate::error::{Error, Result};
 use crate::model::config::RawConfig;
 use crate::model::physical::PhysicalModel;

@@ -8,14 +8,18 @@
 //! - `bode`: the data (with noise-disk error bars, eq. (5)) against the nominal model,
 //!   as in Fig. 7;
 //! - `mu`: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
-//! - `batch`: every dataset's envelope, the combined envelope and the one fitted `r`.
+//! - `batch`: every dataset's envelope, the combined envelope and the one fitted `r`;
+//! - `bode_overlay`: `compare`'s data against one or more models;
+//! - `history`: the error measures after each revision (`history`).
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 pub(crate) mod axis;
 pub(crate) mod batch;
 pub(crate) mod bode;
+pub(crate) mod bode_overlay;
 pub(crate) mod fine;
+pub(crate) mod history;
 pub(crate) mod mu;
 pub(crate) mod r_vs_delta;
 pub(crate) mod stability;

@@ -7,6 +7,7 @@
 mod common;
 
 mod architecture;
+mod diagnose_layers;
 mod docs_commands;
 mod docs_figures;
 mod docs_snippets;

@@ -1,9 +1,9 @@
 //! The chosen effects as they stand in the final, jointly refit model: one entry per chosen
 //! effect, in the order added, with its refit parameters and their standard deviations
-//! (`cov = (2JᵀJ)⁻¹` over every refit parameter, [`super::changes`]).
+//! (`cov = (2JᵀJ)⁻¹` over every refit parameter, [`crate::diagnose::changes`]).
 //!
 //! Added terms and path effects follow the configured ones in every list (the modes put there
-//! by [`super::assign::align`], matched to the configured modes by frequency and shape, never
+//! by [`crate::diagnose::search::assign::align`], matched to the configured modes by frequency and shape, never
 //! by slot); the k-th chosen effect with a label is the k-th **added** term with that note.  A
 //! term the input already had is never reported as added, whatever its note says (a revision
 //! written by `diagnose` keeps the notes of its earlier steps).  Effects that change a
@@ -12,12 +12,12 @@
 //! absorbed in the residues), so no σ.  MIMO residues `ρ_oi = c_o b_i / m` get the σ of
 //! `c_o` (the input gain's share is left out).
 
-use super::candidates::Cand;
-use super::changes::slot_sigmas;
-use super::channels::Channels;
-use super::report::FinalEffect;
-use super::retune::ADDED_NOTE;
-use super::slots::{slots, Lin, Nl, Term};
+use crate::diagnose::changes::slot_sigmas;
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::effects::candidates::ADDED_NOTE;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::slots::{slots, Lin, Nl, Term};
+use crate::diagnose::report::FinalEffect;
 use crate::model::physical::{EffectKind, Feedthrough, PhysicalModel};
 use std::collections::BTreeMap;
 
@@ -88,7 +88,7 @@ pub fn final_effects(
             put("zeta".into(), md.zeta, sz.map(|s| s * md.zeta));
         };
         let residues = |t: Term, put: &mut dyn FnMut(String, f64, Option<f64>), name: &str| {
-            let (cg, bg, mass) = super::slots::gains_of(m, t);
+            let (cg, bg, mass) = crate::diagnose::lsq::slots::gains_of(m, t);
             let (cv, bv) = (cg.to_vec(p), bg.to_vec(n_in));
             for (o, co) in cv.iter().enumerate() {
                 let so = sig.as_ref().and_then(|s| {

@@ -2,8 +2,8 @@
 //! frequencies, each with its noise radius, and the model entry each channel compares with.
 //! Several channels are diagnosed jointly (a mode has one `ω_n` and `ζ` across them).
 
-use super::compare::{prepare, Siso};
 use crate::data::FrfData;
+use crate::diagnose::compare::{prepare, Siso};
 use crate::error::{Error, Result};
 use crate::model::Config;
 use num_complex::Complex64;
@@ -182,6 +182,6 @@ pub fn misfit_channels(m: &crate::model::physical::PhysicalModel, data: &Channel
                 .collect()
         })
         .collect();
-    let me = super::problem::measures_of(&c);
+    let me = crate::diagnose::lsq::measures::measures_of(&c);
     (me.misfit_rms, me.invalid_fraction)
 }

@@ -1,9 +1,10 @@
 //! Screening the candidates on top of a model (each fitted alone, the model fixed) and their
-//! physical plausibility (where two fitted models can be told apart: [`super::ties`]).
+//! physical plausibility (where two fitted models can be told apart: [`crate::diagnose::search::ties`]).
 
-use super::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
-use super::channels::Channels;
-use super::problem::{Measures, Mods, Problem};
+use crate::diagnose::effects::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::problem::{Mods, Problem};
 use crate::model::physical::{PhysicalModel, Quantity};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -259,7 +260,7 @@ pub struct Screened {
 
 impl Problem<'_> {
     /// Fits candidate `c` alone on top of the problem's model (multi-start).
-    pub(super) fn fit_candidate(&self, c: Cand, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
+    pub(crate) fn fit_candidate(&self, c: Cand, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
         let cur = Mods::default();
         // The starts are independent fits: in parallel, the best chosen in their order (the
         // first of equal costs), as a sequential loop would.
@@ -278,7 +279,7 @@ impl Problem<'_> {
     }
 
     /// Fits every candidate alone on the model and sorts them by ΔBIC (best first).
-    pub(super) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
+    pub(crate) fn screen(&self, cands: &[Cand], cur: Measures) -> Vec<Screened> {
         let all: Vec<usize> = (0..self.f()).collect();
         let ln2f = (2.0 * self.n_data() as f64).ln();
         // Each candidate is fitted alone, independently of the others: in parallel (the

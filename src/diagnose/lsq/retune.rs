@@ -22,13 +22,13 @@
 //! `ω_n₀/1.3 … 1.3ω_n₀` and five damping values, the residues solved at every point.  The
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
-use super::channels::Channels;
-use super::fit::{lm_box_jac, LmSettings};
-use super::slots::{
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
+use crate::diagnose::lsq::slots::{
     anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
     MODE_BOX,
 };
-use super::varpro::VarPro;
+use crate::diagnose::lsq::varpro::VarPro;
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -36,9 +36,6 @@ use rayon::prelude::*;
 
 /// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
 pub(crate) const GIVE_UP_AFTER: usize = 10;
-
-/// Names of modes and terms `diagnose` adds start with this.
-pub const ADDED_NOTE: &str = "added by rshape diagnose";
 
 /// The result of a refit.
 #[derive(Debug, Clone)]
@@ -65,7 +62,7 @@ fn solve_linear(m: &mut PhysicalModel, lin: &[Lin], data: &Channels, mask: &[usi
 }
 
 /// [`solve_linear`], returning the weighted residual (real and imaginary parts).
-pub(super) fn solve_linear_res(
+pub(crate) fn solve_linear_res(
     m: &mut PhysicalModel,
     lin: &[Lin],
     data: &Channels,
@@ -210,10 +207,10 @@ pub(crate) fn retune_or_give_up(
                 })
                 .collect();
             // The other columns factored once, each grid point's cost from the mode's own
-            // columns projected off them ([`super::varpro::ModeGrid`]); the full least
+            // columns projected off them ([`crate::diagnose::lsq::varpro::ModeGrid`]); the full least
             // squares at every point where they are rank-deficient.  The points are
             // independent: costed in parallel, the best taken in grid order as before.
-            let fast = super::varpro::ModeGrid::new(&start, i, &lin, data, mask);
+            let fast = crate::diagnose::lsq::varpro::ModeGrid::new(&start, i, &lin, data, mask);
             let costs: Vec<f64> = grid
                 .par_iter()
                 .map(|&(w, z)| match &fast {

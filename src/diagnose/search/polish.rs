@@ -13,17 +13,18 @@
 //!
 //! `min_θ  V(θ) + μ² Σ_k max(0, |e_k|/r_k − t)²`,  `t = 0.95`,
 //!
-//! over every parameter (linear and nonlinear, [`super::slots`]), by bounded
+//! over every parameter (linear and nonlinear, [`crate::diagnose::lsq::slots`]), by bounded
 //! Levenberg–Marquardt from `θ̂`, for `μ = 2, 6, 20, 60` in turn (each from the last), stopping
 //! when `V` leaves the region.  The point with the fewest data outside (then the lowest `V`)
 //! inside the region is returned.  The information criterion of a model stays that of its
 //! least-squares fit; the polish decides only whether the model is consistent.
 
-use super::channels::Channels;
-use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
-use super::fit::{lm_box, LmSettings};
-use super::problem::{Measures, Problem};
-use super::slots::{
+use crate::diagnose::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::lm::{lm_box, LmSettings};
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::lsq::slots::{
     anchor_value, bounds, design, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl,
 };
 use crate::model::physical::PhysicalModel;

@@ -2,30 +2,30 @@
 //! gains, i.e. residues, and feedthrough: solved by least squares) and the nonlinear ones
 //! (ω_n and ζ of every mode, friction poles, input gains of several inputs, path-effect
 //! parameters: moved by Levenberg–Marquardt), with their boxes and the weighted design matrix
-//! of the linear ones (the variable projection of [`super::retune`]).
+//! of the linear ones (the variable projection of [`crate::diagnose::lsq::retune`]).
 
-use super::channels::Channels;
-use super::problem::path_at;
-use super::retune::ADDED_NOTE;
+use crate::diagnose::effects::candidates::ADDED_NOTE;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::shapes::path_at;
 use crate::model::physical::{EffectKind, Feedthrough, Gains, PhysicalModel};
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Term {
+pub(crate) enum Term {
     Rigid(usize),
     Int(usize),
     Mode(usize),
 }
 
 #[derive(Debug, Clone, Copy)]
-pub(super) enum Lin {
+pub(crate) enum Lin {
     Out(Term, usize),
     Feed(usize, usize),
 }
 
 #[derive(Debug, Clone, Copy)]
-pub(super) enum Nl {
+pub(crate) enum Nl {
     ModeW(usize),
     ModeZ(usize),
     RigidPole(usize),
@@ -34,7 +34,7 @@ pub(super) enum Nl {
     LogEffect(usize),
 }
 
-pub(super) fn gains_of(m: &PhysicalModel, t: Term) -> (&Gains, &Gains, f64) {
+pub(crate) fn gains_of(m: &PhysicalModel, t: Term) -> (&Gains, &Gains, f64) {
     match t {
         Term::Rigid(i) => {
             let r = &m.rigid_body[i];
@@ -51,7 +51,7 @@ pub(super) fn gains_of(m: &PhysicalModel, t: Term) -> (&Gains, &Gains, f64) {
     }
 }
 
-pub(super) fn gains_mut(m: &mut PhysicalModel, t: Term) -> (&mut Gains, &mut Gains) {
+pub(crate) fn gains_mut(m: &mut PhysicalModel, t: Term) -> (&mut Gains, &mut Gains) {
     match t {
         Term::Rigid(i) => {
             let r = &mut m.rigid_body[i];
@@ -68,7 +68,7 @@ pub(super) fn gains_mut(m: &mut PhysicalModel, t: Term) -> (&mut Gains, &mut Gai
     }
 }
 
-pub(super) fn set_entry(g: &mut Gains, n: usize, idx: usize, x: f64) {
+pub(crate) fn set_entry(g: &mut Gains, n: usize, idx: usize, x: f64) {
     let mut v = g.to_vec(n);
     v[idx] = x;
     *g = if n == 1 {
@@ -78,7 +78,7 @@ pub(super) fn set_entry(g: &mut Gains, n: usize, idx: usize, x: f64) {
     };
 }
 
-pub(super) fn terms(m: &PhysicalModel) -> Vec<Term> {
+pub(crate) fn terms(m: &PhysicalModel) -> Vec<Term> {
     (0..m.rigid_body.len())
         .map(Term::Rigid)
         .chain((0..m.integrator.len()).map(Term::Int))
@@ -87,7 +87,7 @@ pub(super) fn terms(m: &PhysicalModel) -> Vec<Term> {
 }
 
 /// The slots of `m` on the outputs the data observe.
-pub(super) fn slots(m: &PhysicalModel, data: &Channels) -> (Vec<Lin>, Vec<Nl>) {
+pub(crate) fn slots(m: &PhysicalModel, data: &Channels) -> (Vec<Lin>, Vec<Nl>) {
     let (p, n_in) = (m.n_outputs(), m.n_inputs());
     let outs: Vec<usize> = (0..p)
         .filter(|o| data.entries.iter().any(|e| e.0 == *o))
@@ -137,7 +137,7 @@ pub(super) fn slots(m: &PhysicalModel, data: &Channels) -> (Vec<Lin>, Vec<Nl>) {
     (lin, nl)
 }
 
-pub(super) fn get_nl(m: &PhysicalModel, s: Nl) -> f64 {
+pub(crate) fn get_nl(m: &PhysicalModel, s: Nl) -> f64 {
     match s {
         Nl::ModeW(i) => m.mode[i].omega_n.ln(),
         Nl::ModeZ(i) => m.mode[i].zeta.ln(),
@@ -157,7 +157,7 @@ pub(super) fn get_nl(m: &PhysicalModel, s: Nl) -> f64 {
     }
 }
 
-pub(super) fn set_nl(m: &mut PhysicalModel, s: Nl, x: f64) {
+pub(crate) fn set_nl(m: &mut PhysicalModel, s: Nl, x: f64) {
     let n_in = m.n_inputs();
     match s {
         Nl::ModeW(i) => m.mode[i].omega_n = x.exp(),
@@ -177,7 +177,7 @@ pub(super) fn set_nl(m: &mut PhysicalModel, s: Nl, x: f64) {
     }
 }
 
-pub(super) fn set_lin(m: &mut PhysicalModel, s: Lin, x: f64) {
+pub(crate) fn set_lin(m: &mut PhysicalModel, s: Lin, x: f64) {
     let (p, n_in) = (m.n_outputs(), m.n_inputs());
     match s {
         Lin::Out(t, o) => set_entry(gains_mut(m, t).0, p, o, x),
@@ -205,7 +205,7 @@ pub const MODE_BOX: f64 = 1.3;
 /// The value a nonlinear slot of `m` is bounded around: its value in `anchor` (the
 /// configured model `m` was built from: configured terms and effects come first in every
 /// list) when the slot is a configured one, else its value in `m` (an added effect).
-pub(super) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> f64 {
+pub(crate) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> f64 {
     let configured = match s {
         Nl::ModeW(i) | Nl::ModeZ(i) => i < anchor.mode.len(),
         Nl::RigidPole(i) => anchor
@@ -226,7 +226,7 @@ pub(super) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> 
 }
 
 /// `(lo, hi, typ)` of a nonlinear slot bounded around `x0` (see [`anchor_value`]).
-pub(super) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) -> (f64, f64, f64) {
+pub(crate) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) -> (f64, f64, f64) {
     match s {
         Nl::ModeW(i) => {
             let (mut lo, mut hi) = (x0 - MODE_BOX.ln(), x0 + MODE_BOX.ln());
@@ -250,26 +250,7 @@ pub(super) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) 
     }
 }
 
-/// The weighted design matrix of the linear slots `lin` of `m` (nonlinear ones fixed) on the
-/// data at `mask`, and the weighted data: rows are `(Re, Im)` of `√2/r · (·)` per channel and
-/// datum, so `‖y − A x‖²` is the cost `V` with the linear parameters `x`.
-/// A mode's denominator `d(s) = s² + 2ζω_n s + ω_n²` (its shape is `1/(m d)`).
-pub(super) fn mode_den(s: Complex64, w: f64, z: f64) -> Complex64 {
-    s * s + 2.0 * z * w * s + w * w
-}
-
-/// The relative derivative of a mode's shape `1/d(s)` along `ln ω_n` (`by_w`) or `ln ζ`:
-/// `−(2ζω_n s + 2ω_n²)/d` or `−2ζω_n s/d` (the shape's derivative is this times the shape).
-pub(super) fn mode_log_slope(s: Complex64, w: f64, z: f64, by_w: bool) -> Complex64 {
-    let num = if by_w {
-        2.0 * z * w * s + 2.0 * w * w
-    } else {
-        2.0 * z * w * s
-    };
-    -num / mode_den(s, w, z)
-}
-
-pub(super) fn design(
+pub(crate) fn design(
     m: &PhysicalModel,
     lin: &[Lin],
     data: &Channels,
@@ -337,7 +318,7 @@ pub(super) fn design(
 }
 
 /// The current value of a linear slot of `m`.
-pub(super) fn get_lin(m: &PhysicalModel, s: Lin) -> f64 {
+pub(crate) fn get_lin(m: &PhysicalModel, s: Lin) -> f64 {
     let (p, n_in) = (m.n_outputs(), m.n_inputs());
     match s {
         Lin::Out(t, o) => gains_of(m, t).0.to_vec(p)[o],
@@ -352,7 +333,7 @@ pub(super) fn get_lin(m: &PhysicalModel, s: Lin) -> f64 {
 /// The rows of the design matrix `a` that belong to channels `chs` (each channel owns
 /// `rows_per_ch` consecutive rows) and the sub-matrix of those rows and columns `cols`: one
 /// block of the block-diagonal least-squares problem of [`blocks`].
-pub(super) fn block_matrix(
+pub(crate) fn block_matrix(
     a: &DMatrix<f64>,
     chs: &[usize],
     cols: &[usize],
@@ -370,7 +351,7 @@ pub(super) fn block_matrix(
 /// linear slot with the other groups (an output gain acts on the channels of its output, a
 /// feedthrough on one channel), each with the slots acting on it.  With one input every
 /// output is its own block, so the QR factors a few small matrices instead of one large.
-pub(super) fn blocks(lin: &[Lin], data: &Channels) -> Vec<(Vec<usize>, Vec<usize>)> {
+pub(crate) fn blocks(lin: &[Lin], data: &Channels) -> Vec<(Vec<usize>, Vec<usize>)> {
     let n_ch = data.n_ch();
     let acts = |l: &Lin, ch: usize| {
         let e = data.entries[ch];

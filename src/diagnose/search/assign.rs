@@ -14,8 +14,8 @@
 //! model slot by slot (the moved-parameter table, the chosen effects' final values, the
 //! per-peak account, the written file's notes) then tells the truth.
 
-use super::candidates::Cand;
-use super::retune::ADDED_NOTE;
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::effects::candidates::ADDED_NOTE;
 use crate::model::physical::{ModeSpec, PhysicalModel};
 
 /// Weight of the shape term `1 − MAC` against `|ln(ω_f/ω_b)|`: two modes 5 % apart with

@@ -9,11 +9,11 @@
 //! search runs outward from the band, up to two decades above and below it, and reports the
 //! first such frequency on each side.
 
-use super::candidates::fmt_w;
-use super::channels::Channels;
-use super::rank::TIE_BIC;
-use super::report::{CandidateReport, Tie};
-use super::search::SearchResult;
+use crate::diagnose::effects::candidates::fmt_w;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::report::{CandidateReport, Tie};
+use crate::diagnose::search::beam::SearchResult;
+use crate::diagnose::search::rank::TIE_BIC;
 use crate::model::physical::PhysicalModel;
 
 /// The nearest frequencies (rad/s) outside the measured band where two fitted models differ

@@ -1,15 +1,15 @@
-//! The Jacobian of the variable-projection residual of [`super::retune`] (Golub & Pereyra
+//! The Jacobian of the variable-projection residual of [`crate::diagnose::lsq::retune`] (Golub & Pereyra
 //! 1973; Kaufman 1975 for the notation), from one Householder QR per point instead of one
 //! per parameter.
 //!
 //! With the linear slots solved, the residual is `r(θ) = P⊥(θ) y`, `P⊥ = I − A A⁺`, `A(θ)`
-//! the weighted design matrix of the linear slots ([`super::slots::design`]).  Its exact
+//! the weighted design matrix of the linear slots ([`crate::diagnose::lsq::slots::design`]).  Its exact
 //! derivative along a nonlinear parameter `θ_k` (Golub & Pereyra, eq. (4.3)) is
 //!
 //! `∂r/∂θ_k = −P⊥ A_k x − (A⁺)ᵀ A_kᵀ r`,   `A_k = ∂A/∂θ_k`, `x = A⁺ y`.
 //!
 //! With `Ã = A S = Q R` (columns scaled to unit norm, `S` diagonal; thin Householder QR of
-//! each independent block, [`super::slots::blocks`]), `P⊥ v = v − Q Qᵀ v` and
+//! each independent block, [`crate::diagnose::lsq::slots::blocks`]), `P⊥ v = v − Q Qᵀ v` and
 //! `(A⁺)ᵀ w = Q R⁻ᵀ S w`.  `A_k` is analytic where the parameter acts on a few columns: a
 //! mode's `ln ω_n` and `ln ζ` on its own columns,
 //! `∂/∂ln ω_n [1/d(s)] = −(2ζω_n s + 2ω_n²)/d(s)²`, `∂/∂ln ζ [1/d(s)] = −2ζω_n s/d(s)²`,
@@ -20,10 +20,9 @@
 //! `1e-12` of the largest, where the least squares drops a column) the caller falls back to
 //! the forward-difference Jacobian of the whole residual.
 
-use super::channels::Channels;
-use super::slots::{
-    block_matrix, blocks, design, gains_of, mode_den, mode_log_slope, set_nl, Lin, Nl, Term,
-};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::shapes::{mode_den, mode_log_slope};
+use crate::diagnose::lsq::slots::{block_matrix, blocks, design, gains_of, set_nl, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
@@ -39,7 +38,7 @@ struct Block {
 
 /// The variable-projection problem of a refit: the model with its nonlinear slots `nl` at
 /// `θ` and its linear slots `lin` solved on the data at `mask`.
-pub(super) struct VarPro<'a> {
+pub(crate) struct VarPro<'a> {
     pub start: &'a PhysicalModel,
     pub nl: &'a [Nl],
     pub lin: &'a [Lin],
@@ -201,7 +200,7 @@ impl VarPro<'_> {
     }
 
     /// Fills `jac` with `∂r/∂θ` at `θ` (the residual `r = y − A x`, rows as
-    /// [`super::slots::design`]); `false` when a block is rank-deficient or the solution is
+    /// [`crate::diagnose::lsq::slots::design`]); `false` when a block is rank-deficient or the solution is
     /// not finite.
     pub fn jacobian(&self, th: &[f64], jac: &mut DMatrix<f64>) -> bool {
         let mm = self.model(th);
@@ -281,11 +280,11 @@ impl VarPro<'_> {
 }
 
 /// The cost of the least squares as one mode's `ω_n`, `ζ` move (the rough placement of
-/// [`super::retune`]): the other columns `A_o` are factored once (`A_o S = Q R`), and at
+/// [`crate::diagnose::lsq::retune`]): the other columns `A_o` are factored once (`A_o S = Q R`), and at
 /// each point the mode's columns `a` are projected off them,
 /// `V(ω_n, ζ) = ‖r_o − Q_b Q_bᵀ r_o‖²`, `r_o = P⊥_o y`, `b = P⊥_o a = Q_b R_b`: the cost of
 /// the full least squares, in `O(m n)` per point instead of `O(m n²)`.
-pub(super) struct ModeGrid<'a> {
+pub(crate) struct ModeGrid<'a> {
     data: &'a Channels,
     mask: &'a [usize],
     /// The mode's columns with its denominator left out: `a_{row,j} = coef_{row,j}/d(s_k)`
@@ -382,9 +381,9 @@ impl<'a> ModeGrid<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::retune::solve_linear_res;
-    use super::super::slots::{get_nl, slots};
     use super::*;
+    use crate::diagnose::lsq::retune::solve_linear_res;
+    use crate::diagnose::lsq::slots::{get_nl, slots};
     use crate::model::physical::{
         EffectKind, EffectSpec, Feedthrough, Gains, ModeSpec, PoleAtZeroSpec,
     };
@@ -512,7 +511,7 @@ mod tests {
     /// every column at every point) over a grid that crosses the mode's resonance.
     #[test]
     fn the_mode_grid_cost_is_the_full_least_squares_cost() {
-        use super::super::retune::solve_linear_res;
+        use crate::diagnose::lsq::retune::solve_linear_res;
         let data = channels(&model(1.07));
         let start = model(1.0);
         let (lin, _) = slots(&start, &data);

@@ -32,11 +32,11 @@
 //! does not depend on how the search proposes candidates, so it also tells whether a
 //! proposer missed a mode the data support.
 
-use super::candidates::{sig, Cand};
-use super::channels::Channels;
-use super::problem::{Mods, Problem};
-use super::rank::{improves, plausibility, MIN_DELTA_BIC};
-use super::report::{CandidateReport, Peak, PeakFate, PeakProbe};
+use crate::diagnose::effects::candidates::{sig, Cand};
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::problem::{Mods, Problem};
+use crate::diagnose::report::{CandidateReport, Peak, PeakFate, PeakProbe};
+use crate::diagnose::search::rank::{improves, plausibility, MIN_DELTA_BIC};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -139,7 +139,7 @@ fn residual(m: &PhysicalModel, data: &Channels) -> Result<(Vec<f64>, Vec<f64>)> 
 /// What the run did, for the account: the model before it added anything (retuned), the
 /// final model, the chosen labels, the first-level candidates and the effects the holdout
 /// and the backward elimination dropped.
-pub(super) struct Outcome<'a> {
+pub(crate) struct Outcome<'a> {
     pub retuned: &'a PhysicalModel,
     pub final_model: &'a PhysicalModel,
     pub chosen: &'a [String],
@@ -151,7 +151,7 @@ pub(super) struct Outcome<'a> {
 }
 
 /// The per-peak account (module docs) and the number of peaks not listed.
-pub(super) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, usize)> {
+pub(crate) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, usize)> {
     let (s0, e0) = residual(o.retuned, data)?;
     let (s1, e1) = residual(o.final_model, data)?;
     let mut raw = find_peaks(&data.omega, &s0, &e0);
@@ -302,7 +302,7 @@ fn mode_candidates(c: &[CandidateReport]) -> String {
 /// Levenberg–Marquardt.
 fn probe_mode(
     pb: &Problem<'_>,
-    cur: &super::problem::Measures,
+    cur: &crate::diagnose::lsq::measures::Measures,
     p: &RawPeak,
     data: &Channels,
 ) -> Option<PeakProbe> {

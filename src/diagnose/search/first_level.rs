@@ -2,20 +2,23 @@
 //! it (fitted alone, or jointly refit when the search expanded it), with ΔBIC, the bands each
 //! explains, 2σ uncertainties, and the ranking the report shows.
 
-use super::candidates::{explain, sig};
-use super::channels::Channels;
-use super::compare::{bands, Band};
-use super::problem::{Measures, Problem};
-use super::rank::{improves, prior, si_map, TIE_BIC};
-use super::report::CandidateReport;
-use super::search::{add_effect, SearchResult};
+use crate::diagnose::compare::{bands, Band};
+use crate::diagnose::effects::candidates::sig;
+use crate::diagnose::effects::explain::explain;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::report::CandidateReport;
+use crate::diagnose::search::beam::SearchResult;
+use crate::diagnose::search::node::add_effect;
+use crate::diagnose::search::rank::{improves, prior, si_map, TIE_BIC};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use std::collections::BTreeMap;
 
 /// The root the candidates are measured against: the configured model's measures `before`,
 /// the retuned model and its measures, and the retune's least-squares cost `v_ret`.
-pub(super) struct Root<'a> {
+pub(crate) struct Root<'a> {
     /// The configured model.
     pub base: &'a PhysicalModel,
     /// Its measures.
@@ -32,7 +35,7 @@ pub(super) struct Root<'a> {
 
 /// The ranked first-level candidates: usable fits by ΔBIC (near-ties by fewer parameters,
 /// then the catalogue's prior order), no-fits last; ranks from 1.
-pub(super) fn ranked_candidates(
+pub(crate) fn ranked_candidates(
     root: &Root<'_>,
     res: &SearchResult,
     data: &Channels,

@@ -14,8 +14,10 @@ use crate::model::physical::{
 };
 use num_complex::Complex64;
 
-pub use super::explain::explain;
 pub use crate::report::fmt::{fmt_change, fmt_w, sig};
+
+/// Names of modes and terms `diagnose` adds start with this.
+pub const ADDED_NOTE: &str = "added by rshape diagnose";
 
 /// The channels a multiplicative effect acts on (0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -38,7 +40,7 @@ impl Sel {
         }
     }
 
-    pub(super) fn suffix(&self) -> String {
+    pub(crate) fn suffix(&self) -> String {
         match self {
             Sel::All => String::new(),
             Sel::Output(o) => format!(" (output {})", o + 1),

@@ -8,7 +8,7 @@
 //!   (ΔBIC > 10, plausible: no parameter at a bound, a mode inside the band) are written into
 //!   the model and **every** parameter is refit jointly (the node's own and the new
 //!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10, it
-//!   improves on the node ([`super::rank::improves`]: no more invalid data, or a lower
+//!   improves on the node ([`crate::diagnose::search::rank::improves`]: no more invalid data, or a lower
 //!   `misfit_rms`), and the refit left no new mode at a band edge.
 //! * **Level**: the children of all nodes, one per effect set (the best of the orders that
 //!   reach it), the `beam` lowest `BIC = 2V + n_θ·ln(2F)` kept.
@@ -23,25 +23,27 @@
 //!   moved inside its own 95 % confidence region towards the disks.  The BIC stays that of
 //!   the least-squares fit.
 
-use super::admissible::{check, Child, Refusal};
-use super::candidates::Cand;
-use super::channels::Channels;
-use super::final_effects::final_effects;
-use super::holdout::same_set;
-use super::polish::settle;
-use super::problem::{Measures, Problem};
-use super::rank::{
+use crate::diagnose::admissible::{check, Child, Refusal};
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::lsq::retune::{retune, retune_or_give_up};
+use crate::diagnose::report::{Phases, Step};
+use crate::diagnose::search::final_effects::final_effects;
+use crate::diagnose::search::holdout::same_set;
+use crate::diagnose::search::node::{add_effect, Node};
+use crate::diagnose::search::polish::settle;
+use crate::diagnose::search::rank::{
     candidate_list, improves, modes_at_band_edge, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC,
 };
-use super::report::{Phases, Step};
-use super::retune::{retune, retune_or_give_up, ADDED_NOTE};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
 
 /// A child's joint refit whose cost is still above this many times its reference (the
 /// node's, or the better root's for the configured model) after
-/// [`GIVE_UP_AFTER`](super::retune::GIVE_UP_AFTER)
+/// [`GIVE_UP_AFTER`](crate::diagnose::lsq::retune::GIVE_UP_AFTER)
 /// iterations is given up: a child counts only below its reference (ΔBIC > 10) and the
 /// cost of a least-squares fit never rises.  Across the diagnose suites (5840 child refits,
 /// 2167 of them of the configured root), every refit that ended able to pass and ran past
@@ -50,8 +52,8 @@ use rayon::prelude::*;
 pub const GIVE_UP_FACTOR: f64 = 3.0;
 
 /// BICs closer than this are the same fit: each least-squares cost is within
-/// [`V_TOL`](super::fit::V_TOL) of its minimum, a BIC (`2V + …`) within twice that.
-const SAME_FIT_BIC: f64 = 4.0 * super::fit::V_TOL;
+/// [`V_TOL`](crate::diagnose::lsq::lm::V_TOL) of its minimum, a BIC (`2V + …`) within twice that.
+const SAME_FIT_BIC: f64 = 4.0 * crate::diagnose::lsq::lm::V_TOL;
 
 /// `a`'s steps explain more than `b`'s: the first step where their ΔBICs differ is larger
 /// in `a`.
@@ -142,7 +144,7 @@ pub struct SearchSettings {
     /// ΔBIC an effect must exceed to be added (`2(V_ref − V) − n ln(2F)`; default
     /// 10, "very strong" evidence on Kass & Raftery's scale).
     pub min_delta_bic: f64,
-    /// Write modes at mains frequencies ([`super::admissible`]); refused by default.
+    /// Write modes at mains frequencies ([`crate::diagnose::admissible`]); refused by default.
     pub allow_mains: bool,
 }
 
@@ -168,35 +170,6 @@ impl Default for SearchSettings {
     }
 }
 
-/// A node: an effect set written into the model and jointly refit.
-#[derive(Debug, Clone)]
-pub struct Node {
-    /// The effects and their parameters when they were added (fitted alone).
-    pub effects: Vec<(Cand, Vec<f64>)>,
-    /// The jointly refit model.
-    pub model: PhysicalModel,
-    /// Its measures (of the polished model when the polish made it consistent).
-    pub measures: Measures,
-    /// Cost `V` of the least-squares fit (the BIC's; the polish may raise `measures.v`).
-    pub v_fit: f64,
-    /// Number of parameters of the model (configured and added).
-    pub n_params: usize,
-    /// `2V + n_θ ln(2F)`.
-    pub bic: f64,
-    /// The path that led here.
-    pub steps: Vec<Step>,
-    /// The model is the configured one, not refit: a child's joint refit starts with the
-    /// mode grid of a rough start.
-    pub configured: bool,
-}
-
-impl Node {
-    /// Labels of the effects, in order.
-    pub fn labels(&self) -> Vec<String> {
-        self.effects.iter().map(|(c, _)| c.label()).collect()
-    }
-}
-
 /// The outcome of a search.
 pub struct SearchResult {
     /// Every node kept, the root first.
@@ -206,7 +179,7 @@ pub struct SearchResult {
     /// The root's screened candidates (first level) and the children made of them.
     pub first_level: Vec<(Screened, Option<Node>, Option<Refusal>)>,
     /// Effects whose joint refit passed the likelihood but not physical admissibility
-    /// ([`super::admissible`]), one per (effect, rule, frequency), in the order met.
+    /// ([`crate::diagnose::admissible`]), one per (effect, rule, frequency), in the order met.
     pub refused: Vec<(usize, Refusal)>,
     /// Nodes expanded.
     pub expanded: usize,
@@ -218,28 +191,6 @@ pub struct SearchResult {
     pub phases: Phases,
 }
 
-/// Writes effect `c` with parameters `th` into `m`.
-/// An effect on a term `m` lacks (friction on a rigid body that an effect left out of a
-/// holdout or elimination set had added) is not written: it has nothing to act on.
-pub fn add_effect(m: &PhysicalModel, c: &Cand, th: &[f64], data: &Channels) -> PhysicalModel {
-    let mut next = m.clone();
-    let missing = match c {
-        Cand::Friction(i) => *i >= m.rigid_body.len(),
-        Cand::ModeShift(i) | Cand::Damping(i) => *i >= m.mode.len(),
-        _ => false,
-    };
-    if missing {
-        return next;
-    }
-    c.apply_to(
-        th,
-        &data.entries,
-        &mut next,
-        &format!("{ADDED_NOTE}: {}", c.label()),
-    );
-    next
-}
-
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {
     2.0 * v + n as f64 * (2.0 * data.n_data() as f64).ln()
 }
@@ -249,7 +200,11 @@ pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
     let r = retune(base, data, None, true);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
     let v_fit = r.v_after;
-    let (model, measures) = settle(super::assign::align(base, &r.model, &[]), base, data)?;
+    let (model, measures) = settle(
+        crate::diagnose::search::assign::align(base, &r.model, &[]),
+        base,
+        data,
+    )?;
     Ok([
         Node {
             effects: vec![],
@@ -379,8 +334,11 @@ pub fn search(
                     // Matched against the retuned root (the configured modes where the retune
                     // put them): from a rough start a configured mode may lie nearer the
                     // added one than where it belongs.
-                    let model =
-                        super::assign::align_from(&[&anchor, &nodes[1].model], &model, &effects);
+                    let model = crate::diagnose::search::assign::align_from(
+                        &[&anchor, &nodes[1].model],
+                        &model,
+                        &effects,
+                    );
                     let likely =
                         d_bic > s.min_delta_bic && improves(&m, &node.measures) && !at_edge;
                     // Physical admissibility of the joint refit, against the node (or, for
@@ -434,7 +392,7 @@ pub fn search(
                             .map(|e| e.params)
                             .unwrap_or_default(),
                             params_fitted_alone: si_map(&sc.cand, &sc.mods.theta, &data.entries),
-                            explanation: super::candidates::explain(
+                            explanation: crate::diagnose::effects::explain::explain(
                                 &sc.cand,
                                 &sc.mods.theta,
                                 &data.entries,

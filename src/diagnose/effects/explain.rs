@@ -2,7 +2,7 @@
 //! data (where the misfit peaks, how magnitude and phase move) and what it is physically,
 //! in the terms of the measured quantity (receptance, mobility or accelerance).
 
-use super::candidates::{fmt_change, fmt_w, sig, Cand, Sel};
+use crate::diagnose::effects::candidates::{fmt_change, fmt_w, sig, Cand, Sel};
 use crate::model::physical::{PhysicalModel, Quantity};
 
 /// A plain-language explanation of the candidate's signature in the data.

@@ -1,15 +1,15 @@
 //! Starting points of each candidate's new parameters: closed-form estimates (linear least
 //! squares on the residual, one residue per channel), the best points of a 1-D grid, and for
 //! an added mode the peaks of the noise-normalized misfit (docs/design/effects.md, step 3)
-//! and the poles of the residual an LSCF stabilization diagram proposes ([`super::lscf`]).
+//! and the poles of the residual an LSCF stabilization diagram proposes ([`crate::diagnose::effects::lscf`]).
 
-use super::candidates::{Cand, Sel};
-use super::problem::{Mods, Problem};
+use crate::diagnose::effects::candidates::{Cand, Sel};
+use crate::diagnose::lsq::problem::{Mods, Problem};
 use num_complex::Complex64;
 
 impl Problem<'_> {
     /// Starting points for the new parameters of `c`, given the current model `cur`.
-    pub(super) fn starts(&self, cur: &Mods, c: Cand, mask: &[usize]) -> Vec<Vec<f64>> {
+    pub(crate) fn starts(&self, cur: &Mods, c: Cand, mask: &[usize]) -> Vec<Vec<f64>> {
         let gm = self.response(cur);
         let (wmin, wmax) = (self.omega_min(), self.omega_max());
         let om = self.omega();
@@ -100,7 +100,7 @@ impl Problem<'_> {
                     .flat_map(|p| zetas.map(|z| (p.1, z)))
                     .collect();
                 // The poles of the residual stable across the orders of an LSCF diagram
-                // (`super::lscf`), at their own damping; the log grid over the band only
+                // (`crate::diagnose::effects::lscf`), at their own damping; the log grid over the band only
                 // when the diagram has none.
                 let proposals = self.mode_proposals(&gm, mask);
                 if proposals.is_empty() {
@@ -125,7 +125,7 @@ impl Problem<'_> {
     /// Linear least squares of the residual `e = G_d − G_m` (`gm`: the model's response) on
     /// a basis `ψ` over the channels `chs` and the data in `mask`, noise-weighted:
     /// `ρ = Re Σ ψ* e w / Σ |ψ|² w` (0 when the basis vanishes or the sum is not finite).
-    pub(super) fn ls_coefficient(
+    pub(crate) fn ls_coefficient(
         &self,
         gm: &[Vec<Complex64>],
         chs: &[usize],
@@ -151,7 +151,7 @@ impl Problem<'_> {
     /// The parameters `[ln ω_n, ln ζ, ρ_1 … ρ_C]` of an added mode at `(w, z)` on the model
     /// `cur` (response `gm`): each channel's residue by [`Problem::ls_coefficient`] on the
     /// basis `path/(s² + 2ζω_n s + ω_n²)`.
-    pub(super) fn mode_theta(
+    pub(crate) fn mode_theta(
         &self,
         cur: &Mods,
         gm: &[Vec<Complex64>],
@@ -170,13 +170,13 @@ impl Problem<'_> {
         th
     }
 
-    /// The mode proposals of an LSCF stabilization diagram ([`super::lscf`]) on the
+    /// The mode proposals of an LSCF stabilization diagram ([`crate::diagnose::effects::lscf`]) on the
     /// residual `G_d − G_m` (`gm`: the current model) at the data in `mask`, noise-weighted.
-    pub(super) fn mode_proposals(
+    pub(crate) fn mode_proposals(
         &self,
         gm: &[Vec<Complex64>],
         mask: &[usize],
-    ) -> Vec<super::lscf::Proposal> {
+    ) -> Vec<crate::diagnose::effects::lscf::Proposal> {
         let omega: Vec<f64> = mask.iter().map(|k| self.omega()[*k]).collect();
         let h: Vec<Vec<Complex64>> = (0..self.n_ch())
             .map(|ch| {
@@ -188,8 +188,8 @@ impl Problem<'_> {
         let w: Vec<Vec<f64>> = (0..self.n_ch())
             .map(|ch| mask.iter().map(|k| self.inv_sigma[ch][*k]).collect())
             .collect();
-        super::lscf::propose(
-            &super::lscf::Frf {
+        crate::diagnose::effects::lscf::propose(
+            &crate::diagnose::effects::lscf::Frf {
                 omega: &omega,
                 h: &h,
                 w: &w,

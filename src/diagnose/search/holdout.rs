@@ -1,4 +1,4 @@
-//! The final-set holdout of `diagnose` (see [`super::engine`]): per effect of the chosen
+//! The final-set holdout of `diagnose` (see [`crate::diagnose::engine`]): per effect of the chosen
 //! set, fitted on 3 of every 4 data, the held-out quarter's `V` must be lower with the effect
 //! than without it; for a multiplicative effect, also fitted below 70 % of the band (log
 //! frequency), the top 30 % must be predicted better.
@@ -9,12 +9,12 @@
 //! from there) on the part: an effect the part does not see keeps its all-data value
 //! instead of drifting.
 
-use super::candidates::Cand;
-use super::channels::Channels;
-use super::rank::{EXTRAPOLATION_SPLIT, MIN_SPLIT_DATA};
-use super::report::Holdout;
-use super::retune::{cost, retune_within};
-use super::search::{add_effect, Node};
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::retune::{cost, retune_within};
+use crate::diagnose::report::Holdout;
+use crate::diagnose::search::node::{add_effect, Node};
+use crate::diagnose::search::rank::{EXTRAPOLATION_SPLIT, MIN_SPLIT_DATA};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -222,7 +222,7 @@ pub fn holdouts(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::diagnose::problem::Measures;
+    use crate::diagnose::lsq::measures::Measures;
 
     /// A node holding one added mode at `f_hz` with BIC `bic`.
     fn node(f_hz: f64, bic: f64) -> Node {

@@ -3,24 +3,24 @@
 //! `V = Σ_ch Σ_k |G_d − Ĝ(θ)|²/σ²` (`σ = r/√2`, noise uniform in the disk of radius `r`), and
 //! the bounded Levenberg–Marquardt refit of every candidate parameter.
 
-use super::candidates::Cand;
-use super::channels::Channels;
-use super::compare::{MAX_INVALID_FRACTION, MAX_MISFIT_RMS};
-use super::fit::{lm_box_jac, LmSettings};
-use super::slots::{mode_den, mode_log_slope};
+use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
+use crate::diagnose::lsq::measures::{measures_of, Measures};
+use crate::diagnose::lsq::shapes::path_at;
+use crate::diagnose::lsq::shapes::{mode_den, mode_log_slope};
 use crate::error::{Error, Result};
-use crate::model::physical::{EffectPath, PhysicalModel};
+use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use serde::Serialize;
 
 /// The fitting problem.
 pub struct Problem<'a> {
-    pub(super) base: &'a PhysicalModel,
-    pub(super) data: &'a Channels,
-    pub(super) inv_sigma: Vec<Vec<f64>>,
-    pub(super) core0: Vec<Vec<Complex64>>,
-    pub(super) path0: Vec<Vec<Complex64>>,
+    pub(crate) base: &'a PhysicalModel,
+    pub(crate) data: &'a Channels,
+    pub(crate) inv_sigma: Vec<Vec<f64>>,
+    pub(crate) core0: Vec<Vec<Complex64>>,
+    pub(crate) path0: Vec<Vec<Complex64>>,
     /// Residue of each configured mode at each channel, `[ch][mode]`.
     mode_rho: Vec<Vec<f64>>,
     /// Residue of each rigid body at each channel, `[ch][body]`.
@@ -37,48 +37,12 @@ pub struct Mods {
 }
 
 impl Mods {
-    pub(super) fn with(&self, c: Cand, th: &[f64]) -> Mods {
+    pub(crate) fn with(&self, c: Cand, th: &[f64]) -> Mods {
         let mut m = self.clone();
         m.cands.push(c);
         m.theta.extend_from_slice(th);
         m
     }
-}
-
-/// Error measures of a model.
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct Measures {
-    /// `Σ|e|²/σ²`.
-    pub v: f64,
-    /// `sqrt(mean (|e|/r)²)` over every datum of every channel.
-    pub misfit_rms: f64,
-    /// Share of data with `|e| > r`.
-    pub invalid_fraction: f64,
-}
-
-impl Measures {
-    /// Explained within the noise.
-    pub fn consistent(&self) -> bool {
-        self.invalid_fraction <= MAX_INVALID_FRACTION && self.misfit_rms <= MAX_MISFIT_RMS
-    }
-}
-
-/// The product of the path effects of `m` on model entry `entry` at `ω`, times `(jω)^k` of
-/// the measured quantity (the core stays the displacement model, so added modes, rigid
-/// bodies and residual terms keep their displacement form).
-pub fn path_at(m: &PhysicalModel, omega: f64, entry: (usize, usize)) -> Complex64 {
-    let q = m.quantity.factor(omega);
-    q * m
-        .effect
-        .iter()
-        .filter(|e| {
-            let idx = match e.path {
-                EffectPath::Input => entry.1,
-                EffectPath::Output => entry.0,
-            };
-            e.channel.is_none_or(|c| c == idx + 1)
-        })
-        .fold(Complex64::new(1.0, 0.0), |a, e| a * e.eval(omega))
 }
 
 /// Checks that `base` can be diagnosed on `data`: sizes agree, and with several channels
@@ -136,35 +100,35 @@ impl<'a> Problem<'a> {
     }
 
     /// Number of frequencies.
-    pub(super) fn f(&self) -> usize {
+    pub(crate) fn f(&self) -> usize {
         self.data.len()
     }
 
     /// Number of channels.
-    pub(super) fn n_ch(&self) -> usize {
+    pub(crate) fn n_ch(&self) -> usize {
         self.data.n_ch()
     }
 
     /// Number of complex data (for `ln(2F)` in the BIC).
-    pub(super) fn n_data(&self) -> usize {
+    pub(crate) fn n_data(&self) -> usize {
         self.data.n_data()
     }
 
-    pub(super) fn omega(&self) -> &[f64] {
+    pub(crate) fn omega(&self) -> &[f64] {
         &self.data.omega
     }
 
-    pub(super) fn omega_max(&self) -> f64 {
+    pub(crate) fn omega_max(&self) -> f64 {
         *self.data.omega.last().expect("data")
     }
 
-    pub(super) fn omega_min(&self) -> f64 {
+    pub(crate) fn omega_min(&self) -> f64 {
         self.data.omega[0]
     }
 
     /// `(core, path)` of channel `ch` with `mods` applied, at datum `k` or at any `ω` with
     /// `k = None`.
-    pub(super) fn parts(
+    pub(crate) fn parts(
         &self,
         mods: &Mods,
         ch: usize,
@@ -243,7 +207,7 @@ impl<'a> Problem<'a> {
             .collect()
     }
 
-    pub(super) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
+    pub(crate) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
         out.clear();
         let nat = self.naturals_of(mods);
         for ch in 0..self.n_ch() {
@@ -256,7 +220,7 @@ impl<'a> Problem<'a> {
         }
     }
 
-    pub(super) fn v(&self, mods: &Mods, mask: &[usize]) -> f64 {
+    pub(crate) fn v(&self, mods: &Mods, mask: &[usize]) -> f64 {
         let mut r = Vec::with_capacity(2 * mask.len() * self.n_ch());
         self.residual(mods, mask, &mut r);
         let v: f64 = r.iter().map(|x| x * x).sum();
@@ -268,7 +232,7 @@ impl<'a> Problem<'a> {
     }
 
     /// Normalized misfit `|e|/r` per channel and datum.
-    pub(super) fn misfits(&self, mods: &Mods) -> Vec<Vec<f64>> {
+    pub(crate) fn misfits(&self, mods: &Mods) -> Vec<Vec<f64>> {
         let gm = self.response(mods);
         (0..self.n_ch())
             .map(|ch| {
@@ -286,7 +250,7 @@ impl<'a> Problem<'a> {
 
     /// Per frequency: the largest misfit over the channels, and whether any channel is
     /// invalid there.
-    pub(super) fn invalid_flags(&self, mods: &Mods) -> (Vec<f64>, Vec<bool>) {
+    pub(crate) fn invalid_flags(&self, mods: &Mods) -> (Vec<f64>, Vec<bool>) {
         let c = self.misfits(mods);
         let worst: Vec<f64> = (0..self.f())
             .map(|k| c.iter().map(|ch| ch[k]).fold(0.0, f64::max))
@@ -296,7 +260,7 @@ impl<'a> Problem<'a> {
     }
 
     /// Box bounds of every parameter of `mods`.
-    pub(super) fn bounds(&self, mods: &Mods) -> (Vec<f64>, Vec<f64>) {
+    pub(crate) fn bounds(&self, mods: &Mods) -> (Vec<f64>, Vec<f64>) {
         let (mut lo, mut hi) = (Vec::new(), Vec::new());
         for c in &mods.cands {
             for (a, b) in c.bounds(self.n_ch(), self.omega_min(), self.omega_max()) {
@@ -345,7 +309,7 @@ impl<'a> Problem<'a> {
     }
 
     /// Joint bounded LM fit of `mods` (all its parameters free) on the data in `mask`.
-    pub(super) fn refit(&self, mods: &Mods, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
+    pub(crate) fn refit(&self, mods: &Mods, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
         if mods.theta.is_empty() {
             return (mods.clone(), self.v(mods, mask), DMatrix::zeros(0, 0));
         }
@@ -386,26 +350,6 @@ impl<'a> Problem<'a> {
             res.v,
             res.jtj,
         )
-    }
-}
-
-/// Measures from the normalized misfits `[ch][k]`.
-pub fn measures_of(c: &[Vec<f64>]) -> Measures {
-    let mut c2 = 0.0;
-    let mut bad = 0usize;
-    let mut n = 0usize;
-    for x in c.iter().flatten() {
-        c2 += x * x;
-        n += 1;
-        if *x > 1.0 {
-            bad += 1;
-        }
-    }
-    let n = n.max(1) as f64;
-    Measures {
-        v: 2.0 * c2,
-        misfit_rms: (c2 / n).sqrt(),
-        invalid_fraction: bad as f64 / n,
     }
 }
 

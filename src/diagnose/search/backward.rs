@@ -5,11 +5,11 @@
 //! forward search kept, such as a lag whose corner refit far above the band (it contributes
 //! nothing there once other effects were added).
 
-use super::channels::Channels;
-use super::holdout::{model_of, without};
-use super::problem::Problem;
-use super::retune::retune_within;
-use super::search::Node;
+use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::lsq::retune::retune_within;
+use crate::diagnose::search::holdout::{model_of, without};
+use crate::diagnose::search::node::Node;
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;

@@ -1,0 +1,21 @@
+//! The least squares of [`crate::diagnose`]: a model with candidate effects fitted to the data
+//! channels (cost `V`, Levenberg–Marquardt, variable projection).  Uses only
+//! [`crate::diagnose::effects`] (and the leaf `compare`).
+//! * `channels`: the data channels, each with its noise radius and model entry;
+//! * `measures`: error measures (`V`, `misfit_rms`, `invalid_fraction`);
+//! * `shapes`: a model's path effects at a datum and a mode's shape;
+//! * `problem`: the least-squares problem (base model, candidate effects, cost `V`);
+//! * `starts`: each candidate's starting points;
+//! * `lm`: Levenberg–Marquardt;
+//! * `slots`: the configured model's parameters `retune` refits;
+//! * `varpro`: the variable-projection Jacobian;
+//! * `retune`: the joint refit of the configured model's own parameters.
+pub(crate) mod channels;
+pub(crate) mod lm;
+pub(crate) mod measures;
+pub(crate) mod problem;
+pub(crate) mod retune;
+pub(crate) mod shapes;
+pub(crate) mod slots;
+pub(crate) mod starts;
+pub(crate) mod varpro;

@@ -1,0 +1,26 @@
+//! The search of [`crate::diagnose`] over effect sets: screening, beam search with joint
+//! refits, hold-out, ties, elimination.  Uses [`crate::diagnose::effects`],
+//! [`crate::diagnose::lsq`] and the vocabulary beside the engine (`report`, `changes`,
+//! `admissible`, `compare`), never the engine.
+//! * `rank`: screening and physical plausibility;
+//! * `node`: an effect set written into the model and jointly refit;
+//! * `beam`: the beam search over effect sets;
+//! * `first_level`: the root's candidates ranked;
+//! * `polish`: the consistency polish;
+//! * `ties`: sets the data cannot tell apart;
+//! * `holdout`: the final set checked on held-out data;
+//! * `backward`: backward elimination;
+//! * `peaks`: every peak of the residual and its fate;
+//! * `assign`: configured and added modes matched to the refit's;
+//! * `final_effects`: the effects the written model has and the input did not.
+pub(crate) mod assign;
+pub(crate) mod backward;
+pub(crate) mod beam;
+pub(crate) mod final_effects;
+pub(crate) mod first_level;
+pub(crate) mod holdout;
+pub(crate) mod node;
+pub(crate) mod peaks;
+pub(crate) mod polish;
+pub(crate) mod rank;
+pub(crate) mod ties;
