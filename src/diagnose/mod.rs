@@ -2,16 +2,16 @@
 //! add them, and watch the error fall.  The effects and their signatures are those of the
 //! catalogue `docs/design/effects.md`.
 //!
-//! In layers, each using only those below it (checked by `tests/docs/architecture.rs`):
-//! * [`effects`]: the catalogue of effects (`candidates`: what each is and how it modifies
+//! In layers, each using only those below it (checked by `tests/docs/diagnose_layers.rs`):
+//! * `effects`: the catalogue of effects (`candidates`: what each is and how it modifies
 //!   the model; `explain`: what each means in the data; `lscf`: mode proposals from the
 //!   residual by an LSCF stabilization diagram);
-//! * [`lsq`]: the least squares: `channels` (the data channels, each with its noise radius
+//! * `lsq`: the least squares: `channels` (the data channels, each with its noise radius
 //!   and model entry), `measures` (error measures), `shapes` (a model's path and mode
 //!   shapes), `problem` (base model, candidate effects, cost `V`), `starts` (each candidate's
 //!   starting points), `lm` (Levenberg–Marquardt), `slots` (the parameters `retune` refits),
 //!   `varpro` (variable projection), `retune` (the joint refit of the model's own parameters);
-//! * [`search`]: `rank` (screening and physical plausibility), `node` (an effect set written
+//! * `search`: `rank` (screening and physical plausibility), `node` (an effect set written
 //!   into the model), `beam` (the beam search over effect sets with joint refits),
 //!   `first_level`, `polish` (the consistency polish), `ties` (sets the data cannot tell
 //!   apart), `holdout` (the final set checked on held-out data), `backward` (backward
