@@ -1,8 +1,115 @@
 //! The catalogue of physical effects (docs/design/effects.md): the bottom layer of
 //! [`crate::diagnose`], using nothing of the layers above.
-//! * `candidates`: the effects the search can add and how each modifies the model;
+//! * `effect`: the [`effect::Effect`] trait each effect implements;
+//! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
+//!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`), registered below;
+//! * `candidates`: the candidate [`Cand`] (one variant per registered effect) and what it
+//!   dispatches to its effect;
 //! * `explain`: what each means in the data;
 //! * `lscf`: mode proposals from the residual by an LSCF stabilization diagram.
+//!
+//! Adding an effect is one file implementing [`effect::Effect`] and one line in the
+//! registration list below (docs/design/effects.md, "Adding an effect").
 pub(crate) mod candidates;
+pub(crate) mod effect;
 pub(crate) mod explain;
 pub(crate) mod lscf;
+mod tests;
+
+/// The registration list: declares each effect's module, makes [`Cand`] (one variant per
+/// line, carrying the effect's target), [`crate::diagnose::EFFECT_NAMES`], the candidate
+/// list and `with_effect!`, which calls a body with the candidate's effect.  The order is the
+/// order in which the candidates are tried (path effects per channel selection first).
+macro_rules! register {
+    ($d:tt $( $(#[$doc:meta])* $variant:ident $(($target:ty))? => $module:ident :: $ty:ident, )*) => {
+        $( pub(crate) mod $module; )*
+
+        /// A candidate effect: one variant per registered effect, carrying its target.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum Cand {
+            $( $(#[$doc])* $variant $(($target))?, )*
+        }
+
+        /// The effect names of the JSON output (`retune` is the refit of the configured
+        /// parameters), in the registration order.
+        pub const EFFECT_NAMES: [&str; 1 + [$( stringify!($variant) ),*].len()] = [
+            "retune",
+            $( <$module::$ty as effect::Effect>::NAME, )*
+        ];
+
+        /// The candidates tried on a model: the path effects on each channel selection of
+        /// `sels` (in turn), then the additive terms of `base`.
+        pub(crate) fn tried(base: &crate::model::physical::PhysicalModel, sels: &[candidates::Sel]) -> Vec<Cand> {
+            let mut v = Vec::new();
+            for s in sels {
+                $( v.extend(<$module::$ty as effect::Effect>::tried_on(*s)); )*
+            }
+            $( v.extend(<$module::$ty as effect::Effect>::tried(base)); )*
+            v
+        }
+
+        /// `with_effect!(c, e => body)`: `body` with `e` the effect of candidate `c`.
+        macro_rules! with_effect {
+            ($d c:expr, $d e:ident => $d body:expr) => {
+                match $d c {
+                    $( $crate::diagnose::effects::cand_pattern!($variant, t $(, $target)?) => {
+                        let $d e = $crate::diagnose::effects::effect_of!($module::$ty, t $(, $target)?);
+                        $d body
+                    } )*
+                }
+            };
+        }
+        pub(crate) use with_effect;
+    };
+}
+
+/// The pattern of a registered variant, binding its target to `$t` when it has one.
+macro_rules! cand_pattern {
+    ($variant:ident, $t:ident, $target:ty) => {
+        $crate::diagnose::effects::Cand::$variant($t)
+    };
+    ($variant:ident, $t:ident) => {
+        $crate::diagnose::effects::Cand::$variant
+    };
+}
+pub(crate) use cand_pattern;
+
+/// The effect of a registered variant, from its target `$t` when it has one.
+macro_rules! effect_of {
+    ($module:ident :: $ty:ident, $t:ident, $target:ty) => {
+        $crate::diagnose::effects::$module::$ty(*$t)
+    };
+    ($module:ident :: $ty:ident, $t:ident) => {
+        $crate::diagnose::effects::$module::$ty
+    };
+}
+pub(crate) use effect_of;
+
+register! { $
+    /// Pure delay `e^{−sτ}`; θ = \[τ\] (s, |τ| used).
+    Delay(candidates::Sel) => delay::Delay,
+    /// First-order lag; θ = [ln ω_c].
+    Lag(candidates::Sel) => lag::Lag,
+    /// NMP zero all-pass; θ = [ln z].
+    NmpZero(candidates::Sel) => nmp_zero::NmpZero,
+    /// Zero-order hold; θ = [ln T].
+    Zoh(candidates::Sel) => zoh::Zoh,
+    /// Gain; θ = \[k\].
+    Gain(candidates::Sel) => gain::Gain,
+    /// Sign flip; no parameter.
+    Sign(candidates::Sel) => sign::Sign,
+    /// Added mode `ρ_ch/(s² + 2ζω s + ω²)`; θ = [ln ω_n, ln ζ, ρ_1 … ρ_C] (one residue per
+    /// channel, shared `ω_n` and `ζ`).
+    Mode => mode::Mode,
+    /// Added `c_ch/s^order` (order 1: integrator, 2: rigid body); θ = [c_1 … c_C].
+    Integrator(u8) => integrator::Integrator,
+    /// Added feedthrough; θ = [d_1 … d_C].
+    Feedthrough => feedthrough::Feedthrough,
+    /// Viscous friction on rigid body `i` of the base model: `1/s²` becomes
+    /// `1/(s (s + p))`; θ = [ln p].
+    Friction(usize) => friction::Friction,
+    /// Shifted frequency of mode `i` (0-based) of the base model; θ = [ln ω_n].
+    ModeShift(usize) => mode_shift::ModeShift,
+    /// Changed damping of mode `i`; θ = [ln ζ].
+    Damping(usize) => damping::Damping,
+}

@@ -175,7 +175,9 @@ impl<'a> Problem<'a> {
             let rho = match c {
                 Cand::ModeShift(i) | Cand::Damping(i) => self.mode_rho[ch][*i],
                 Cand::Friction(i) => self.rigid_rho[ch][*i],
-                _ => 0.0,
+                // The others' residues are not cached (0 for every effect that changes no
+                // configured term).
+                _ => c.base_residue(self.base, entry),
             };
             c.modify_natural(
                 &nat[off..off + n],

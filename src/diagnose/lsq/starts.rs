@@ -4,122 +4,94 @@
 //! and the poles of the residual an LSCF stabilization diagram proposes ([`crate::diagnose::effects::lscf`]).
 
 use crate::diagnose::effects::candidates::{Cand, Sel};
+use crate::diagnose::effects::effect::Site;
 use crate::diagnose::lsq::problem::{Mods, Problem};
+use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
+/// The least-squares problem as an effect's starts see it ([`Site`]): the current model
+/// `cur` (response `gm`), candidate `c` and the data in `mask`.
+struct StartSite<'p, 'a> {
+    p: &'p Problem<'a>,
+    cur: &'p Mods,
+    c: Cand,
+    mask: &'p [usize],
+    gm: Vec<Vec<Complex64>>,
+}
+
+impl Site for StartSite<'_, '_> {
+    fn omega(&self) -> &[f64] {
+        self.p.omega()
+    }
+
+    fn band(&self) -> (f64, f64) {
+        (self.p.omega_min(), self.p.omega_max())
+    }
+
+    fn n_ch(&self) -> usize {
+        self.p.n_ch()
+    }
+
+    fn base(&self) -> &PhysicalModel {
+        self.p.base
+    }
+
+    fn channels(&self, sel: Sel) -> Vec<usize> {
+        (0..self.p.n_ch())
+            .filter(|ch| sel.hits(self.p.data.entries[*ch]))
+            .collect()
+    }
+
+    fn response(&self, ch: usize, k: usize) -> Complex64 {
+        self.gm[ch][k]
+    }
+
+    fn path(&self, ch: usize, k: usize) -> Complex64 {
+        let om = self.p.omega();
+        self.p.parts(self.cur, ch, Some(k), om[k]).1
+    }
+
+    fn ls(&self, chs: &[usize], psi: &dyn Fn(usize, usize) -> Complex64) -> f64 {
+        self.p.ls_coefficient(&self.gm, chs, self.mask, psi)
+    }
+
+    fn cost(&self, th: &[f64]) -> f64 {
+        self.p.v(&self.cur.with(self.c, th), self.mask)
+    }
+
+    fn delay_costs(&self, sel: Sel, step: f64, n: usize) -> Vec<(f64, f64)> {
+        self.p.delay_grid(&self.gm, sel, self.mask, step, n)
+    }
+
+    fn worst_misfit(&self) -> Vec<f64> {
+        self.p.invalid_flags(self.cur).0
+    }
+
+    fn mode_proposals(&self) -> Vec<(f64, f64)> {
+        self.p
+            .mode_proposals(&self.gm, self.mask)
+            .iter()
+            .map(|p| (p.omega_n, p.zeta))
+            .collect()
+    }
+
+    fn mode_theta(&self, w: f64, z: f64) -> Vec<f64> {
+        self.p.mode_theta(self.cur, &self.gm, w, z, self.mask)
+    }
+}
+
 impl Problem<'_> {
-    /// Starting points for the new parameters of `c`, given the current model `cur`.
+    /// Starting points for the new parameters of `c`, given the current model `cur`: each
+    /// effect's own ([`crate::diagnose::effects::effect::Effect::starts`]).
     pub(crate) fn starts(&self, cur: &Mods, c: Cand, mask: &[usize]) -> Vec<Vec<f64>> {
-        let gm = self.response(cur);
-        let (wmin, wmax) = (self.omega_min(), self.omega_max());
-        let om = self.omega();
-        let n_ch = self.n_ch();
-        let ls = |chs: &[usize], psi: &dyn Fn(usize, usize) -> Complex64| -> f64 {
-            self.ls_coefficient(&gm, chs, mask, psi)
+        let site = StartSite {
+            p: self,
+            cur,
+            c,
+            mask,
+            gm: self.response(cur),
         };
-        // Best few points of a 1-D grid of the new parameter: the grid's local minima by
-        // cost, then the rest by cost.
-        let pick = |mut vs: Vec<(f64, f64)>, keep: usize| -> Vec<Vec<f64>> {
-            let mut local: Vec<(f64, f64)> = (0..vs.len())
-                .filter(|&i| {
-                    (i == 0 || vs[i].0 <= vs[i - 1].0)
-                        && (i + 1 == vs.len() || vs[i].0 <= vs[i + 1].0)
-                })
-                .map(|i| vs[i])
-                .collect();
-            local.sort_by(|a, b| a.0.total_cmp(&b.0));
-            vs.sort_by(|a, b| a.0.total_cmp(&b.0));
-            local
-                .into_iter()
-                .chain(vs)
-                .take(keep)
-                .map(|(_, x)| vec![x])
-                .collect()
-        };
-        let grid_best = |grid: &[f64], keep: usize| -> Vec<Vec<f64>> {
-            let vs = grid
-                .iter()
-                .map(|x| (self.v(&cur.with(c, &[*x]), mask), *x))
-                .collect();
-            pick(vs, keep)
-        };
-        let log_grid = |lo: f64, hi: f64, n: usize| -> Vec<f64> {
-            (0..n)
-                .map(|i| lo.ln() + (hi.ln() - lo.ln()) * i as f64 / (n - 1) as f64)
-                .collect()
-        };
-        // The path of the current model at each datum (for additive bases).
-        let path_of = |ch: usize, k: usize| self.parts(cur, ch, Some(k), om[k]).1;
-        let s = |k: usize| Complex64::new(0.0, om[k]);
-        let sel_chans = |sel: Sel| -> Vec<usize> {
-            (0..n_ch)
-                .filter(|ch| sel.hits(self.data.entries[*ch]))
-                .collect()
-        };
-        match c {
-            Cand::Sign(_) => vec![vec![]],
-            Cand::Gain(sel) => vec![vec![1.0 + ls(&sel_chans(sel), &|ch, k| gm[ch][k])]],
-            Cand::Delay(sel) => {
-                let step = 0.05 / wmax;
-                let n = (6.0 * std::f64::consts::PI / 0.05) as usize + 1;
-                pick(self.delay_grid(&gm, sel, mask, step, n), 3)
-            }
-            Cand::Lag(_) | Cand::NmpZero(_) => grid_best(&log_grid(wmin / 3.0, wmax * 30.0, 40), 3),
-            Cand::Zoh(_) => grid_best(&log_grid(0.01 / wmax, 3.0 / wmax, 40), 3),
-            Cand::Integrator(o) => vec![(0..n_ch)
-                .map(|ch| ls(&[ch], &|ch, k| path_of(ch, k) / s(k).powi(o as i32)))
-                .collect()],
-            Cand::Feedthrough => vec![(0..n_ch)
-                .map(|ch| ls(&[ch], &|ch, k| path_of(ch, k)))
-                .collect()],
-            Cand::ModeShift(i) => {
-                let w0 = self.base.mode[i].omega_n;
-                let grid: Vec<f64> = (0..61)
-                    .map(|j| w0.ln() + (j as f64 - 30.0) / 60.0)
-                    .collect();
-                grid_best(&grid, 3)
-            }
-            Cand::Damping(_) => grid_best(&log_grid(1e-3, 0.7, 30), 3),
-            Cand::Friction(_) => grid_best(&log_grid(wmin / 1000.0, wmax, 40), 3),
-            Cand::Mode => {
-                // ω_n candidates: local maxima of the worst channel's |e|/r (five dampings
-                // each), plus the LSCF proposals; residues by LS per channel.
-                let (cw, _) = self.invalid_flags(cur);
-                let f = self.f();
-                let mut peaks: Vec<(f64, f64)> = (0..f)
-                    .filter(|&k| {
-                        (k == 0 || cw[k] >= cw[k - 1]) && (k + 1 == f || cw[k] >= cw[k + 1])
-                    })
-                    .map(|k| (cw[k], om[k]))
-                    .collect();
-                peaks.sort_by(|a, b| b.0.total_cmp(&a.0));
-                let zetas = [0.005, 0.02, 0.06, 0.2, 0.5];
-                let mut points: Vec<(f64, f64)> = peaks
-                    .iter()
-                    .take(4)
-                    .flat_map(|p| zetas.map(|z| (p.1, z)))
-                    .collect();
-                // The poles of the residual stable across the orders of an LSCF diagram
-                // (`crate::diagnose::effects::lscf`), at their own damping; the log grid over the band only
-                // when the diagram has none.
-                let proposals = self.mode_proposals(&gm, mask);
-                if proposals.is_empty() {
-                    points.extend(
-                        log_grid(wmin, wmax, 30)
-                            .iter()
-                            .flat_map(|x| zetas.map(|z| (x.exp(), z))),
-                    );
-                }
-                points.extend(proposals.iter().map(|p| (p.omega_n, p.zeta)));
-                let mut trials: Vec<(f64, Vec<f64>)> = Vec::new();
-                for (w, z) in points {
-                    let th = self.mode_theta(cur, &gm, w, z, mask);
-                    trials.push((self.v(&cur.with(Cand::Mode, &th), mask), th));
-                }
-                trials.sort_by(|a, b| a.0.total_cmp(&b.0));
-                trials.into_iter().take(4).map(|t| t.1).collect()
-            }
-        }
+        c.starts(&site)
     }
 
     /// Linear least squares of the residual `e = G_d − G_m` (`gm`: the model's response) on

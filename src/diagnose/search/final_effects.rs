@@ -15,6 +15,7 @@
 use crate::diagnose::changes::slot_sigmas;
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::effects::candidates::ADDED_NOTE;
+use crate::diagnose::effects::effect::Stands;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::slots::{slots, Lin, Nl, Term};
 use crate::diagnose::report::FinalEffect;
@@ -104,8 +105,8 @@ pub fn final_effects(
                 }
             }
         };
-        match c {
-            Cand::Mode => {
+        match c.stands() {
+            Stands::AddedMode => {
                 let idx = m
                     .mode
                     .iter()
@@ -117,23 +118,23 @@ pub fn final_effects(
                     residues(Term::Mode(i), &mut put, "rho");
                 }
             }
-            Cand::ModeShift(i) | Cand::Damping(i) => {
-                if *i < m.mode.len() {
-                    put("mode".into(), (*i + 1) as f64, None);
-                    mode_params(*i, &mut put);
+            Stands::ConfiguredMode(i) => {
+                if i < m.mode.len() {
+                    put("mode".into(), (i + 1) as f64, None);
+                    mode_params(i, &mut put);
                 }
             }
-            Cand::Friction(i) => {
-                put("rigid_body".into(), (*i + 1) as f64, None);
-                if let Some(x) = m.rigid_body.get(*i).and_then(|r| r.friction_pole) {
+            Stands::FrictionPole(i) => {
+                put("rigid_body".into(), (i + 1) as f64, None);
+                if let Some(x) = m.rigid_body.get(i).and_then(|r| r.friction_pole) {
                     let s = sig
                         .as_ref()
-                        .and_then(|s| s.of_nl(|y| matches!(y, Nl::RigidPole(j) if j == i)));
+                        .and_then(|s| s.of_nl(|y| matches!(y, Nl::RigidPole(j) if *j == i)));
                     put("pole".into(), x, s.map(|s| s * x));
                 }
             }
-            Cand::Integrator(order) => {
-                let (list, term, n_base): (&[_], fn(usize) -> Term, _) = if *order == 2 {
+            Stands::AddedPoleAtZero(order) => {
+                let (list, term, n_base): (&[_], fn(usize) -> Term, _) = if order == 2 {
                     (&m.rigid_body, Term::Rigid, base.rigid_body.len())
                 } else {
                     (&m.integrator, Term::Int, base.integrator.len())
@@ -145,11 +146,11 @@ pub fn final_effects(
                     .filter(|(_, r)| note_is(&r.name, &label))
                     .nth(nth);
                 if let Some((i, _)) = found {
-                    put("order".into(), *order as f64, None);
+                    put("order".into(), order as f64, None);
                     residues(term(i), &mut put, "c");
                 }
             }
-            Cand::Feedthrough => {
+            Stands::Feedthrough => {
                 let d = |o: usize, i: usize| match &m.feedthrough {
                     Some(Feedthrough::Scalar(x)) => *x,
                     Some(Feedthrough::Matrix(r)) => r[o][i],
@@ -167,12 +168,7 @@ pub fn final_effects(
                     put(n, d(*o, *i), s);
                 }
             }
-            Cand::Delay(_)
-            | Cand::Lag(_)
-            | Cand::Gain(_)
-            | Cand::Sign(_)
-            | Cand::NmpZero(_)
-            | Cand::Zoh(_) => {
+            Stands::AddedPathEffect => {
                 let found = m
                     .effect
                     .iter()

@@ -40,11 +40,7 @@ impl Node {
 /// holdout or elimination set had added) is not written: it has nothing to act on.
 pub fn add_effect(m: &PhysicalModel, c: &Cand, th: &[f64], data: &Channels) -> PhysicalModel {
     let mut next = m.clone();
-    let missing = match c {
-        Cand::Friction(i) => *i >= m.rigid_body.len(),
-        Cand::ModeShift(i) | Cand::Damping(i) => *i >= m.mode.len(),
-        _ => false,
-    };
+    let missing = c.lacks_its_term(m);
     if missing {
         return next;
     }

@@ -1,7 +1,8 @@
 //! Screening the candidates on top of a model (each fitted alone, the model fixed) and their
 //! physical plausibility (where two fitted models can be told apart: [`crate::diagnose::search::ties`]).
 
-use crate::diagnose::effects::candidates::{fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
+use crate::diagnose::effects::candidates::{fmt_w, Cand, Sel};
+use crate::diagnose::effects::effect::Band;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::{Mods, Problem};
@@ -13,8 +14,6 @@ use std::collections::BTreeMap;
 /// ΔBIC a candidate needs to be accepted.
 pub const MIN_DELTA_BIC: f64 = 10.0;
 
-/// Largest phase lag (rad) a delay candidate may have at the band top: half a cycle.
-pub const MAX_DELAY_PHASE: f64 = std::f64::consts::PI;
 /// BIC gap under which two candidates (or two effect sets) are a tie.
 pub const TIE_BIC: f64 = 6.0;
 /// Extrapolation holdout: fit below this share of the band (log frequency), predict above.
@@ -57,21 +56,10 @@ pub fn modes_at_band_edge(m: &PhysicalModel, w_min: f64, w_max: f64) -> usize {
         .count()
 }
 
-/// Prior order among near-ties (lower first): fewer assumptions first.
+/// Prior order among near-ties (lower first): fewer assumptions first (each effect's
+/// [`crate::diagnose::effects::effect::Effect::prior`]).
 pub fn prior(c: &Cand) -> usize {
-    match c {
-        Cand::Sign(_) => 0,
-        Cand::Gain(_) => 1,
-        Cand::Delay(_) => 2,
-        Cand::Lag(_) => 3,
-        Cand::Zoh(_) => 4,
-        Cand::Feedthrough => 5,
-        Cand::Integrator(_) | Cand::Friction(_) => 6,
-        Cand::Damping(_) => 7,
-        Cand::ModeShift(_) => 8,
-        Cand::NmpZero(_) => 9,
-        Cand::Mode => 10,
-    }
+    c.prior()
 }
 
 /// SI parameters by name.
@@ -103,27 +91,10 @@ pub fn candidate_list(base: &PhysicalModel, data: &Channels) -> Vec<Cand> {
             sels.extend(ins.iter().map(|i| Sel::Input(*i)));
         }
     }
-    let mut v = Vec::new();
-    for s in &sels {
-        v.extend([Cand::Delay(*s), Cand::Lag(*s)]);
-        // A sensor carries a delay or a lag; a hold or an NMP zero sits on the actuator
-        // side (or on every channel).
-        if !matches!(s, Sel::Output(_)) {
-            v.extend([Cand::NmpZero(*s), Cand::Zoh(*s)]);
-        }
-    }
-    v.extend([
-        Cand::Mode,
-        Cand::Integrator(1),
-        Cand::Integrator(2),
-        Cand::Feedthrough,
-    ]);
-    for (i, r) in base.rigid_body.iter().enumerate() {
-        if r.friction_pole.is_none() {
-            v.push(Cand::Friction(i));
-        }
-    }
-    v
+    // Path effects on each selection in turn (a sensor carries a delay or a lag; a hold or
+    // an NMP zero sits on the actuator side or on every channel), then the additive terms:
+    // each effect says where it is tried, in the registration order.
+    crate::diagnose::effects::tried(base, &sels)
 }
 
 /// Physical plausibility of fitted parameters (docs/design/effects.md step 3): `(flags, no_fit)`.
@@ -175,65 +146,17 @@ pub fn plausibility(
         let tol = 1e-3 * (1.0 + th[i].abs());
         (th[i] - lo).abs() < tol || (hi - th[i]).abs() < tol
     };
-    match c {
-        Cand::Mode => {
-            if at(0) {
-                let w = th[0].exp();
-                let edge = if w < (w_min * w_max).sqrt() {
-                    "below: the lower residual of modes below the band, see the integrator candidate of order 2"
-                } else {
-                    "above: the upper residual of modes above the band, see the feedthrough candidate"
-                };
-                flags.push(format!(
-                    "ω_n at the band edge {}: the resonance is not inside the measured band ({edge})",
-                    fmt_w(w)
-                ));
-            }
-            if at(1) {
-                let z = th[1].exp().clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1);
-                flags.push(format!(
-                    "ζ at its {} bound {}: not identified",
-                    if z < 0.01 { "lower" } else { "upper" },
-                    sig(z)
-                ));
-            }
-        }
-        Cand::Damping(_) if at(0) => flags.push("ζ at its bound: not identified".into()),
-        // On a mobility or an accelerance, c/s (displacement) is a constant mobility or an
-        // accelerance rising as ω: no structural term (a rigid body or the lower residual is
-        // c/s², the upper residual a constant D).
-        Cand::Integrator(1) if quantity != Quantity::Displacement => flags.push(format!(
-            "implausible on a {}: c/s in displacement is {} here, which no structural term gives (a rigid-body mode or the lower residual is c/s², the upper residual D)",
-            quantity.frf_name(),
-            if quantity == Quantity::Acceleration { "c·s" } else { "a constant c" }
-        )),
-        // More than half a cycle of lag at the band top is not a transport or computation
-        // delay a servo loop works with; it fits the slope of dynamics the model lacks.
-        Cand::Delay(_) if th[0].abs() * w_max > MAX_DELAY_PHASE => flags.push(format!(
-            "implausible: a delay of {} s lags {:.0}° at the band top {} (more than {:.0}°): the phase slope is unmodelled dynamics, not a delay",
-            sig(th[0].abs()),
-            (th[0].abs() * w_max).to_degrees(),
-            fmt_w(w_max),
-            MAX_DELAY_PHASE.to_degrees()
-        )),
-        // A zero-order hold whose Nyquist frequency π/T lies inside the band: the data above
-        // it would be aliases, not a hold's roll-off.
-        Cand::Zoh(_) if std::f64::consts::PI / th[0].exp() < w_max => flags.push(format!(
-            "implausible: a zero-order hold with T = {} s has its Nyquist frequency {} inside the measured band (up to {})",
-            sig(th[0].exp()),
-            fmt_w(std::f64::consts::PI / th[0].exp()),
-            fmt_w(w_max)
-        )),
-        Cand::Lag(_) | Cand::NmpZero(_) | Cand::Zoh(_) | Cand::Friction(_) | Cand::Delay(_)
-            if at(0) =>
-        {
-            flags.push(format!(
-                "{} at its bound: not identified",
-                si.keys().last().cloned().unwrap_or_default()
-            ))
-        }
-        _ => {}
-    }
+    c.flags(
+        th,
+        &at,
+        &si,
+        Band {
+            w_min,
+            w_max,
+            quantity,
+        },
+        &mut flags,
+    );
     (flags, None)
 }
 
