@@ -67,6 +67,7 @@ fn open_loop_noisy_theorem4(bencher: divan::Bencher) {
                 divan::black_box(&data),
                 &radii,
                 &BisectionSettings::default(),
+                &Default::default(),
             )
             .unwrap()
         });

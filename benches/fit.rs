@@ -58,7 +58,7 @@ fn smooth_1000_chained(bencher: divan::Bencher, order: usize) {
         chain: true,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Orders 0..N chained (`chain = true`).
@@ -70,7 +70,7 @@ fn jagged_1000_chained(bencher: divan::Bencher, order: usize) {
         chain: true,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Order N alone (`chain = false`, the default of `fit_unit` and `--order N`).
@@ -82,7 +82,7 @@ fn jagged_1000_unchained(bencher: divan::Bencher, order: usize) {
         chain: false,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Order N alone (`chain = false`), smooth envelope.
@@ -94,7 +94,7 @@ fn smooth_1000_unchained(bencher: divan::Bencher, order: usize) {
         chain: false,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Issue 11: jagged 1000-point envelope, orders 2, 6, 10 (order N alone).
@@ -105,7 +105,7 @@ fn jagged_1000(bencher: divan::Bencher, order: usize) {
         order,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Issue 11: jagged 100,000-point envelope, orders 2, 6, 10 (order N alone).
@@ -116,7 +116,7 @@ fn jagged_100000(bencher: divan::Bencher, order: usize) {
         order,
         ..Default::default()
     };
-    bencher.bench(|| fit_unit(&env, None, &set).expect("fit"));
+    bencher.bench(|| fit_unit(&env, None, &set, &Default::default()).expect("fit"));
 }
 
 /// Issue 21: `--order auto` (orders 0..=8 chained, the order table) on a jagged 2000-point
@@ -125,7 +125,7 @@ fn jagged_100000(bencher: divan::Bencher, order: usize) {
 fn jagged_2000_auto(bencher: divan::Bencher) {
     let env = envelope_n(true, 2000);
     let set = FitSettings::default();
-    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+    bencher.bench(|| fit_auto(&env, None, &set, 8, &Default::default()).expect("fit"));
 }
 
 /// Issue 38: `--order auto` on a smooth 4-decade 2000-point envelope with two bumps
@@ -134,7 +134,7 @@ fn jagged_2000_auto(bencher: divan::Bencher) {
 fn smooth_2000_bumps_auto(bencher: divan::Bencher) {
     let env = random_envelopes::smooth_bumps(2000);
     let set = FitSettings::default();
-    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+    bencher.bench(|| fit_auto(&env, None, &set, 8, &Default::default()).expect("fit"));
 }
 
 /// Issue 38: `--order auto` on the same envelope at 21 points.  Target ≤ 0.2 s.
@@ -142,7 +142,7 @@ fn smooth_2000_bumps_auto(bencher: divan::Bencher) {
 fn smooth_21_bumps_auto(bencher: divan::Bencher) {
     let env = random_envelopes::smooth_bumps(21);
     let set = FitSettings::default();
-    bencher.bench(|| fit_auto(&env, None, &set, 8).expect("fit"));
+    bencher.bench(|| fit_auto(&env, None, &set, 8, &Default::default()).expect("fit"));
 }
 
 /// Issue 38: `--order auto` on each of the 24 random envelopes of the sweep
@@ -156,7 +156,7 @@ fn sweep24_auto(bencher: divan::Bencher) {
     let set = FitSettings::default();
     bencher.bench(|| {
         for env in &envs {
-            fit_auto(env, None, &set, 8).expect("fit");
+            fit_auto(env, None, &set, 8, &Default::default()).expect("fit");
         }
     });
 }
@@ -175,7 +175,7 @@ fn sweep24_order6(bencher: divan::Bencher) {
     };
     bencher.bench(|| {
         for env in &envs {
-            fit_unit(env, None, &set).expect("fit");
+            fit_unit(env, None, &set, &Default::default()).expect("fit");
         }
     });
 }
@@ -200,7 +200,7 @@ fn iss_stability_fit(bencher: divan::Bencher) {
     let f = &config.factorization;
     let a1 = |w: f64| f.a1_limit(w);
     let set = FitSettings::default();
-    bencher.bench(|| fit_auto(&env, Some(&a1), &set, 8).expect("fit"));
+    bencher.bench(|| fit_auto(&env, Some(&a1), &set, 8, &Default::default()).expect("fit"));
 }
 
 /// Issue 21: `run configs/paper_mimo.toml` as the library runs it (envelope, check,

@@ -67,7 +67,18 @@ fn envelope_robot_211_la_0_06(b: Bencher) {
     let (cfg, data) = robot();
     let radius = vec![0.06; data.len()];
     let set = BisectionSettings::default();
-    b.bench(|| black_box(noisy_envelope(&cfg.factorization, &data, &radius, &set).unwrap()));
+    b.bench(|| {
+        black_box(
+            noisy_envelope(
+                &cfg.factorization,
+                &data,
+                &radius,
+                &set,
+                &Default::default(),
+            )
+            .unwrap(),
+        )
+    });
 }
 
 /// The whole 211-point noisy envelope with `L_a = 0.02`: most data need the full search.
@@ -76,7 +87,18 @@ fn envelope_robot_211_la_0_02(b: Bencher) {
     let (cfg, data) = robot();
     let radius = vec![0.02; data.len()];
     let set = BisectionSettings::default();
-    b.bench(|| black_box(noisy_envelope(&cfg.factorization, &data, &radius, &set).unwrap()));
+    b.bench(|| {
+        black_box(
+            noisy_envelope(
+                &cfg.factorization,
+                &data,
+                &radius,
+                &set,
+                &Default::default(),
+            )
+            .unwrap(),
+        )
+    });
 }
 
 /// The whole 211-point noisy envelope with `L_a = 0.005`.
@@ -85,5 +107,16 @@ fn envelope_robot_211_la_0_005(b: Bencher) {
     let (cfg, data) = robot();
     let radius = vec![0.005; data.len()];
     let set = BisectionSettings::default();
-    b.bench(|| black_box(noisy_envelope(&cfg.factorization, &data, &radius, &set).unwrap()));
+    b.bench(|| {
+        black_box(
+            noisy_envelope(
+                &cfg.factorization,
+                &data,
+                &radius,
+                &set,
+                &Default::default(),
+            )
+            .unwrap(),
+        )
+    });
 }

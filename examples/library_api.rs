@@ -15,10 +15,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         order: 2,
         ..Default::default()
     };
-    let fit = fit_unit(&env, Some(&a1), &settings)?;
+    let fit = fit_unit(&env, Some(&a1), &settings, &Default::default())?;
     println!("order 2: worst |r|/r_min = {}", fit.certificate.worst_ratio);
     // The smallest good order among 0..=8, with the order table.
-    let (fit, table) = fit_auto(&env, Some(&a1), &FitSettings::default(), 8)?;
+    let (fit, table) = fit_auto(
+        &env,
+        Some(&a1),
+        &FitSettings::default(),
+        8,
+        &Default::default(),
+    )?;
     println!("auto: order {} of {} tried", fit.order, table.len());
     // The whole job of `rshape fit`: fit, certificate and a report; then the exports
     // (r.json, r.m, r.py, r.jl) into a folder.

@@ -56,7 +56,7 @@
 //! assert!(!report.consistent);
 //! // The smallest certified biproper unit of order 2 above the envelope.
 //! let a1 = |w: f64| config.factorization.a1_limit(w);
-//! let fit = fit_unit(&env, Some(&a1), &FitSettings { order: 2, ..Default::default() })?;
+//! let fit = fit_unit(&env, Some(&a1), &FitSettings { order: 2, ..Default::default() }, &Default::default())?;
 //! assert!(fit.certificate.passed);
 //! assert!(env.omega.iter().zip(&env.r_min).all(|(w, r)| fit.r.freq(*w).norm() >= *r * (1.0 - 1e-9)));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
@@ -93,7 +93,7 @@ pub use consistency::{check, CheckReport, Envelope};
 /// Data in: frequency-response measurements and their CSV reader.
 pub use data::{read_frf_csv, FrfData};
 /// Fit and certificate of the smallest unit `r(s)` above the envelope.
-pub use fit::{fit_auto, fit_unit, Certificate, FitError, FitResult, FitSettings};
+pub use fit::{fit_auto, fit_unit, Certificate, FitError, FitOptions, FitResult, FitSettings};
 /// Model in: a loaded config ([`model::Config`]) and its factorization.
 pub use model::{Config, Factorization};
 pub use pipeline::envelope::{envelope, EnvelopeOutcome};

@@ -34,8 +34,7 @@ pub use noise_free::{
     min_norm_perturbation, r_min_special, r_min_standard, theorem3_x, AssumptionFailure,
 };
 pub use noisy::{
-    gamma_lft, lower_lft, noisy_envelope, noisy_envelope_observed, noisy_envelope_report,
-    noisy_envelope_report_observed, r_min_noisy, v_matrix, BisectionSettings, DatumProgressFn,
-    NoisyDatum, NoisyFailure, NoisyReport,
+    gamma_lft, lower_lft, noisy_envelope, noisy_envelope_report, r_min_noisy, v_matrix,
+    BisectionSettings, DatumProgressFn, EnvelopeOptions, NoisyDatum, NoisyFailure, NoisyReport,
 };
 pub use stream::noise_free_envelope_rows;

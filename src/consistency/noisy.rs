@@ -365,26 +365,26 @@ pub struct NoisyReport {
 /// Hears how many data of how many are done (from any thread; the library never prints).
 pub type DatumProgressFn<'a> = &'a (dyn Fn(usize, usize) + Sync);
 
-/// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].
+/// What a noisy envelope is told besides its settings, none of it changing the result: who
+/// hears of the data done.  `&EnvelopeOptions::default()` (or `&Default::default()`) for none.
+#[derive(Clone, Copy, Default)]
+pub struct EnvelopeOptions<'a> {
+    /// Hears how many data of how many are done.
+    pub progress: Option<DatumProgressFn<'a>>,
+}
+
+/// The noisy envelope with per-datum diagnostics; see [`noisy_envelope`].  The data are
+/// independent, so they are processed in parallel (rayon); the first failing datum in
+/// frequency order is the error, as in a sequential loop.  `options.progress` hears of the
+/// data done.
 pub fn noisy_envelope_report(
     f: &Factorization,
     data: &FrfData,
     radius: &[f64],
     settings: &BisectionSettings,
+    options: &EnvelopeOptions<'_>,
 ) -> Result<NoisyReport> {
-    noisy_envelope_report_observed(f, data, radius, settings, None)
-}
-
-/// As [`noisy_envelope_report`], reporting the data done to `progress`.  The data are
-/// independent, so they are processed in parallel (rayon); the first failing datum in
-/// frequency order is the error, as in a sequential loop.
-pub fn noisy_envelope_report_observed(
-    f: &Factorization,
-    data: &FrfData,
-    radius: &[f64],
-    settings: &BisectionSettings,
-    progress: Option<DatumProgressFn<'_>>,
-) -> Result<NoisyReport> {
+    let progress = options.progress;
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
     settings
@@ -462,19 +462,9 @@ pub fn noisy_envelope(
     data: &FrfData,
     radius: &[f64],
     settings: &BisectionSettings,
+    options: &EnvelopeOptions<'_>,
 ) -> Result<Envelope> {
-    noisy_envelope_observed(f, data, radius, settings, None)
-}
-
-/// As [`noisy_envelope`], reporting the data done to `progress`.
-pub fn noisy_envelope_observed(
-    f: &Factorization,
-    data: &FrfData,
-    radius: &[f64],
-    settings: &BisectionSettings,
-    progress: Option<DatumProgressFn<'_>>,
-) -> Result<Envelope> {
-    let rep = noisy_envelope_report_observed(f, data, radius, settings, progress)?;
+    let rep = noisy_envelope_report(f, data, radius, settings, options)?;
     for (w, d) in rep.envelope.omega.iter().zip(&rep.data) {
         if matches!(d.mu_status, MuStatus::SvdFailed | MuStatus::NonFinite) {
             return Err(Error::Assumption {

@@ -393,10 +393,15 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
             Err(e) => (None, format!("not computed: {e}")),
             Ok(f) => {
                 let frf = siso.as_frf();
-                let noisy = siso
-                    .radius
-                    .as_ref()
-                    .map(|rad| noisy_envelope(&f, &frf, rad, &BisectionSettings::default()));
+                let noisy = siso.radius.as_ref().map(|rad| {
+                    noisy_envelope(
+                        &f,
+                        &frf,
+                        rad,
+                        &BisectionSettings::default(),
+                        &Default::default(),
+                    )
+                });
                 match noisy {
                     Some(Ok(e)) => {
                         exact = true;

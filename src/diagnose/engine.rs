@@ -67,6 +67,8 @@ pub fn diagnose_channels(
     s: &SearchSettings,
 ) -> Result<Diagnosis> {
     let t0 = Instant::now();
+    // Settings first: a bad one is an error even where the search would not run.
+    s.validate().map_err(|e| Error::Invalid(e.to_string()))?;
     if data.is_empty() {
         return Err(Error::Invalid(format!("{}: no data", data.path.display())));
     }

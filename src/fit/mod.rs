@@ -44,7 +44,7 @@ pub(crate) mod spectral;
 pub use basis::Scaling;
 pub use certificate::{certify, CertInput, Certificate};
 pub use order::format_table;
-pub use order::{fit_auto, fit_auto_observed, OrderRow};
+pub use order::{fit_auto, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};
 pub use provenance::{EventKind, Origin, PoleSet};
 pub use realization::realize;
@@ -251,28 +251,28 @@ pub struct FitProgress {
 /// Receives a [`FitProgress`] before each order is fitted.
 pub type ProgressFn<'a> = &'a (dyn Fn(FitProgress) + Sync);
 
+/// What a fit is told besides its settings, none of it changing the result: who hears its
+/// progress.  `&FitOptions::default()` (or `&Default::default()`) for none.
+#[derive(Clone, Copy, Default)]
+pub struct FitOptions<'a> {
+    /// Hears of each order before it is fitted.
+    pub progress: Option<ProgressFn<'a>>,
+}
+
 /// Fits a unit `r(s)` of order `settings.order` above the envelope (see the module doc).
 ///
 /// `a1` is `ω ↦ σ_min(M̃(jω))` when the model is known (for example
 /// `|w| factorization.a1_limit(w)`); without it, A1 is taken from `env.a1_limit` at the data
 /// (interpolated between them) or not enforced.  With `settings.chain`, orders `0..order` are
 /// fitted first and carried forward.  The result is certified; an uncertified fit is an
-/// error carrying it.
+/// error carrying it.  `options.progress` hears of each order before it is fitted.
 pub fn fit_unit(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
+    options: &FitOptions<'_>,
 ) -> Result<FitResult, FitError> {
-    fit_unit_observed(env, a1, settings, None)
-}
-
-/// [`fit_unit`], reporting its progress to `progress`.
-pub fn fit_unit_observed(
-    env: &Envelope,
-    a1: Option<A1Fn<'_>>,
-    settings: &FitSettings,
-    progress: Option<ProgressFn<'_>>,
-) -> Result<FitResult, FitError> {
+    let progress = options.progress;
     let ctx = prepare(env, a1, settings)?;
     let fit_with =
         |set: &FitSettings, solves_before: usize| fit_with(&ctx, set, progress, solves_before);

@@ -5,7 +5,7 @@
 
 use super::context::prepare;
 use super::engine::{fit_order, Scored};
-use super::{A1Fn, EventKind, FitError, FitProgress, FitResult, FitSettings, ProgressFn};
+use super::{A1Fn, EventKind, FitError, FitOptions, FitProgress, FitResult, FitSettings};
 use crate::consistency::Envelope;
 use serde::Serialize;
 
@@ -24,16 +24,6 @@ pub struct OrderRow {
     pub solver_events: usize,
     /// LPs solved for this order (every working-set round counts as one).
     pub lp_solves: usize,
-}
-
-/// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table.
-pub fn fit_auto(
-    env: &Envelope,
-    a1: Option<A1Fn<'_>>,
-    settings: &FitSettings,
-    n_max: usize,
-) -> Result<(FitResult, Vec<OrderRow>), FitError> {
-    fit_auto_observed(env, a1, settings, n_max, None)
 }
 
 /// An order that gains less than this (decades of max `log10 |r|/r_min`) on the order below
@@ -105,14 +95,16 @@ fn recheck_stall(
     }
 }
 
-/// [`fit_auto`], reporting its progress to `progress`.
-pub fn fit_auto_observed(
+/// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table;
+/// `options.progress` hears of each order before it is fitted.
+pub fn fit_auto(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
     settings: &FitSettings,
     n_max: usize,
-    progress: Option<ProgressFn<'_>>,
+    options: &FitOptions<'_>,
 ) -> Result<(FitResult, Vec<OrderRow>), FitError> {
+    let progress = options.progress;
     let ctx = prepare(env, a1, settings)?;
     let mut prev: Option<Scored> = None;
     let mut masks = (Vec::new(), Vec::new());

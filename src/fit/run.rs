@@ -2,8 +2,8 @@
 //! to print.  The fit writes nothing: [`crate::pipeline::write_fit_exports`] writes the
 //! exports of a [`FitOutcome`].  The CLI subcommand is a thin wrapper around both.
 
-use super::order::{fit_auto_observed, format_table, OrderRow};
-use super::{fit_unit_observed, A1Fn, FitError, FitResult, FitSettings, ProgressFn};
+use super::order::{fit_auto, format_table, OrderRow};
+use super::{fit_unit, A1Fn, FitError, FitOptions, FitResult, FitSettings, ProgressFn};
 use crate::consistency::Envelope;
 
 /// `--order N` or `--order auto` (sweep `0..=max`).
@@ -64,10 +64,10 @@ pub fn run_fit(
                 order: n,
                 ..settings.clone()
             };
-            (fit_unit_observed(env, a1, &s, progress)?, None)
+            (fit_unit(env, a1, &s, &FitOptions { progress })?, None)
         }
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto_observed(env, a1, settings, max, progress)?;
+            let (r, t) = fit_auto(env, a1, settings, max, &FitOptions { progress })?;
             (r, Some(t))
         }
     };

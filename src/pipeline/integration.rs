@@ -7,13 +7,13 @@
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
 use crate::consistency::noisy::{
-    gamma_lft, noisy_envelope_observed, BisectionSettings, DatumProgressFn,
+    gamma_lft, noisy_envelope, BisectionSettings, DatumProgressFn, EnvelopeOptions,
 };
 use crate::consistency::{noise_free_envelope, Envelope};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::fit::{
-    fit_auto_observed, fit_unit_observed, FitResult, FitSettings, OrderChoice, OrderRow, ProgressFn,
+    fit_auto, fit_unit, FitOptions, FitResult, FitSettings, OrderChoice, OrderRow, ProgressFn,
 };
 use crate::model::{Config, Factorization};
 use crate::mu::{mu_full_scalar, FullPlusScalar, MuSettings};
@@ -47,7 +47,13 @@ pub(super) fn open_loop_envelope(
     match radii {
         None => Ok((noise_free_envelope(f, data)?, Vec::new())),
         Some(r) => {
-            let env = noisy_envelope_observed(f, data, r, &BisectionSettings::default(), progress)?;
+            let env = noisy_envelope(
+                f,
+                data,
+                r,
+                &BisectionSettings::default(),
+                &EnvelopeOptions { progress },
+            )?;
             let inf = env.r_min.iter().filter(|x| x.is_infinite()).count();
             let w = if inf > 0 {
                 vec![format!("{inf} datum(s) have r_min = ∞: no r explains them with this noise level and model")]
@@ -135,12 +141,12 @@ pub fn fit_r(
     };
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto_observed(env, a1, &base, max, progress)?;
+            let (r, t) = fit_auto(env, a1, &base, max, &FitOptions { progress })?;
             (r, Some(t))
         }
         OrderChoice::Fixed(n) => {
             let s = FitSettings { order: n, ..base };
-            (fit_unit_observed(env, a1, &s, progress)?, None)
+            (fit_unit(env, a1, &s, &FitOptions { progress })?, None)
         }
     };
     let text = crate::report::export::r_json(&result, table.as_deref());

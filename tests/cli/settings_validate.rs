@@ -41,7 +41,14 @@ fn noisy_envelope_names_the_bad_mu_setting() {
         },
         ..Default::default()
     };
-    let e = noisy_envelope(&config.factorization, &data, &[0.01; 3], &settings).unwrap_err();
+    let e = noisy_envelope(
+        &config.factorization,
+        &data,
+        &[0.01; 3],
+        &settings,
+        &Default::default(),
+    )
+    .unwrap_err();
     assert_eq!(
         e.to_string(),
         "MuSettings.max_evals = 0: must be at least 1"
@@ -50,7 +57,14 @@ fn noisy_envelope_names_the_bad_mu_setting() {
         rel_tol: 2.0,
         ..Default::default()
     };
-    let e = noisy_envelope(&config.factorization, &data, &[0.01; 3], &settings).unwrap_err();
+    let e = noisy_envelope(
+        &config.factorization,
+        &data,
+        &[0.01; 3],
+        &settings,
+        &Default::default(),
+    )
+    .unwrap_err();
     assert_eq!(
         e.to_string(),
         "BisectionSettings.rel_tol = 2: must be in (0, 1)"
@@ -61,6 +75,7 @@ fn noisy_envelope_names_the_bad_mu_setting() {
         &data,
         &[0.01; 3],
         &BisectionSettings::default(),
+        &Default::default(),
     )
     .expect("default settings");
     assert_eq!(env.r_min.len(), 3);
@@ -80,7 +95,7 @@ fn fit_names_the_bad_tolerance() {
         bisection_tol: 0.0,
         ..Default::default()
     };
-    let e = fit_unit(&env, None, &settings).unwrap_err();
+    let e = fit_unit(&env, None, &settings, &Default::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
         "FitSettings.bisection_tol = 0: must be in (0, 1)"

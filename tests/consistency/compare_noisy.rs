@@ -20,7 +20,14 @@ fn check(config: &str, radius: Option<f64>) {
         PlantModel::Factored(f) => f.clone(),
     };
     let rad = s.radius.clone().unwrap();
-    let env = noisy_envelope(&f, &s.as_frf(), &rad, &BisectionSettings::default()).unwrap();
+    let env = noisy_envelope(
+        &f,
+        &s.as_frf(),
+        &rad,
+        &BisectionSettings::default(),
+        &Default::default(),
+    )
+    .unwrap();
     let finite: Vec<f64> = env
         .r_min
         .iter()

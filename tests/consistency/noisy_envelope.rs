@@ -199,6 +199,7 @@ fn cross_check_on_robot_dataset() {
         &data,
         &vec![la; data.len()],
         &BisectionSettings::default(),
+        &Default::default(),
     )
     .unwrap();
     let (mut compared, mut zero, mut finite, mut inf, mut worst) = (0, 0, 0, 0, 0.0f64);
@@ -241,6 +242,7 @@ fn zero_noise_equals_theorem3() {
         &data,
         &vec![0.0; data.len()],
         &BisectionSettings::default(),
+        &Default::default(),
     )
     .unwrap();
     let (mut eq, mut inf) = (0, 0);
@@ -399,7 +401,14 @@ fn assumptions_a6_a7() {
     );
     let mut data = robot_data(&cfg);
     data.response[3][(0, 0)] = c(0.0, 0.0);
-    let err = noisy_envelope(&cfg.factorization, &data, &vec![0.06; data.len()], &s).unwrap_err();
+    let err = noisy_envelope(
+        &cfg.factorization,
+        &data,
+        &vec![0.06; data.len()],
+        &s,
+        &Default::default(),
+    )
+    .unwrap_err();
     match err {
         Error::Assumption { omega, msg } => {
             assert_eq!(omega, data.omega[3]);
@@ -419,6 +428,7 @@ fn a1_violations_are_reported() {
         &data,
         &vec![0.06; data.len()],
         &BisectionSettings::default(),
+        &Default::default(),
     )
     .unwrap();
     let r = cfg.r.as_ref().unwrap();

@@ -25,5 +25,6 @@ mod diagnose_pyfrf;
 mod diagnose_realdata;
 mod diagnose_retune_changes;
 mod diagnose_scan;
+mod diagnose_settings;
 mod diagnose_ties;
 mod diagnose_twomass;

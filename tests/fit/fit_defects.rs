@@ -44,8 +44,20 @@ fn zero_rows_do_not_inflate_the_fit() {
             order,
             ..Default::default()
         };
-        let a = fit_unit(&env(omega.clone(), full.clone()), None, &s).unwrap();
-        let b = fit_unit(&env(omega.clone(), zeroed.clone()), None, &s).unwrap();
+        let a = fit_unit(
+            &env(omega.clone(), full.clone()),
+            None,
+            &s,
+            &Default::default(),
+        )
+        .unwrap();
+        let b = fit_unit(
+            &env(omega.clone(), zeroed.clone()),
+            None,
+            &s,
+            &Default::default(),
+        )
+        .unwrap();
         let (la, lb) = (a.certificate.max_log10_ratio, b.certificate.max_log10_ratio);
         // Fewer bounds can only help: the zeroed envelope's level is at most the full one's.
         assert!(
@@ -75,7 +87,8 @@ fn steeply_rising_envelope_is_not_declared_infeasible() {
             order,
             ..Default::default()
         };
-        let f = fit_unit(&e, None, &s).unwrap_or_else(|e| panic!("order {order}: {e}"));
+        let f = fit_unit(&e, None, &s, &Default::default())
+            .unwrap_or_else(|e| panic!("order {order}: {e}"));
         assert!(f.certificate.passed);
         // The constant at the largest bound (6 decades above the smallest) is feasible.
         assert!(f.certificate.max_log10_ratio <= 6.0 + 1e-6);
@@ -115,7 +128,7 @@ fn state_space_agrees_with_num_den_to_1e_12() {
             order,
             ..Default::default()
         };
-        let f = fit_unit(&e, None, &s).unwrap();
+        let f = fit_unit(&e, None, &s, &Default::default()).unwrap();
         let z = Zpk {
             gain: f.gain,
             zeros: f.zeros.clone(),

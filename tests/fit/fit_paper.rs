@@ -82,7 +82,7 @@ fn paper_order1_beats_hand_made_r1() {
         ..Default::default()
     };
     let t0 = std::time::Instant::now();
-    let fit = fit_unit(&env, Some(&a1), &set).unwrap();
+    let fit = fit_unit(&env, Some(&a1), &set, &Default::default()).unwrap();
     let dt = t0.elapsed();
     let lr = log_ratios(&fit.r, &env);
     let mean = lr.iter().sum::<f64>() / lr.len() as f64;
@@ -120,7 +120,7 @@ fn paper_order1_beats_hand_made_r1() {
         objective: Objective::Area,
         ..Default::default()
     };
-    let fit = fit_unit(&env, Some(&a1), &set).unwrap();
+    let fit = fit_unit(&env, Some(&a1), &set, &Default::default()).unwrap();
     let lr = log_ratios(&fit.r, &env);
     println!("area: mean {}", lr.iter().sum::<f64>() / 5.0);
     assert!(lr.iter().all(|l| *l >= 0.0));
@@ -132,7 +132,7 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
             objective,
             ..Default::default()
         };
-        let (fit, rows) = fit_auto(env, a1, &set, 6).unwrap();
+        let (fit, rows) = fit_auto(env, a1, &set, 6, &Default::default()).unwrap();
         println!(
             "{name} {objective:?}:\n{}",
             rshape::fit::format_table(&rows, fit.order, set.auto_tolerance)
@@ -160,7 +160,7 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
             chain: true,
             ..Default::default()
         };
-        let fit = fit_unit(env, a1, &set).unwrap();
+        let fit = fit_unit(env, a1, &set, &Default::default()).unwrap();
         let m = fit.certificate.mean_log10_ratio;
         assert!(m <= prev + 1e-9, "{name}: order {n} mean {m} > {prev}");
         prev = m;
@@ -186,14 +186,14 @@ fn beyond_a1_is_reported_with_frequencies() {
     let (_, mut env) = paper();
     let a1 = env.a1_limit.clone().unwrap();
     env.r_min[2] = a1[2] * 1.5;
-    let e = fit_unit(&env, None, &FitSettings::default()).unwrap_err();
+    let e = fit_unit(&env, None, &FitSettings::default(), &Default::default()).unwrap_err();
     let msg = e.to_string();
     assert!(
         msg.contains("model must change") && msg.contains("1.000000e0"),
         "{msg}"
     );
     env.r_min[2] = f64::INFINITY;
-    let e = fit_unit(&env, None, &FitSettings::default()).unwrap_err();
+    let e = fit_unit(&env, None, &FitSettings::default(), &Default::default()).unwrap_err();
     assert!(e.to_string().contains("r_min = inf"), "{e}");
 }
 
@@ -212,6 +212,7 @@ fn conservatism_does_not_increase_with_order_shipped_robot() {
         &data,
         &radii,
         &rshape::consistency::BisectionSettings::default(),
+        &Default::default(),
     )
     .unwrap();
     assert!(env.r_min.iter().any(|r| *r > 0.0) && env.r_min.iter().all(|r| r.is_finite()));

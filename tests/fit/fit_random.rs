@@ -95,7 +95,8 @@ fn random_envelopes_give_certified_units() {
             (env.omega[env.omega.len() - 1] / env.omega[0]).log10()
         );
         let t0 = std::time::Instant::now();
-        let fit = fit_unit(&env, None, &set).unwrap_or_else(|e| panic!("{tag}: {e}"));
+        let fit = fit_unit(&env, None, &set, &Default::default())
+            .unwrap_or_else(|e| panic!("{tag}: {e}"));
         worst_time = worst_time.max(t0.elapsed().as_secs_f64());
         assert!(
             fit.certificate.passed,

@@ -334,7 +334,7 @@ fn sweep(list: &[(usize, usize)], min_pairs: usize) {
             order,
             ..Default::default()
         };
-        let fit = fit_unit(&env, None, &set)
+        let fit = fit_unit(&env, None, &set, &Default::default())
             .unwrap_or_else(|e| panic!("envelope {k}, order {order}: {e}"));
         assert!(fit.certificate.passed, "envelope {k}, order {order}");
         let ours = fit.certificate.max_log10_ratio;
@@ -388,7 +388,7 @@ fn higher_order_never_worse_and_auto_never_worse_than_its_best() {
             method: EnvelopeMethod::File,
         };
         let set = FitSettings::default();
-        let (fit, rows) = rshape::fit::fit_auto(&env, None, &set, 4)
+        let (fit, rows) = rshape::fit::fit_auto(&env, None, &set, 4, &Default::default())
             .unwrap_or_else(|e| panic!("envelope {k}: {e}"));
         assert!(fit.certificate.passed, "envelope {k}");
         let ok: Vec<_> = rows.iter().filter(|r| r.status == "ok").collect();
@@ -436,7 +436,8 @@ fn steep_rise_is_fitted_near_the_reference_at_orders_1_to_3() {
             order,
             ..Default::default()
         };
-        let fit = fit_unit(&env, None, &set).unwrap_or_else(|e| panic!("order {order}: {e}"));
+        let fit = fit_unit(&env, None, &set, &Default::default())
+            .unwrap_or_else(|e| panic!("order {order}: {e}"));
         assert!(fit.certificate.passed, "order {order}");
         let ours = fit.certificate.max_log10_ratio;
         let reference = reference_level(&omega, &r_min, order, set.floor_rel)

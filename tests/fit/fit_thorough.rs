@@ -38,7 +38,7 @@ fn route(config: &Config, controller: &Controller, thorough: bool) -> Route {
         thorough,
         ..Default::default()
     };
-    let (fit, table) = fit_auto(&env, Some(&a1), &set, 8).expect("fit");
+    let (fit, table) = fit_auto(&env, Some(&a1), &set, 8, &Default::default()).expect("fit");
     assert!(fit.certificate.passed);
     let out = rshape::pipeline::stability::run(
         config,

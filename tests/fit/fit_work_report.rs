@@ -3,7 +3,7 @@
 //! `N LPs in T s` by default and the solver events only with `--verbose`.
 
 use rshape::consistency::{Envelope, EnvelopeMethod};
-use rshape::fit::{fit_auto_observed, fit_unit_observed, FitProgress, FitSettings};
+use rshape::fit::{fit_auto, fit_unit, FitOptions, FitProgress, FitSettings};
 use rshape::system::logspace;
 use std::process::Command;
 use std::sync::Mutex;
@@ -36,8 +36,10 @@ fn lps_per_order_add_up_and_progress_hears_every_order() {
     let env = envelope(300);
     let heard = Mutex::new(Vec::<FitProgress>::new());
     let progress = |p: FitProgress| heard.lock().unwrap().push(p);
-    let (fit, rows) =
-        fit_auto_observed(&env, None, &FitSettings::default(), 4, Some(&progress)).unwrap();
+    let options = FitOptions {
+        progress: Some(&progress),
+    };
+    let (fit, rows) = fit_auto(&env, None, &FitSettings::default(), 4, &options).unwrap();
     assert!(fit.certificate.passed);
     let sum: usize = rows.iter().map(|r| r.lp_solves).sum();
     assert_eq!(sum, fit.lp_solves, "{rows:?}");
@@ -65,7 +67,10 @@ fn a_fixed_order_reports_its_order_and_its_lps() {
         order: 3,
         ..Default::default()
     };
-    let fit = fit_unit_observed(&env, None, &set, Some(&progress)).unwrap();
+    let options = FitOptions {
+        progress: Some(&progress),
+    };
+    let fit = fit_unit(&env, None, &set, &options).unwrap();
     let heard = heard.into_inner().unwrap();
     assert_eq!(heard.first().map(|p| (p.order, p.last_order)), Some((3, 3)));
     assert!(fit.lp_solves > 0);
