@@ -42,6 +42,29 @@ pub enum Error {
         /// Which assumption and what to do.
         msg: String,
     },
+    /// An input file that cannot serve as given: not the kind of file expected, or its
+    /// content does not fit the model or the run (sizes, channels, frequencies, missing
+    /// parts).  The message says what is wrong and what to do.
+    #[error("{}: {msg}", path.display())]
+    Input {
+        /// The file (or the data set named by it).
+        path: PathBuf,
+        /// What is wrong and what to do.
+        msg: String,
+    },
+    /// A command-line argument (or the library setting it stands for) out of its range or
+    /// not applicable: `--band 5:1: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX`.
+    #[error("{arg}: {msg}")]
+    Argument {
+        /// The argument with its value, as given (`--band 5:1`).
+        arg: String,
+        /// What is wrong and what to do.
+        msg: String,
+    },
+    /// A settings field out of its range (`FitSettings.margin = -1: must be a finite number
+    /// ≥ 0`).
+    #[error(transparent)]
+    Setting(#[from] crate::settings::InvalidSetting),
     /// Inputs that do not fit together (sizes, missing parts).
     #[error("{0}")]
     Invalid(String),
@@ -67,10 +90,21 @@ impl Error {
     }
 
     /// The same error with `; hint` appended to its message, its kind kept for
-    /// [`Error::Invalid`] and [`Error::Numerical`]; `None` for the other kinds.
+    /// [`Error::Invalid`], [`Error::Input`], [`Error::Argument`] and [`Error::Numerical`]
+    /// (a [`Error::Setting`] becomes an [`Error::Invalid`] with the same text); `Err(self)`
+    /// for the other kinds.
     pub fn with_hint(self, hint: &str) -> std::result::Result<Self, Self> {
         match self {
             Self::Invalid(msg) => Ok(Self::Invalid(format!("{msg}; {hint}"))),
+            Self::Input { path, msg } => Ok(Self::Input {
+                path,
+                msg: format!("{msg}; {hint}"),
+            }),
+            Self::Argument { arg, msg } => Ok(Self::Argument {
+                arg,
+                msg: format!("{msg}; {hint}"),
+            }),
+            Self::Setting(s) => Ok(Self::Invalid(format!("{s}; {hint}"))),
             Self::Numerical { what, msg } => Ok(Self::Numerical {
                 what,
                 msg: format!("{msg}; {hint}"),
@@ -102,6 +136,45 @@ pub type Result<T> = std::result::Result<T, Error>;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::Path;
+
+    /// The typed kinds read as the `Invalid(format!(…))` messages they replaced, and keep
+    /// their kind (and path) under a hint.
+    #[test]
+    fn typed_kinds_read_as_the_messages_they_replaced() {
+        let e = Error::Input {
+            path: "data/a.csv".into(),
+            msg: "2 noise radii for 3 data".into(),
+        };
+        assert_eq!(e.to_string(), "data/a.csv: 2 noise radii for 3 data");
+        let h = e.with_hint("check the std file").unwrap();
+        assert!(matches!(&h, Error::Input { path, .. } if path == Path::new("data/a.csv")));
+        assert_eq!(
+            h.to_string(),
+            "data/a.csv: 2 noise radii for 3 data; check the std file"
+        );
+        let e = Error::Argument {
+            arg: "--band 5:1".into(),
+            msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
+        };
+        assert_eq!(
+            e.to_string(),
+            "--band 5:1: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX"
+        );
+        let s = crate::settings::InvalidSetting {
+            settings: "SearchSettings",
+            field: "beam",
+            value: "0".into(),
+            requirement: "must be at least 1",
+        };
+        let e = Error::from(s.clone());
+        assert_eq!(e.to_string(), "SearchSettings.beam = 0: must be at least 1");
+        assert!(matches!(&e, Error::Setting(x) if *x == s));
+        assert_eq!(
+            e.with_hint("h").unwrap().to_string(),
+            "SearchSettings.beam = 0: must be at least 1; h"
+        );
+    }
 
     #[test]
     fn a_numerical_failure_reads_as_the_message_it_replaced() {

@@ -27,10 +27,10 @@ pub fn write_atomic_nosync(path: &Path, contents: &[u8]) -> Result<()> {
 /// `/dev/null`, a FIFO, a socket): the atomic rename would replace it with a regular file.
 pub fn check_not_special(path: &Path) -> Result<()> {
     match std::fs::metadata(path) {
-        Ok(m) if !m.is_file() && !m.is_dir() => Err(Error::Invalid(format!(
-            "{}: is a device, FIFO or socket, not a regular file; rshape writes results to regular files only: give a file name",
-            path.display()
-        ))),
+        Ok(m) if !m.is_file() && !m.is_dir() => Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: "is a device, FIFO or socket, not a regular file; rshape writes results to regular files only: give a file name".into(),
+        }),
         _ => Ok(()),
     }
 }
@@ -207,10 +207,10 @@ fn create_dir_error(dir: &Path, source: std::io::Error) -> Error {
         .find(|a| a.exists() || a.as_os_str().is_empty())
         .is_some_and(|a| !a.as_os_str().is_empty() && a.is_dir());
     if source.kind() == std::io::ErrorKind::NotFound && parent_exists {
-        return Error::Invalid(format!(
-            "{}: the folder cannot be created there (the file system refuses new folders): choose a writable location",
-            dir.display()
-        ));
+        return Error::Input {
+            path: dir.to_path_buf(),
+            msg: "the folder cannot be created there (the file system refuses new folders): choose a writable location".into(),
+        };
     }
     Error::Io {
         path: dir.to_path_buf(),
@@ -230,11 +230,13 @@ pub(crate) fn open_regular(path: &Path) -> Result<std::fs::File> {
         return Err(io(std::io::Error::from(std::io::ErrorKind::IsADirectory)));
     }
     if !meta.is_file() {
-        return Err(Error::Invalid(format!(
-            "{}: not a regular file ({}): give a file on disk",
-            path.display(),
-            file_kind(&meta)
-        )));
+        return Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: format!(
+                "not a regular file ({}): give a file on disk",
+                file_kind(&meta)
+            ),
+        });
     }
     std::fs::File::open(path).map_err(io)
 }
@@ -251,11 +253,10 @@ pub(crate) fn read_regular(path: &Path, cap: u64) -> Result<Vec<u8>> {
             source,
         })?;
     if bytes.len() as u64 > cap {
-        return Err(Error::Invalid(format!(
-            "{}: larger than {} MB: is this the right file?",
-            path.display(),
-            cap >> 20
-        )));
+        return Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: format!("larger than {} MB: is this the right file?", cap >> 20),
+        });
     }
     Ok(bytes)
 }

@@ -68,10 +68,10 @@ pub fn discover_dir(dir: &Path) -> Result<Vec<Dataset>> {
         .collect();
     paths.sort();
     if paths.is_empty() {
-        return Err(Error::Invalid(format!(
-            "{}: no *.csv dataset in this directory",
-            dir.display()
-        )));
+        return Err(Error::Input {
+            path: dir.to_path_buf(),
+            msg: "no *.csv dataset in this directory".into(),
+        });
     }
     let list = paths
         .into_iter()

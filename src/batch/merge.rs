@@ -54,8 +54,9 @@ pub fn merge_then(
     let mut first: Option<BatchReport> = None;
     for dir in shards {
         let bj = dir.join("batch.json");
-        let rep: BatchReport = serde_json::from_str(&read(&bj)?).map_err(|e| {
-            Error::Invalid(format!("{}: not a batch.json of rshape: {e}", bj.display()))
+        let rep: BatchReport = serde_json::from_str(&read(&bj)?).map_err(|e| Error::Input {
+            path: bj.to_path_buf(),
+            msg: format!("not a batch.json of rshape: {e}"),
         })?;
         if let Some(f) = &first {
             // Shards of different configs would mix two models' envelopes under one r.
@@ -64,22 +65,26 @@ pub fn merge_then(
                 _ => f.config != rep.config,
             } || f.closed_loop != rep.closed_loop;
             if differ {
-                return Err(Error::Invalid(format!(
-                    "{}: this shard was made from the config {} ({}), the first one from {} ({}): merge only the shards of one batch (same config)",
-                    dir.display(),
-                    rep.config.display(),
-                    rep.config_digest.as_deref().unwrap_or("no digest"),
-                    f.config.display(),
-                    f.config_digest.as_deref().unwrap_or("no digest")
-                )));
+                return Err(Error::Input {
+                    path: dir.to_path_buf(),
+                    msg: format!(
+                        "this shard was made from the config {} ({}), the first one from {} ({}): merge only the shards of one batch (same config)",
+                        rep.config.display(),
+                        rep.config_digest.as_deref().unwrap_or("no digest"),
+                        f.config.display(),
+                        f.config_digest.as_deref().unwrap_or("no digest"),
+                    ),
+                });
             }
             if f.n_total != rep.n_total {
-                return Err(Error::Invalid(format!(
-                    "{}: this shard comes from a batch of {} datasets, the first one from a batch of {}",
-                    dir.display(),
-                    rep.n_total,
-                    f.n_total
-                )));
+                return Err(Error::Input {
+                    path: dir.to_path_buf(),
+                    msg: format!(
+                        "this shard comes from a batch of {} datasets, the first one from a batch of {}",
+                        rep.n_total,
+                        f.n_total,
+                    ),
+                });
             }
         }
         let sp = dir.join("summary.csv");

@@ -91,10 +91,10 @@ fn fill(
 ) -> Result<()> {
     let data = crate::pipeline::envelope::load_data(config, &d.path)?;
     if data.is_empty() {
-        return Err(Error::Invalid(format!(
-            "{}: no data rows",
-            d.path.display()
-        )));
+        return Err(Error::Input {
+            path: d.path.to_path_buf(),
+            msg: "no data rows".into(),
+        });
     }
     res.n_data = data.len();
     let options = crate::pipeline::RunOptions::noise_radius(d.noise_radius.or(opts.noise_radius));

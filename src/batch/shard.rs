@@ -20,8 +20,10 @@ impl Shard {
 
     /// Parses `K/N`.
     pub fn parse(s: &str) -> Result<Self> {
-        let bad = || {
-            Error::Invalid(format!("--shard `{s}`: expected K/N with 0 ≤ K < N, e.g. 0/4 (K is 0-based, like $SLURM_ARRAY_TASK_ID)"))
+        let bad = || Error::Argument {
+            arg: format!("--shard `{s}`"),
+            msg: "expected K/N with 0 ≤ K < N, e.g. 0/4 (K is 0-based, like $SLURM_ARRAY_TASK_ID)"
+                .into(),
         };
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let (k, n): (usize, usize) = (

@@ -78,14 +78,16 @@ pub fn check_sizes(f: &Factorization, data: &FrfData) -> Result<()> {
 /// Checks that `p×m` data read from `path` have the sizes the model needs.
 pub fn check_shape(f: &Factorization, path: &std::path::Path, p: usize, m: usize) -> Result<()> {
     if p != f.outputs() || m != f.inputs() {
-        return Err(Error::Invalid(format!(
-            "{}: the data are {}×{} (outputs×inputs) but the model is {}×{}; select a channel or fix the model",
-            path.display(),
-            p,
-            m,
-            f.outputs(),
-            f.inputs()
-        )));
+        return Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: format!(
+                "the data are {}×{} (outputs×inputs) but the model is {}×{}; select a channel or fix the model",
+                p,
+                m,
+                f.outputs(),
+                f.inputs(),
+            ),
+        });
     }
     Ok(())
 }

@@ -387,24 +387,19 @@ pub fn noisy_envelope_report(
     let progress = options.progress;
     use rayon::prelude::*;
     use std::sync::atomic::{AtomicUsize, Ordering};
-    settings
-        .validate()
-        .map_err(|e| Error::Invalid(e.to_string()))?;
+    settings.validate()?;
     check_sizes(f, data)?;
     if data.outputs() != 1 || data.inputs() != 1 {
-        return Err(Error::Invalid(format!(
-            "{}: {}",
-            data.path.display(),
-            NoisyFailure::NotSiso.message()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!("{}", NoisyFailure::NotSiso.message()),
+        });
     }
     if radius.len() != data.len() {
-        return Err(Error::Invalid(format!(
-            "{}: {} noise radii for {} data",
-            data.path.display(),
-            radius.len(),
-            data.len()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!("{} noise radii for {} data", radius.len(), data.len()),
+        });
     }
     let total = data.len();
     let done = AtomicUsize::new(0);

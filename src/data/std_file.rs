@@ -148,11 +148,9 @@ impl StdData {
         out: usize,
         inp: usize,
     ) -> Result<Vec<f64>> {
-        let col = self.std.get(&(out, inp)).ok_or_else(|| {
-            Error::Invalid(format!(
-                "{}: no column {prefix}_{out}_{inp} for the selected channel",
-                path.display()
-            ))
+        let col = self.std.get(&(out, inp)).ok_or_else(|| Error::Input {
+            path: path.to_path_buf(),
+            msg: format!("no column {prefix}_{out}_{inp} for the selected channel"),
         })?;
         omega
             .iter()
@@ -162,11 +160,13 @@ impl StdData {
                     .position(|x| (x - w).abs() <= 1e-6 * w)
                     .map(|k| col[k])
                     .ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "{}: no {prefix} at omega = {w} rad/s ({} Hz) of the data: the file's frequencies must match the FRF file's",
-                            path.display(),
-                            w / (2.0 * std::f64::consts::PI)
-                        ))
+                        Error::Input {
+                            path: path.to_path_buf(),
+                            msg: format!(
+                                "no {prefix} at omega = {w} rad/s ({} Hz) of the data: the file's frequencies must match the FRF file's",
+                                w / (2.0 * std::f64::consts::PI),
+                            ),
+                        }
                     })
             })
             .collect()

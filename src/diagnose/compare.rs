@@ -140,35 +140,41 @@ pub fn prepare(
         .unwrap_or((1, 1));
     let (out, inp) = chan;
     if out == 0 || inp == 0 || out > data.outputs() || inp > data.inputs() {
-        return Err(Error::Invalid(format!(
-            "{}: channel ({out},{inp}) is not in the data ({}×{} outputs×inputs)",
-            data.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "channel ({out},{inp}) is not in the data ({}×{} outputs×inputs)",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     }
     let model_entry = if mp == 1 && mm == 1 {
         (0, 0)
     } else if mp == data.outputs() && mm == data.inputs() {
         (out - 1, inp - 1)
     } else {
-        return Err(Error::Invalid(format!(
-            "{}: the model is {mp}×{mm} but the data are {}×{}; give a SISO model or one of the data's size",
-            config.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: config.path.to_path_buf(),
+            msg: format!(
+                "the model is {mp}×{mm} but the data are {}×{}; give a SISO model or one of the data's size",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     };
     if channel.is_none()
         && config.raw.channel.is_none()
         && (data.outputs() > 1 || data.inputs() > 1)
     {
-        return Err(Error::Invalid(format!(
-            "{}: the data are {}×{}: choose the SISO channel to compare with [channel] output/input or --channel OUT,IN",
-            data.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "the data are {}×{}: choose the SISO channel to compare with [channel] output/input or --channel OUT,IN",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     }
     let ch = data.channel(out - 1, inp - 1);
     let resolved = resolve_noise_for_channel(noise_override, Some(config), data, chan)?;
@@ -179,12 +185,13 @@ pub fn prepare(
     let radius = resolved.map(|r| r.radii);
     if let Some(r) = &radius {
         if let Some(k) = r.iter().position(|x| x.is_nan() || *x <= 0.0) {
-            return Err(Error::Invalid(format!(
-                "{}: noise radius {} at omega = {} rad/s must be positive",
-                data.path.display(),
-                r[k],
-                ch.omega[k]
-            )));
+            return Err(Error::Input {
+                path: data.path.to_path_buf(),
+                msg: format!(
+                    "noise radius {} at omega = {} rad/s must be positive",
+                    r[k], ch.omega[k],
+                ),
+            });
         }
     }
     Ok(Siso {

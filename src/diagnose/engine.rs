@@ -68,9 +68,12 @@ pub fn diagnose_channels(
 ) -> Result<Diagnosis> {
     let t0 = Instant::now();
     // Settings first: a bad one is an error even where the search would not run.
-    s.validate().map_err(|e| Error::Invalid(e.to_string()))?;
+    s.validate()?;
     if data.is_empty() {
-        return Err(Error::Invalid(format!("{}: no data", data.path.display())));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: "no data".into(),
+        });
     }
     let before = measures(base, data)?;
     let n = data.n_data();
@@ -449,24 +452,31 @@ pub fn apply_candidate(
     rank: usize,
     force: bool,
 ) -> Result<PhysicalModel> {
-    let c = d.candidates.get(rank.wrapping_sub(1)).ok_or_else(|| {
-        Error::Invalid(format!(
-            "--apply {rank}: there are {} candidates (1..={})",
-            d.candidates.len(),
-            d.candidates.len()
-        ))
-    })?;
+    let c = d
+        .candidates
+        .get(rank.wrapping_sub(1))
+        .ok_or_else(|| Error::Argument {
+            arg: format!("--apply {rank}"),
+            msg: format!(
+                "there are {} candidates (1..={})",
+                d.candidates.len(),
+                d.candidates.len()
+            ),
+        })?;
     if let Some(why) = &c.no_fit {
-        return Err(Error::Invalid(format!(
-            "--apply {rank}: {} has no fit ({why})",
-            c.effect
-        )));
+        return Err(Error::Argument {
+            arg: format!("--apply {rank}"),
+            msg: format!("{} has no fit ({why})", c.effect),
+        });
     }
     if let (Some(why), false) = (c.rejection(), force) {
-        return Err(Error::Invalid(format!(
-            "--apply {rank}: {} was rejected: {why}; add --force to write it anyway",
-            c.effect
-        )));
+        return Err(Error::Argument {
+            arg: format!("--apply {rank}"),
+            msg: format!(
+                "{} was rejected: {why}; add --force to write it anyway",
+                c.effect
+            ),
+        });
     }
     Ok(c.model.clone())
 }
@@ -481,9 +491,9 @@ pub fn apply_chosen(d: &Diagnosis) -> Result<PhysicalModel> {
             "--apply chosen: the model already explains the data within the noise; nothing to write"
                 .into(),
         )),
-        DiagnoseVerdict::NoEffectFound => Err(Error::Invalid(format!(
-            "--apply chosen: no effect set was chosen ({}); nothing to write",
-            d.message
-        ))),
+        DiagnoseVerdict::NoEffectFound => Err(Error::Argument {
+            arg: "--apply chosen".into(),
+            msg: format!("no effect set was chosen ({}); nothing to write", d.message),
+        }),
     }
 }

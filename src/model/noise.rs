@@ -82,12 +82,14 @@ pub fn radii_from_output_bound(
     data: &FrfData,
 ) -> Result<Vec<f64>> {
     if data.outputs() != 1 || data.inputs() != 1 {
-        return Err(Error::Invalid(format!(
-            "{}: [noise] output_bound (Sec. III) is defined for SISO data; these are {}×{}",
-            data.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "[noise] output_bound (Sec. III) is defined for SISO data; these are {}×{}",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     }
     data.omega
         .iter()
@@ -209,9 +211,10 @@ pub fn resolve_noise_for_channel(
         (NoiseSource::CliFlag, _) => {
             let r = cli_radius.unwrap_or_default();
             if !(r.is_finite() && r >= 0.0) {
-                return Err(Error::Invalid(format!(
-                    "--noise-radius {r}: must be a finite number ≥ 0"
-                )));
+                return Err(Error::Argument {
+                    arg: format!("--noise-radius {r}"),
+                    msg: "must be a finite number ≥ 0".into(),
+                });
             }
             ResolvedNoise {
                 radii: all(r),
@@ -242,12 +245,10 @@ pub fn resolve_noise_for_channel(
         _ => {
             let col = data.noise_radius.clone().unwrap_or_default();
             if col.len() != data.len() {
-                return Err(Error::Invalid(format!(
-                    "{}: {} noise radii for {} data",
-                    data.path.display(),
-                    col.len(),
-                    data.len()
-                )));
+                return Err(Error::Input {
+                    path: data.path.to_path_buf(),
+                    msg: format!("{} noise radii for {} data", col.len(), data.len()),
+                });
             }
             ResolvedNoise {
                 radii: col,
@@ -302,12 +303,14 @@ fn coherence_noise(
     } else if (1..=data.outputs()).contains(&out) && (1..=data.inputs()).contains(&inp) {
         (out - 1, inp - 1)
     } else {
-        return Err(Error::Invalid(format!(
-            "{}: channel ({out}, {inp}) of [noise] coherence is not in the {}×{} data",
-            data.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "channel ({out}, {inp}) of [noise] coherence is not in the {}×{} data",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     };
     let radii = gamma2
         .iter()
@@ -349,11 +352,13 @@ fn file_for_data(
             .unwrap_or_default();
         let sib = data.path.with_file_name(format!("{stem}_{suffix}.csv"));
         if !sib.exists() {
-            return Err(Error::Invalid(format!(
-                "{}: the config's [noise] {key} belongs to its own data; put {} beside these data or pass --noise-radius",
-                data.path.display(),
-                sib.display()
-            )));
+            return Err(Error::Input {
+                path: data.path.to_path_buf(),
+                msg: format!(
+                    "the config's [noise] {key} belongs to its own data; put {} beside these data or pass --noise-radius",
+                    sib.display(),
+                ),
+            });
         }
         sib
     })

@@ -186,10 +186,10 @@ pub fn open_loop_equivalent(
         out.lines.push(data.lines.get(i).copied().unwrap_or(0));
     }
     if out.is_empty() {
-        return Err(crate::error::Error::Invalid(format!(
-            "{}: no datum has a recoverable open-loop plant (the experiment's sensitivity is singular everywhere)",
-            data.path.display()
-        )));
+        return Err(crate::error::Error::Input {
+            path: data.path.to_path_buf(),
+            msg: "no datum has a recoverable open-loop plant (the experiment's sensitivity is singular everywhere)".into(),
+        });
     }
     Ok(OpenLoopEquivalent { data: out, dropped })
 }

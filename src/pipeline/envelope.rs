@@ -45,12 +45,14 @@ pub fn envelope(
         && config.closed_loop.is_none()
         && (data.outputs() != 1 || data.inputs() != 1)
     {
-        return Err(Error::Invalid(format!(
-            "{}: noisy consistency (Theorem 4) is for SISO data, these are {}×{}; select a channel with [channel] or pass --noise-radius 0",
-            data.path.display(),
-            data.outputs(),
-            data.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "noisy consistency (Theorem 4) is for SISO data, these are {}×{}; select a channel with [channel] or pass --noise-radius 0",
+                data.outputs(),
+                data.inputs(),
+            ),
+        });
     }
     let (envelope, warnings, closed_loop) =
         closed_loop::envelope_by_kind(config, data, radii.as_deref(), options.envelope_progress)?;

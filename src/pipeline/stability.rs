@@ -22,25 +22,25 @@ struct RFile {
 /// Reads the `r` of an `r.json` written by `rshape fit` or `rshape run` (keys `num`, `den`).
 pub fn read_r_json(path: &Path) -> Result<TransferFunction> {
     let text = crate::util::read_text_file(path)?;
-    let r: RFile = serde_json::from_str(&text).map_err(|e| {
-        Error::Invalid(format!(
-            "{}: {e}; expected the r.json of `rshape fit` (keys num, den)",
-            path.display()
-        ))
+    let r: RFile = serde_json::from_str(&text).map_err(|e| Error::Input {
+        path: path.to_path_buf(),
+        msg: format!("{e}; expected the r.json of `rshape fit` (keys num, den)"),
     })?;
     if r.num.iter().chain(&r.den).any(|v| !v.is_finite()) || r.den.iter().all(|v| *v == 0.0) {
-        return Err(Error::Invalid(format!(
-            "{}: num/den must be finite, den non-zero",
-            path.display()
-        )));
+        return Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: "num/den must be finite, den non-zero".into(),
+        });
     }
     let r = TransferFunction::new(r.num, r.den);
     if let Some(why) = r.unit_violation() {
-        return Err(Error::Invalid(format!(
-            "{}: r = {} is not a unit of RH∞: {why}; Theorem 1 needs a stable, minimum-phase, biproper r (the r.json of `rshape fit` is one)",
-            path.display(),
-            r.brief()
-        )));
+        return Err(Error::Input {
+            path: path.to_path_buf(),
+            msg: format!(
+                "r = {} is not a unit of RH∞: {why}; Theorem 1 needs a stable, minimum-phase, biproper r (the r.json of `rshape fit` is one)",
+                r.brief(),
+            ),
+        });
     }
     Ok(r)
 }

@@ -127,7 +127,10 @@ pub fn plant_factors(config: &Config, path: &Path) -> Result<Arc<NormalizedLcf>>
     let g = crate::stability::plant_system(&config.factorization)?.minimal(1e-10);
     NormalizedLcf::new(g)
         .map(Arc::new)
-        .map_err(|e| Error::Invalid(format!("{}: the plant of the factors: {e}", path.display())))
+        .map_err(|e| Error::Input {
+            path: path.to_path_buf(),
+            msg: format!("the plant of the factors: {e}"),
+        })
 }
 
 /// Synthesizes the Glover–McFarlane controller of the config's plant and proves it with the
@@ -209,9 +212,12 @@ pub fn run(
             let from = gm.k.states();
             let abscissa = spectral_abscissa(&eigenvalues(&gm.k.a, "controller poles")?);
             if abscissa.is_nan() || abscissa >= 0.0 {
-                return Err(Error::Invalid(format!(
-                    "--reduce {order}: the controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce"
-                )));
+                return Err(Error::Argument {
+                    arg: format!("--reduce {order}"),
+                    msg: format!(
+                        "the controller is unstable (pole with real part {abscissa:.3e}); balanced truncation needs a stable controller: drop --reduce",
+                    ),
+                });
             }
             let (kr, hsv) = gm.k.balanced_truncation(order)?;
             gm.k = kr;

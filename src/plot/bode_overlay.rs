@@ -376,8 +376,9 @@ pub fn bode_overlay(
     data: &BodeData,
     models: &[ModelCurve],
 ) -> Result<()> {
-    let svg = bode_svg(title, data, models).map_err(|e| {
-        crate::error::Error::Invalid(format!("{}: cannot draw the figure: {e}", path.display()))
+    let svg = bode_svg(title, data, models).map_err(|e| crate::error::Error::Input {
+        path: path.to_path_buf(),
+        msg: format!("cannot draw the figure: {e}"),
     })?;
     crate::util::write_atomic(path, svg.as_bytes())
 }

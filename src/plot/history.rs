@@ -297,7 +297,10 @@ pub fn error_history(
     invalid_fraction: &[f64],
 ) -> Result<()> {
     let svg = history_svg(title, labels, misfit_rms, invalid_fraction).map_err(|e| {
-        crate::error::Error::Invalid(format!("{}: cannot draw the figure: {e}", path.display()))
+        crate::error::Error::Input {
+            path: path.to_path_buf(),
+            msg: format!("cannot draw the figure: {e}"),
+        }
     })?;
     crate::util::write_atomic(path, svg.as_bytes())
 }

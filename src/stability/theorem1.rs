@@ -143,14 +143,16 @@ pub fn analyze(
 ) -> Result<(RobustStability, GridCurve)> {
     let k = controller.negative_feedback_gain();
     if k.d.shape() != (f.inputs(), f.outputs()) {
-        return Err(Error::Invalid(format!(
-            "{}: the controller is {}×{} but must be {}×{} (plant inputs × plant outputs)",
-            controller.path.display(),
-            k.d.nrows(),
-            k.d.ncols(),
-            f.inputs(),
-            f.outputs()
-        )));
+        return Err(Error::Input {
+            path: controller.path.to_path_buf(),
+            msg: format!(
+                "the controller is {}×{} but must be {}×{} (plant inputs × plant outputs)",
+                k.d.nrows(),
+                k.d.ncols(),
+                f.inputs(),
+                f.outputs(),
+            ),
+        });
     }
     let t = theorem1_system(f, &k)?;
     let poles = eigenvalues(&t.a, "closed-loop poles")?;

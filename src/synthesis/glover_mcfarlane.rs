@@ -216,10 +216,10 @@ pub const MAX_GAMMA_FACTOR: f64 = 1e3;
 /// Validates `--gamma-factor` (`1 < factor ≤ 1e3`), before any work.
 pub fn check_gamma_factor(factor: f64) -> Result<()> {
     if !(factor.is_finite() && factor > 1.0 && factor <= MAX_GAMMA_FACTOR) {
-        return Err(Error::Invalid(format!(
-            "--gamma-factor {}: must be a number with 1 < factor ≤ 1000 (γ = factor·γ_min; the central controller is undefined at γ_min, and 1.1 is the usual practice)",
-            crate::report::fmt::sig(factor)
-        )));
+        return Err(Error::Argument {
+            arg: format!("--gamma-factor {}", crate::report::fmt::sig(factor)),
+            msg: "must be a number with 1 < factor ≤ 1000 (γ = factor·γ_min; the central controller is undefined at γ_min, and 1.1 is the usual practice)".into(),
+        });
     }
     Ok(())
 }

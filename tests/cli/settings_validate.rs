@@ -69,6 +69,18 @@ fn noisy_envelope_names_the_bad_mu_setting() {
         e.to_string(),
         "BisectionSettings.rel_tol = 2: must be in (0, 1)"
     );
+    // A typed kind a library user can match on, its message unchanged.
+    assert!(matches!(e, rshape::Error::Setting(ref s) if s.field == "rel_tol"));
+    let e = noisy_envelope(
+        &config.factorization,
+        &data,
+        &[0.01; 2],
+        &BisectionSettings::default(),
+        &Default::default(),
+    )
+    .unwrap_err();
+    assert_eq!(e.to_string(), "d.csv: 2 noise radii for 3 data");
+    assert!(matches!(e, rshape::Error::Input { ref path, .. } if path == Path::new("d.csv")));
     // The defaults work.
     let env = noisy_envelope(
         &config.factorization,

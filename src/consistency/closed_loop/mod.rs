@@ -76,14 +76,16 @@ impl ClosedLoopReport {
 
 fn check_sizes(model: &ClosedLoopModel, data: &FrfData) -> Result<()> {
     if data.outputs() != model.outputs() || data.inputs() != model.inputs() {
-        return Err(Error::Invalid(format!(
-            "{}: the closed-loop data are {}×{} (outputs×references) but the plant is {}×{}; fix the data or the [closed_loop] table",
-            data.path.display(),
-            data.outputs(),
-            data.inputs(),
-            model.outputs(),
-            model.inputs()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "the closed-loop data are {}×{} (outputs×references) but the plant is {}×{}; fix the data or the [closed_loop] table",
+                data.outputs(),
+                data.inputs(),
+                model.outputs(),
+                model.inputs(),
+            ),
+        });
     }
     Ok(())
 }
@@ -110,26 +112,24 @@ pub fn closed_loop_envelope(
     radii: Option<&[f64]>,
     settings: &VBisectionSettings,
 ) -> Result<ClosedLoopReport> {
-    settings
-        .validate()
-        .map_err(|e| Error::Invalid(e.to_string()))?;
+    settings.validate()?;
     check_sizes(model, data)?;
     if let Some(r) = radii {
         if data.outputs() != 1 || data.inputs() != 1 {
-            return Err(Error::Invalid(format!(
-                "{}: the noisy closed-loop test (Theorem 2) is for SISO data, these are {}×{}; pass --noise-radius 0 for the noise-free test",
-                data.path.display(),
-                data.outputs(),
-                data.inputs()
-            )));
+            return Err(Error::Input {
+                path: data.path.to_path_buf(),
+                msg: format!(
+                    "the noisy closed-loop test (Theorem 2) is for SISO data, these are {}×{}; pass --noise-radius 0 for the noise-free test",
+                    data.outputs(),
+                    data.inputs(),
+                ),
+            });
         }
         if r.len() != data.len() {
-            return Err(Error::Invalid(format!(
-                "{}: {} noise radii for {} data",
-                data.path.display(),
-                r.len(),
-                data.len()
-            )));
+            return Err(Error::Input {
+                path: data.path.to_path_buf(),
+                msg: format!("{} noise radii for {} data", r.len(), data.len()),
+            });
         }
     }
     let mut rows = Vec::with_capacity(data.len());

@@ -58,10 +58,10 @@ impl Channels {
     /// One SISO channel (the noise radius must be known).
     pub fn from_siso(s: &Siso) -> Result<Self> {
         let radius = s.radius.clone().ok_or_else(|| {
-            Error::Invalid(format!(
-                "{}: diagnose needs the noise radius: pass --noise-radius X, add a noise_radius column, or [noise] radius / std_file / coherence",
-                s.path.display()
-            ))
+            Error::Input {
+                path: s.path.to_path_buf(),
+                msg: "diagnose needs the noise radius: pass --noise-radius X, add a noise_radius column, or [noise] radius / std_file / coherence".into(),
+            }
         })?;
         Ok(Self {
             path: s.path.clone(),
@@ -92,18 +92,22 @@ impl Channels {
                 }
             }
         }
-        let out =
-            out.ok_or_else(|| Error::Invalid(format!("{}: no channel", data.path.display())))?;
+        let out = out.ok_or_else(|| Error::Input {
+            path: data.path.to_path_buf(),
+            msg: "no channel".into(),
+        })?;
         let mut e = out.entries.clone();
         e.sort();
         e.dedup();
         if e.len() != out.entries.len() {
-            return Err(Error::Invalid(format!(
-                "{}: the data have {} channels but the model {} is SISO: describe every output and input in the model, or pick one channel with --channel OUT,IN",
-                data.path.display(),
-                out.entries.len(),
-                config.path.display()
-            )));
+            return Err(Error::Input {
+                path: data.path.to_path_buf(),
+                msg: format!(
+                    "the data have {} channels but the model {} is SISO: describe every output and input in the model, or pick one channel with --channel OUT,IN",
+                    out.entries.len(),
+                    config.path.display(),
+                ),
+            });
         }
         Ok(out)
     }
@@ -113,9 +117,10 @@ impl Channels {
     pub fn band(&self, f_lo: f64, f_hi: f64) -> Result<Self> {
         let tau = std::f64::consts::TAU;
         if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
-            return Err(Error::Invalid(format!(
-                "--band {f_lo}:{f_hi}: give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX"
-            )));
+            return Err(Error::Argument {
+                arg: format!("--band {f_lo}:{f_hi}"),
+                msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
+            });
         }
         let keep: Vec<usize> = (0..self.len())
             // Hz from rad/s carries rounding: a line at exactly FMIN or FMAX is kept.
@@ -125,12 +130,15 @@ impl Channels {
             })
             .collect();
         if keep.len() < 2 {
-            return Err(Error::Invalid(format!(
-                "--band {f_lo}:{f_hi}: {} of the data's lines lie in it (the data span {} … {} Hz); at least 2 are needed",
-                keep.len(),
-                crate::report::fmt::sig(self.omega.first().copied().unwrap_or(0.0) / tau),
-                crate::report::fmt::sig(self.omega.last().copied().unwrap_or(0.0) / tau)
-            )));
+            return Err(Error::Argument {
+                arg: format!("--band {f_lo}:{f_hi}"),
+                msg: format!(
+                    "{} of the data's lines lie in it (the data span {} … {} Hz); at least 2 are needed",
+                    keep.len(),
+                    crate::report::fmt::sig(self.omega.first().copied().unwrap_or(0.0) / tau),
+                    crate::report::fmt::sig(self.omega.last().copied().unwrap_or(0.0) / tau),
+                ),
+            });
         }
         fn pick<T: Copy>(v: &[Vec<T>], keep: &[usize]) -> Vec<Vec<T>> {
             v.iter()

@@ -50,10 +50,10 @@ impl Mods {
 pub fn check_shapes(base: &PhysicalModel, data: &Channels) -> Result<()> {
     let (p, m) = (base.n_outputs(), base.n_inputs());
     if data.entries.iter().any(|(o, i)| *o >= p || *i >= m) {
-        return Err(Error::Invalid(format!(
-            "{}: the data channels do not fit the {p}×{m} model",
-            data.path.display()
-        )));
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!("the data channels do not fit the {p}×{m} model"),
+        });
     }
     if data.n_ch() > 1 && p > 1 && m > 1 {
         return Err(Error::Invalid(

@@ -237,8 +237,7 @@ pub fn search(
     s: &SearchSettings,
     mut first_screen: Option<Vec<Screened>>,
 ) -> Result<SearchResult> {
-    s.validate()
-        .map_err(|e| crate::error::Error::Invalid(e.to_string()))?;
+    s.validate()?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut level: Vec<usize> = (0..roots.len()).collect();
     // The configured model: the anchor of every refit's boxes.
