@@ -392,7 +392,7 @@ pub fn noisy_envelope_report(
     if data.outputs() != 1 || data.inputs() != 1 {
         return Err(Error::Input {
             path: data.path.to_path_buf(),
-            msg: format!("{}", NoisyFailure::NotSiso.message()),
+            msg: NoisyFailure::NotSiso.message().to_string(),
         });
     }
     if radius.len() != data.len() {

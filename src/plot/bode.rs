@@ -49,7 +49,7 @@ fn model_phase(inp: &BodeInput, ch: (usize, usize)) -> Vec<f64> {
 /// phase at the nearest grid point (data and model never sit 360° apart); unwrapped along the
 /// data where the model is unknown.
 fn data_phases(inp: &BodeInput, ch: (usize, usize), model: &[f64]) -> Vec<f64> {
-    let near = |p: f64, to: f64| p + 360.0 * ((to - p) / 360.0).round();
+    let near = super::phase::nearest_branch;
     let mut out: Vec<f64> = Vec::with_capacity(inp.omega.len());
     for (k, w) in inp.omega.iter().enumerate() {
         let p = phase_deg(inp.data[k][ch]);
@@ -267,11 +267,7 @@ fn panel<DB: DrawingBackend>(
         let r = radius(k);
         if r > 0.0 {
             // The disk of radius r around z subtends ±asin(r/|z|) (all angles if it holds 0).
-            let half = if r >= z.norm() {
-                180.0
-            } else {
-                (r / z.norm()).asin().to_degrees()
-            };
+            let half = super::phase::disk_half_span_deg(r, z.norm());
             let (lo, hi) = (axis.clamp(ang - half), axis.clamp(ang + half));
             ph.draw_series(std::iter::once(PathElement::new(
                 vec![(*w, lo), (*w, hi)],

@@ -85,7 +85,7 @@ fn data_phase(g: &[Complex64], reference: Option<&[f64]>) -> Vec<f64> {
     let Some(r) = reference else {
         return unwrap_deg(g);
     };
-    let near = |p: f64, to: f64| p + 360.0 * ((to - p) / 360.0).round();
+    let near = crate::plot::phase::nearest_branch;
     let mut out: Vec<f64> = Vec::with_capacity(g.len());
     for (z, m) in g.iter().zip(r) {
         let p = z.arg().to_degrees();
@@ -203,11 +203,7 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
             } else {
                 m0
             });
-            let half = if *r < a {
-                (r / a).asin().to_degrees()
-            } else {
-                180.0
-            };
+            let half = crate::plot::phase::disk_half_span_deg(*r, a);
             upper_ph.push((p + half).min(p1));
             lower_ph.push((p - half).max(p0));
         }

@@ -21,6 +21,7 @@ pub(crate) mod bode_overlay;
 pub(crate) mod fine;
 pub(crate) mod history;
 pub(crate) mod mu;
+pub(crate) mod phase;
 pub(crate) mod r_vs_delta;
 pub(crate) mod stability;
 pub(crate) mod style;

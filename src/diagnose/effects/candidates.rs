@@ -13,58 +13,17 @@
 
 use crate::diagnose::effects::effect::{Band, Effect, Explain, Site, Stands, Writer};
 use crate::diagnose::effects::with_effect;
-use crate::model::physical::{Gains, PhysicalModel};
+use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 use std::collections::BTreeMap;
 
 pub use crate::diagnose::effects::{Cand, EFFECT_NAMES};
 
+pub use crate::diagnose::effects::effect::Sel;
 pub use crate::report::fmt::{fmt_change, fmt_w, sig};
 
 /// Names of modes and terms `diagnose` adds start with this.
 pub const ADDED_NOTE: &str = "added by rshape diagnose";
-
-/// The channels a multiplicative effect acts on (0-based).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Sel {
-    /// Every channel.
-    All,
-    /// The channels of one output (a sensor effect).
-    Output(usize),
-    /// The channels of one input (an actuator effect).
-    Input(usize),
-}
-
-impl Sel {
-    /// True when the effect acts on the model entry `(output, input)`.
-    pub fn hits(&self, entry: (usize, usize)) -> bool {
-        match self {
-            Sel::All => true,
-            Sel::Output(o) => entry.0 == *o,
-            Sel::Input(i) => entry.1 == *i,
-        }
-    }
-
-    pub(crate) fn suffix(&self) -> String {
-        match self {
-            Sel::All => String::new(),
-            Sel::Output(o) => format!(" (output {})", o + 1),
-            Sel::Input(i) => format!(" (input {})", i + 1),
-        }
-    }
-}
-
-/// Lower and upper bound of a damping ratio.
-pub const ZETA_BOUNDS: (f64, f64) = (1e-4, 0.7);
-
-pub(crate) fn clamp_zeta(z: f64) -> f64 {
-    z.clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1)
-}
-
-/// The residue `c_o b_i / m` of a term at a model entry.
-pub fn residue(c: &Gains, b: &Gains, m: f64, p: usize, n_in: usize, e: (usize, usize)) -> f64 {
-    c.to_vec(p)[e.0] * b.to_vec(n_in)[e.1] / m
-}
 
 /// The name of effect `E`.
 fn name_of<E: Effect>(_: &E) -> &'static str {

@@ -1,8 +1,7 @@
 //! A changed damping of a configured mode: θ = [ln ζ].  Not tried by the search (the retune
 //! refits the model's own dampings); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::candidates::{clamp_zeta, fmt_w, residue, sig, Cand, Sel, ZETA_BOUNDS};
-use crate::diagnose::effects::effect::{grid_best, log_grid, one, Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{clamp_zeta, fmt_w, grid_best, log_grid, one, residue, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer, ZETA_BOUNDS};
 use crate::diagnose::effects::mode::mode_term;
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
@@ -14,11 +13,11 @@ pub struct Damping(pub usize);
 impl Effect for Damping {
     const NAME: &'static str = "damping";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

@@ -1,8 +1,7 @@
 //! A pure delay `e^{−sτ}` on a path (transport or computation delay): θ = \[τ\] (s, `|τ|`
 //! used).
 
-use crate::diagnose::effects::candidates::{fmt_w, sig, Cand, Sel};
-use crate::diagnose::effects::effect::{at_bound_flag, one, pick, Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, one, pick, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -17,11 +16,11 @@ pub struct Delay(pub Sel);
 impl Effect for Delay {
     const NAME: &'static str = "delay";
 
-    fn tried_on(sel: Sel) -> Vec<Cand> {
-        vec![Cand::Delay(sel)]
+    fn tried_on(sel: Sel) -> Vec<Self> {
+        vec![Delay(sel)]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

@@ -9,10 +9,53 @@
 //! physical model, its starting points, its plausibility flags, its prior rank among
 //! near-ties and the plain-language explanation of its signature.
 
-use crate::diagnose::effects::candidates::{Cand, Sel};
 use crate::model::physical::{EffectKind, EffectPath, EffectSpec, Gains, PhysicalModel, Quantity};
 use num_complex::Complex64;
 use std::collections::BTreeMap;
+
+pub use crate::report::fmt::{fmt_change, fmt_w, sig};
+
+/// The channels a multiplicative effect acts on (0-based).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sel {
+    /// Every channel.
+    All,
+    /// The channels of one output (a sensor effect).
+    Output(usize),
+    /// The channels of one input (an actuator effect).
+    Input(usize),
+}
+
+impl Sel {
+    /// True when the effect acts on the model entry `(output, input)`.
+    pub fn hits(&self, entry: (usize, usize)) -> bool {
+        match self {
+            Sel::All => true,
+            Sel::Output(o) => entry.0 == *o,
+            Sel::Input(i) => entry.1 == *i,
+        }
+    }
+
+    pub(crate) fn suffix(&self) -> String {
+        match self {
+            Sel::All => String::new(),
+            Sel::Output(o) => format!(" (output {})", o + 1),
+            Sel::Input(i) => format!(" (input {})", i + 1),
+        }
+    }
+}
+
+/// Lower and upper bound of a damping ratio.
+pub const ZETA_BOUNDS: (f64, f64) = (1e-4, 0.7);
+
+pub(crate) fn clamp_zeta(z: f64) -> f64 {
+    z.clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1)
+}
+
+/// The residue `c_o b_i / m` of a term at a model entry.
+pub fn residue(c: &Gains, b: &Gains, m: f64, p: usize, n_in: usize, e: (usize, usize)) -> f64 {
+    c.to_vec(p)[e.0] * b.to_vec(n_in)[e.1] / m
+}
 
 /// One physical effect of the catalogue.  Every method is required: a new effect states each
 /// of them (no catch-all can give it another effect's answer).
@@ -22,11 +65,15 @@ pub trait Effect: Copy {
 
     /// The candidates of this effect tried on the channels `sel` (path effects; none for
     /// the others), in the order they are tried.
-    fn tried_on(sel: Sel) -> Vec<Cand>;
+    fn tried_on(sel: Sel) -> Vec<Self>
+    where
+        Self: Sized;
 
     /// The candidates of this effect tried once on `base` (additive terms; none for path
     /// effects).
-    fn tried(base: &PhysicalModel) -> Vec<Cand>;
+    fn tried(base: &PhysicalModel) -> Vec<Self>
+    where
+        Self: Sized;
 
     /// The channels a path effect acts on; `None` for an additive term (which changes
     /// `core`, not `path`).

@@ -1,7 +1,6 @@
 //! An added feedthrough `D` (the upper residual of modes above the band); θ = [d_1 … d_C].
 
-use crate::diagnose::effects::candidates::{Cand, Sel};
-use crate::diagnose::effects::effect::{per_channel, Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{per_channel, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{Feedthrough as Spec, PhysicalModel, Quantity};
 use num_complex::Complex64;
 
@@ -12,12 +11,12 @@ pub struct Feedthrough;
 impl Effect for Feedthrough {
     const NAME: &'static str = "feedthrough";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
-        vec![Cand::Feedthrough]
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
+        vec![Feedthrough]
     }
 
     fn sel(&self) -> Option<Sel> {

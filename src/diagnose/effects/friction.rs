@@ -1,10 +1,7 @@
 //! Viscous friction on rigid body `i` of the configured model: `1/s²` becomes
 //! `1/(s (s + p))`; θ = [ln p].  Tried on each rigid body without a friction pole.
 
-use crate::diagnose::effects::candidates::{fmt_w, residue, Cand, Sel};
-use crate::diagnose::effects::effect::{
-    at_bound_flag, grid_best, log_grid, one, Band, Effect, Explain, Si, Site, Stands, Writer,
-};
+use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, residue, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
@@ -15,16 +12,16 @@ pub struct Friction(pub usize);
 impl Effect for Friction {
     const NAME: &'static str = "friction";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(base: &PhysicalModel) -> Vec<Cand> {
+    fn tried(base: &PhysicalModel) -> Vec<Self> {
         base.rigid_body
             .iter()
             .enumerate()
             .filter(|(_, r)| r.friction_pole.is_none())
-            .map(|(i, _)| Cand::Friction(i))
+            .map(|(i, _)| Friction(i))
             .collect()
     }
 

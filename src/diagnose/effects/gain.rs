@@ -1,9 +1,8 @@
 //! A gain error `k` on a path: θ = \[k\].  Not tried by the search (the retune refits the
 //! model's own gains); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::candidates::{sig, Cand, Sel};
 use crate::diagnose::effects::candidates::fmt_change;
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Si, Site, Stands, Writer, one};
+use crate::diagnose::effects::effect::{one, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -14,12 +13,12 @@ pub struct Gain(pub Sel);
 impl Effect for Gain {
     const NAME: &'static str = "gain";
 
-    fn tried_on(sel: Sel) -> Vec<Cand> {
+    fn tried_on(sel: Sel) -> Vec<Self> {
         let _ = sel;
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

@@ -1,8 +1,7 @@
 //! An added `c_ch/s^order`: order 1 an integrator, order 2 a rigid body (or the lower
 //! residual of modes below the band); θ = [c_1 … c_C].
 
-use crate::diagnose::effects::candidates::{Cand, Sel};
-use crate::diagnose::effects::effect::{one, per_channel, Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{one, per_channel, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{PhysicalModel, PoleAtZeroSpec, Quantity};
 use num_complex::Complex64;
 
@@ -13,12 +12,12 @@ pub struct Integrator(pub u8);
 impl Effect for Integrator {
     const NAME: &'static str = "integrator";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
-        vec![Cand::Integrator(1), Cand::Integrator(2)]
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
+        vec![Integrator(1), Integrator(2)]
     }
 
     fn sel(&self) -> Option<Sel> {

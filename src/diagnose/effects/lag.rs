@@ -1,7 +1,6 @@
 //! A first-order lag `1/(1 + s/ω_c)` on a path (an actuator or a sensor): θ = [ln ω_c].
 
-use crate::diagnose::effects::candidates::{fmt_w, Cand, Sel};
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Si, Site, Stands, Writer, at_bound_flag, grid_best, log_grid, one};
+use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -12,11 +11,11 @@ pub struct Lag(pub Sel);
 impl Effect for Lag {
     const NAME: &'static str = "lag";
 
-    fn tried_on(sel: Sel) -> Vec<Cand> {
-        vec![Cand::Lag(sel)]
+    fn tried_on(sel: Sel) -> Vec<Self> {
+        vec![Lag(sel)]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

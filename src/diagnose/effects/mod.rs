@@ -1,6 +1,7 @@
 //! The catalogue of physical effects (docs/design/effects.md): the bottom layer of
 //! [`crate::diagnose`], using nothing of the layers above.
-//! * `effect`: the [`effect::Effect`] trait each effect implements;
+//! * `effect`: the [`effect::Effect`] trait each effect implements, with what every effect
+//!   shares (the channel selection `Sel`, the ζ bounds, a term's residue);
 //! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
 //!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`), registered below;
 //! * `candidates`: the candidate [`Cand`] (one variant per registered effect) and what it
@@ -39,14 +40,23 @@ macro_rules! register {
 
         /// The candidates tried on a model: the path effects on each channel selection of
         /// `sels` (in turn), then the additive terms of `base`.
-        pub(crate) fn tried(base: &crate::model::physical::PhysicalModel, sels: &[candidates::Sel]) -> Vec<Cand> {
+        pub(crate) fn tried(base: &crate::model::physical::PhysicalModel, sels: &[effect::Sel]) -> Vec<Cand> {
             let mut v = Vec::new();
             for s in sels {
-                $( v.extend(<$module::$ty as effect::Effect>::tried_on(*s)); )*
+                $( v.extend(<$module::$ty as effect::Effect>::tried_on(*s).into_iter().map(IntoCand::into_cand)); )*
             }
-            $( v.extend(<$module::$ty as effect::Effect>::tried(base)); )*
+            $( v.extend(<$module::$ty as effect::Effect>::tried(base).into_iter().map(IntoCand::into_cand)); )*
             v
         }
+
+        $(
+            impl IntoCand for $module::$ty {
+                fn into_cand(self) -> Cand {
+                    let e = self;
+                    $crate::diagnose::effects::cand_of!($variant, e $(, $target)?)
+                }
+            }
+        )*
 
         /// `with_effect!(c, e => body)`: `body` with `e` the effect of candidate `c`.
         macro_rules! with_effect {
@@ -74,6 +84,25 @@ macro_rules! cand_pattern {
 }
 pub(crate) use cand_pattern;
 
+/// An effect value as its candidate (made by the registration list; crate-private, so the
+/// effect types stay private).
+pub(crate) trait IntoCand {
+    /// The candidate of this effect.
+    fn into_cand(self) -> Cand;
+}
+
+/// The candidate of an effect value `$e` of a registered variant (its target is `$e.0`).
+macro_rules! cand_of {
+    ($variant:ident, $e:ident, $target:ty) => {
+        $crate::diagnose::effects::Cand::$variant($e.0)
+    };
+    ($variant:ident, $e:ident) => {{
+        let _ = $e;
+        $crate::diagnose::effects::Cand::$variant
+    }};
+}
+pub(crate) use cand_of;
+
 /// The effect of a registered variant, from its target `$t` when it has one.
 macro_rules! effect_of {
     ($module:ident :: $ty:ident, $t:ident, $target:ty) => {
@@ -87,17 +116,17 @@ pub(crate) use effect_of;
 
 register! { $
     /// Pure delay `e^{−sτ}`; θ = \[τ\] (s, |τ| used).
-    Delay(candidates::Sel) => delay::Delay,
+    Delay(effect::Sel) => delay::Delay,
     /// First-order lag; θ = [ln ω_c].
-    Lag(candidates::Sel) => lag::Lag,
+    Lag(effect::Sel) => lag::Lag,
     /// NMP zero all-pass; θ = [ln z].
-    NmpZero(candidates::Sel) => nmp_zero::NmpZero,
+    NmpZero(effect::Sel) => nmp_zero::NmpZero,
     /// Zero-order hold; θ = [ln T].
-    Zoh(candidates::Sel) => zoh::Zoh,
+    Zoh(effect::Sel) => zoh::Zoh,
     /// Gain; θ = \[k\].
-    Gain(candidates::Sel) => gain::Gain,
+    Gain(effect::Sel) => gain::Gain,
     /// Sign flip; no parameter.
-    Sign(candidates::Sel) => sign::Sign,
+    Sign(effect::Sel) => sign::Sign,
     /// Added mode `ρ_ch/(s² + 2ζω s + ω²)`; θ = [ln ω_n, ln ζ, ρ_1 … ρ_C] (one residue per
     /// channel, shared `ω_n` and `ζ`).
     Mode => mode::Mode,

@@ -2,10 +2,7 @@
 //! one `ω_n` and `ζ` shared by every channel and a residue per channel; θ = [ln ω_n, ln ζ,
 //! ρ_1 … ρ_C].
 
-use crate::diagnose::effects::candidates::{clamp_zeta, fmt_w, sig, Cand, Sel, ZETA_BOUNDS};
-use crate::diagnose::effects::effect::{
-    log_grid, one, per_channel, Band, Effect, Explain, Si, Site, Stands, Writer,
-};
+use crate::diagnose::effects::effect::{clamp_zeta, fmt_w, log_grid, one, per_channel, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer, ZETA_BOUNDS};
 use crate::model::physical::{ModeSpec, PhysicalModel};
 use num_complex::Complex64;
 
@@ -22,12 +19,12 @@ pub fn mode_term(omega: f64, w: f64, z: f64, rho: f64) -> Complex64 {
 impl Effect for Mode {
     const NAME: &'static str = "mode";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
-        vec![Cand::Mode]
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
+        vec![Mode]
     }
 
     fn sel(&self) -> Option<Sel> {

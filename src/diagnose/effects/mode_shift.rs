@@ -1,8 +1,7 @@
 //! A shifted frequency of a configured mode: θ = [ln ω_n].  Not tried by the search (the
 //! retune refits the model's own frequencies); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::candidates::{fmt_change, fmt_w, residue, Cand, Sel};
-use crate::diagnose::effects::effect::{grid_best, one, Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{fmt_change, fmt_w, grid_best, one, residue, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::diagnose::effects::mode::mode_term;
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
@@ -14,11 +13,11 @@ pub struct ModeShift(pub usize);
 impl Effect for ModeShift {
     const NAME: &'static str = "mode_shift";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

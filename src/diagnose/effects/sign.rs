@@ -1,8 +1,7 @@
 //! A sign flip `−1` on a path: no parameter.  Not tried by the search (the retune refits the
 //! model's own gains, signs included); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::candidates::{Cand, Sel};
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -13,11 +12,11 @@ pub struct Sign(pub Sel);
 impl Effect for Sign {
     const NAME: &'static str = "sign";
 
-    fn tried_on(_: Sel) -> Vec<Cand> {
+    fn tried_on(_: Sel) -> Vec<Self> {
         vec![]
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 

@@ -1,8 +1,7 @@
 //! A zero-order hold `e^{−sT/2}·sinc(ωT/2)` on a path: θ = [ln T].  Tried on every channel
 //! and on each input (an actuator-side effect), not on a sensor.
 
-use crate::diagnose::effects::candidates::{fmt_w, sig, Cand, Sel};
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Si, Site, Stands, Writer, at_bound_flag, grid_best, log_grid, one};
+use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -13,15 +12,15 @@ pub struct Zoh(pub Sel);
 impl Effect for Zoh {
     const NAME: &'static str = "zoh";
 
-    fn tried_on(sel: Sel) -> Vec<Cand> {
+    fn tried_on(sel: Sel) -> Vec<Self> {
         if matches!(sel, Sel::Output(_)) {
             vec![]
         } else {
-            vec![Cand::Zoh(sel)]
+            vec![Zoh(sel)]
         }
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Cand> {
+    fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![]
     }
 
