@@ -97,8 +97,10 @@ pub const EFFECT_NAMES: [&str; 13] = [
     "friction",
 ];
 
-/// Lower and upper bound of a damping ratio.
-pub const ZETA_BOUNDS: (f64, f64) = (1e-4, 0.7);
+/// Lower and upper bound of a damping ratio in any model (the fits' lower bound is the
+/// record's floor, `lsq::resolution::band_floor`, above this; the model refuses
+/// `ζ < 1e-12`).
+pub const ZETA_BOUNDS: (f64, f64) = (1e-9, 0.7);
 
 fn clamp_zeta(z: f64) -> f64 {
     z.clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1)
@@ -183,11 +185,12 @@ impl Cand {
 
     /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`
     /// (docs/design/effects.md step 3): an added mode resonates inside the band (an out-of-band one is a
-    /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [1e-4, 0.7]`,
-    /// corners and zeros within two decades of the band, a delay below 100/ω_min.
-    pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+    /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [ζ_lo, 0.7]`
+    /// (`ζ_lo` the record's floor, `lsq::resolution::band_floor`), corners and zeros
+    /// within two decades of the band, a delay below 100/ω_min.
+    pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
         let free = (f64::NEG_INFINITY, f64::INFINITY);
-        let lz = (ZETA_BOUNDS.0.ln(), ZETA_BOUNDS.1.ln());
+        let lz = (zeta_lo.max(ZETA_BOUNDS.0).ln(), ZETA_BOUNDS.1.ln());
         match self {
             Cand::Delay(_) => vec![(-100.0 / w_min, 100.0 / w_min)],
             Cand::Lag(_) | Cand::NmpZero(_) => vec![((w_min / 100.0).ln(), (w_max * 100.0).ln())],

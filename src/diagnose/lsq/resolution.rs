@@ -26,7 +26,7 @@ pub const MIN_LINES_IN_BAND: usize = 3;
 
 /// No floor below this (the model refuses `ζ < 1e-12`; a refit that wants less is at
 /// rounding level).
-pub const ZETA_FLOOR_MIN: f64 = 1e-9;
+pub const ZETA_FLOOR_MIN: f64 = crate::diagnose::effects::candidates::ZETA_BOUNDS.0;
 /// The floor lies this factor below the damping the lines can resolve.
 pub const FLOOR_MARGIN: f64 = 0.5;
 
@@ -91,6 +91,18 @@ pub fn zeta_range(data: &Channels, w: f64) -> ZetaRange {
         floor,
         resolved: MIN_LINES_IN_BAND as f64 * dw / (2.0 * w),
     }
+}
+
+/// The lowest [`ZetaRange::floor`] over the lines of `data`: the lower bound on `ζ` of every
+/// refit and screen (a mode may sit anywhere in the band; below its own floor the
+/// likelihood is flat anyway).  Replaces the fixed bound 1e-4 that held real modes of
+/// ζ ≈ 1e-4 measured on dense lines (issue 33).
+pub fn band_floor(data: &Channels) -> f64 {
+    data.omega
+        .iter()
+        .map(|w| zeta_range(data, *w).floor)
+        .fold(f64::INFINITY, f64::min)
+        .max(ZETA_FLOOR_MIN)
 }
 
 #[cfg(test)]

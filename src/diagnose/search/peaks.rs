@@ -328,8 +328,8 @@ fn probe_mode(
         &fit.theta,
         v,
         &data.entries,
-        data.omega[0],
-        *data.omega.last().expect("data"),
+        (data.omega[0], *data.omega.last().expect("data")),
+        pb.zeta_floor,
         pb.base.quantity,
     );
     flags.extend(no_fit);
