@@ -201,7 +201,15 @@ pub fn diagnose_channels(
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
         + &unreached_modes(&peaks);
     if verdict == DiagnoseVerdict::NoEffectFound {
-        message += &stop_explanation(&res.refused, after.v, n as f64 - node.n_params as f64 / 2.0);
+        let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
+        let white = crate::diagnose::lsq::whiteness::whiteness(
+            &z,
+            node.n_params,
+            (data.len() / 50).max(5),
+        );
+        message += &stop_explanation(&res.refused, &white, |k| {
+            data.omega[k] / std::f64::consts::TAU
+        });
     }
     Ok(Diagnosis {
         verdict,
@@ -354,13 +362,14 @@ fn unreached_modes(peaks: &[crate::diagnose::report::Peak]) -> String {
 }
 
 /// Why nothing was added, for a stop: the effects the likelihood wanted but admissibility
-/// refused (with their rules), and the size of the remaining misfit against the stated
-/// noise (`V / E V`; above 1 either dynamics are missing or the data's own scatter exceeds
-/// the stated σ, and `std_factor × √(V/E V)` is the radius that would cover it).
+/// refused (with their rules), and what the remaining misfit is
+/// ([`crate::diagnose::lsq::whiteness`]): white at the stated noise (nothing more to find),
+/// white above it (the data's own scatter exceeds the stated σ: `std_factor × √(V/E V)`
+/// would cover it), or structured (missing dynamics, and where).
 fn stop_explanation(
     refused: &[(usize, crate::diagnose::admissible::Refusal)],
-    v: f64,
-    ev: f64,
+    white: &crate::diagnose::lsq::whiteness::Whiteness,
+    hz: impl Fn(usize) -> f64,
 ) -> String {
     let mut out = String::new();
     if !refused.is_empty() {
@@ -376,20 +385,9 @@ fn stop_explanation(
             names.join(", ")
         );
     }
-    if ev > 0.0 && v.is_finite() {
-        let ratio = v / ev;
-        if ratio > 1.5 {
-            out += &format!(
-                "; the residual is {}× the stated noise (V/E[V]): if no dynamics are missing, the data scatter more than the stated σ and std_factor × {} would cover it",
-                sig(ratio),
-                sig(ratio.sqrt())
-            );
-        } else {
-            out += &format!(
-                "; the residual is at the stated noise (V/E[V] = {}): nothing more to find",
-                sig(ratio)
-            );
-        }
+    if white.level.is_finite() {
+        out += "; ";
+        out += &white.explain(hz);
     }
     out
 }

@@ -138,10 +138,30 @@ pub fn whiteness(z: &[Vec<Complex64>], n_params: usize, window: usize) -> Whiten
     }
 }
 
+/// The normalized residual `z[ch][k] = (G_d − Ĝ)(ω_k)/σ_k`, `σ = r/√2`, of model `m` on
+/// `data`.
+pub fn normalized_residual(
+    m: &crate::model::physical::PhysicalModel,
+    data: &super::channels::Channels,
+) -> Vec<Vec<Complex64>> {
+    let g: Vec<_> = data.omega.iter().map(|w| m.eval(*w)).collect();
+    data.entries
+        .iter()
+        .enumerate()
+        .map(|(ch, e)| {
+            (0..data.omega.len())
+                .map(|k| {
+                    (data.g[ch][k] - g[k][*e]) * std::f64::consts::SQRT_2 / data.radius[ch][k]
+                })
+                .collect()
+        })
+        .collect()
+}
+
 impl Whiteness {
     /// What the residual says, in words, for the stop explanation; `hz(k)` is line `k`'s
-    /// frequency in Hz; `std_factor` the configured one (1 when none).
-    pub fn explain(&self, hz: impl Fn(usize) -> f64, std_factor: f64) -> String {
+    /// frequency in Hz.
+    pub fn explain(&self, hz: impl Fn(usize) -> f64) -> String {
         use crate::diagnose::effects::candidates::sig;
         let where_ = |w: &Option<(usize, usize, f64)>| match w {
             Some((a, b, m)) if *m > 2.0 => format!(
@@ -168,9 +188,9 @@ impl Whiteness {
                 sig(self.level)
             ),
             (true, true) => format!(
-                "the residual is white but {}× the stated noise (V/E[V], {lb}): no structure is left, the data scatter more than the stated σ; std_factor = {} would cover it",
+                "the residual is white but {}× the stated noise (V/E[V], {lb}): no structure is left, the data scatter more than the stated σ; std_factor × {} would cover it",
                 sig(self.level),
-                sig(std_factor * self.level.sqrt())
+                sig(self.level.sqrt())
             ),
             (false, high) => format!(
                 "the residual is not white ({lb}; V/E[V] = {}): structure is left that no admissible effect explains{}{}",
@@ -238,9 +258,12 @@ mod tests {
         let z3: Vec<Vec<Complex64>> = z.iter().map(|c| c.iter().map(|x| 3.0 * x).collect()).collect();
         let b = whiteness(&z3, 0, 20);
         assert!((a.q - b.q).abs() < 1e-9 * a.q && (b.level / a.level - 9.0).abs() < 1e-9);
-        let text = b.explain(|k| k as f64, 3.0);
+        let text = b.explain(|k| k as f64);
         if b.white {
-            let want = format!("std_factor = {}", crate::diagnose::effects::candidates::sig(3.0 * b.level.sqrt()));
+            let want = format!(
+                "std_factor × {}",
+                crate::diagnose::effects::candidates::sig(b.level.sqrt())
+            );
             assert!(text.contains(&want), "{text}");
         }
     }
@@ -260,7 +283,7 @@ mod tests {
         assert!(w.level < LEVEL_HIGH, "{w:?}");
         let (a, b, _) = w.worst.unwrap();
         assert!(a <= 300 && b >= 300, "{w:?}");
-        let text = w.explain(|k| 10.0 + k as f64, 1.0);
+        let text = w.explain(|k| 10.0 + k as f64);
         assert!(text.contains("not white") && text.contains("Hz"), "{text}");
     }
 }
