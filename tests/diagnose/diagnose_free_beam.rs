@@ -131,19 +131,3 @@ fn discovery_finds_the_four_modes_and_nothing_else() {
     );
 }
 
-#[test]
-#[ignore = "scratch"]
-fn scratch_step2() {
-    let b = free_beam(1, true);
-    let mut m = b.rigid.clone();
-    m.mode = b.truth.mode[2..4].to_vec();
-    let d = diagnose_channels(&m, &b.data, &SearchSettings::default()).unwrap();
-    eprintln!("{:?} {}", d.verdict, d.message);
-    for c in &d.candidates {
-        eprintln!("cand {} {:?} dbic {:.1} pass {} flags {:?} nofit {:?}", c.effect, c.params.get("omega_n").map(|w| w / std::f64::consts::TAU), c.delta_bic, c.passes, c.flags, c.no_fit);
-    }
-    for p in &d.peaks {
-        eprintln!("peak {:.3} Hz h {:.1} fate {:?} {:?} {} probe {:?}", p.frequency_hz, p.height, p.fate, p.effect, p.reason, p.probe);
-    }
-    for r in &d.refused { eprintln!("refused {:?}", r.refusal); }
-}

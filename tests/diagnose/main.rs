@@ -12,6 +12,7 @@ mod diagnose_acceptance_rule;
 mod diagnose_apply;
 mod diagnose_backward;
 mod diagnose_band;
+mod diagnose_ema_reference;
 mod diagnose_free_beam;
 mod diagnose_close_modes;
 mod diagnose_give_up;
