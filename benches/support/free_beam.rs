@@ -27,7 +27,13 @@ pub const F1: f64 = 110.0;
 /// Beam mass, kg.
 pub const MASS: f64 = 1.2;
 /// `β_r L` of the first five free–free bending modes.
-pub const BETA_L: [f64; 5] = [4.730_040_7, 7.853_204_6, 10.995_607_8, 14.137_165_5, 17.278_759_6];
+pub const BETA_L: [f64; 5] = [
+    4.730_040_7,
+    7.853_204_6,
+    10.995_607_8,
+    14.137_165_5,
+    17.278_759_6,
+];
 /// Damping ratio of each mode.
 pub const ZETA: [f64; 5] = [1.0e-4, 1.2e-4, 1.35e-4, 1.5e-4, 1.5e-4];
 /// Modes inside the band.

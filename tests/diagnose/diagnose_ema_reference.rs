@@ -52,7 +52,9 @@ fn chain(start: &Path, dir: &Path, max_steps: usize) -> (PathBuf, Vec<[f64; 4]>)
         let d: Value = serde_json::from_slice(&o.stdout).unwrap_or(Value::Null);
         eprintln!(
             "step {k}: {}",
-            d["message"].as_str().unwrap_or(&String::from_utf8_lossy(&o.stderr))
+            d["message"]
+                .as_str()
+                .unwrap_or(&String::from_utf8_lossy(&o.stderr))
         );
         if !o.status.success() || !out.exists() {
             break;
@@ -70,7 +72,12 @@ fn chain(start: &Path, dir: &Path, max_steps: usize) -> (PathBuf, Vec<[f64; 4]>)
 }
 
 /// Checks the chain's end against the reference; returns the failures (empty: accepted).
-fn judge(last: &Path, steps: &[[f64; 4]], refs: &[(f64, f64, bool)], band: (f64, f64)) -> Vec<String> {
+fn judge(
+    last: &Path,
+    steps: &[[f64; 4]],
+    refs: &[(f64, f64, bool)],
+    band: (f64, f64),
+) -> Vec<String> {
     let mut bad = Vec::new();
     for (k, s) in steps.iter().enumerate() {
         if !(s[1] < s[0]) || s[3] > s[2] {
@@ -149,7 +156,12 @@ fn judge(last: &Path, steps: &[[f64; 4]], refs: &[(f64, f64, bool)], band: (f64,
 fn pyfrf_chain_ends_with_the_stabilization_diagram_modes() {
     let dir = tempfile::tempdir().unwrap();
     let (last, steps) = chain(&repo("configs/pyfrf_rigid.toml"), dir.path(), 6);
-    let bad = judge(&last, &steps, &reference("pyfrf_20_1200.csv"), (20.0, 1200.0));
+    let bad = judge(
+        &last,
+        &steps,
+        &reference("pyfrf_20_1200.csv"),
+        (20.0, 1200.0),
+    );
     assert!(bad.is_empty(), "{bad:#?}");
 }
 

@@ -51,7 +51,10 @@ fn the_generated_beam_is_a_free_free_beam() {
                 shape(r, 0.0) * shape(r, x) / free_beam::MASS * -(x0 * x0) / (w * w - x0 * x0)
             })
             .sum();
-        assert!((g.re - (line + flex)).abs() < 1e-3 * line.abs().max(1.0), "input {j}: {g}");
+        assert!(
+            (g.re - (line + flex)).abs() < 1e-3 * line.abs().max(1.0),
+            "input {j}: {g}"
+        );
     }
     // Dense lines: at least three in each in-band half-power band.
     for r in 0..IN_BAND {
@@ -67,7 +70,10 @@ fn the_generated_beam_is_a_free_free_beam() {
 }
 
 /// One discovery chain: `(model after each applied step, misfit_rms before and after it)`.
-fn chain(start: &PhysicalModel, data: &rshape::diagnose::Channels) -> Vec<(PhysicalModel, f64, f64)> {
+fn chain(
+    start: &PhysicalModel,
+    data: &rshape::diagnose::Channels,
+) -> Vec<(PhysicalModel, f64, f64)> {
     let mut m = start.clone();
     let mut out = Vec::new();
     for step in 1..=6 {
@@ -95,7 +101,11 @@ fn discovery_finds_the_four_modes_and_nothing_else() {
     let steps = chain(&b.rigid, &b.data);
     assert!(!steps.is_empty(), "no step applied");
     for (k, (_, before, after)) in steps.iter().enumerate() {
-        assert!(after < before, "step {}: misfit_rms {before} → {after}", k + 1);
+        assert!(
+            after < before,
+            "step {}: misfit_rms {before} → {after}",
+            k + 1
+        );
     }
     let last = &steps.last().unwrap().0;
     let tau = std::f64::consts::TAU;
@@ -130,4 +140,3 @@ fn discovery_finds_the_four_modes_and_nothing_else() {
         last.rigid_body
     );
 }
-

@@ -178,12 +178,7 @@ mod tests {
         // Resolved: 3 lines in the half-power band from ζ = 1.5 Δω/ω_n up (the peak midway
         // between lines is the worst place).
         assert!((zr.resolved - 1.5 / 460.5).abs() < 1e-9);
-        let band = |z: f64| {
-            omega
-                .iter()
-                .filter(|x| (**x - w).abs() <= z * w)
-                .count()
-        };
+        let band = |z: f64| omega.iter().filter(|x| (**x - w).abs() <= z * w).count();
         assert!(band(1.01 * zr.resolved) >= MIN_LINES_IN_BAND);
         assert!(band(0.6 * zr.resolved) < MIN_LINES_IN_BAND);
     }

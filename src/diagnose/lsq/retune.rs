@@ -238,13 +238,7 @@ pub(crate) fn retune_or_give_up(
     let zeta_lo = super::resolution::band_floor(data);
     for s in &nl {
         // Bounds around the configured value, so a rough start may not wander further.
-        let (a, b, t) = bounds(
-            m,
-            *s,
-            anchor_value(anchor, m, *s),
-            (w_min, w_max),
-            zeta_lo,
-        );
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), (w_min, w_max), zeta_lo);
         lo.push(a);
         hi.push(b);
         typ.push(t);

@@ -101,7 +101,10 @@ pub fn whiteness(z: &[Vec<Complex64>], n_params: usize, window: usize) -> Whiten
             continue;
         }
         for k in 1..=lags {
-            let r: Complex64 = (0..n - k).map(|i| c[i] * c[i + k].conj()).sum::<Complex64>() / s0;
+            let r: Complex64 = (0..n - k)
+                .map(|i| c[i] * c[i + k].conj())
+                .sum::<Complex64>()
+                / s0;
             let nf = n as f64;
             q += 2.0 * nf * nf * r.norm_sqr() / (nf - k as f64);
         }
@@ -150,9 +153,7 @@ pub fn normalized_residual(
         .enumerate()
         .map(|(ch, e)| {
             (0..data.omega.len())
-                .map(|k| {
-                    (data.g[ch][k] - g[k][*e]) * std::f64::consts::SQRT_2 / data.radius[ch][k]
-                })
+                .map(|k| (data.g[ch][k] - g[k][*e]) * std::f64::consts::SQRT_2 / data.radius[ch][k])
                 .collect()
         })
         .collect()
@@ -255,7 +256,10 @@ mod tests {
         // Scale-free: the same noise at 3× its stated σ keeps Q, and the level is 9.
         let z = vec![disk(&mut rng, 400)];
         let a = whiteness(&z, 0, 20);
-        let z3: Vec<Vec<Complex64>> = z.iter().map(|c| c.iter().map(|x| 3.0 * x).collect()).collect();
+        let z3: Vec<Vec<Complex64>> = z
+            .iter()
+            .map(|c| c.iter().map(|x| 3.0 * x).collect())
+            .collect();
         let b = whiteness(&z3, 0, 20);
         assert!((a.q - b.q).abs() < 1e-9 * a.q && (b.level / a.level - 9.0).abs() < 1e-9);
         let text = b.explain(|k| k as f64);

@@ -209,6 +209,9 @@ pub struct SearchResult {
     pub gave_up: usize,
     /// Wall time of the screens and of the joint refits.
     pub phases: Phases,
+    /// Frequencies (Hz) of the modes proposed at residual peaks and refit jointly
+    /// ([`super::peak_modes`]), whatever became of them.
+    pub peak_modes_hz: Vec<f64>,
 }
 
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {
@@ -266,6 +269,7 @@ pub fn search(
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let mut refused: Vec<(usize, Refusal)> = Vec::new();
+    let mut peak_modes_hz: Vec<f64> = Vec::new();
     let (mut expanded, mut joint_refits, mut gave_up) = (0, 0, 0);
     let mut phases = Phases::default();
     for depth in 1..=s.max_effects {
@@ -332,6 +336,9 @@ pub fn search(
                 // A peak's own mode proposal is a search child only (the first-level
                 // candidates stay the screen's).
                 let extra = j >= e.n_screen;
+                if extra && *go {
+                    peak_modes_hz.push(sc.mods.theta[0].exp() / std::f64::consts::TAU);
+                }
                 let mut child_node = None;
                 let mut first_refusal = None;
                 if let Some(refit) = go.then(|| done.next()).flatten() {
@@ -516,5 +523,6 @@ pub fn search(
         joint_refits,
         gave_up,
         phases,
+        peak_modes_hz,
     })
 }
