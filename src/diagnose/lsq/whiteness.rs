@@ -166,7 +166,7 @@ impl Whiteness {
         use crate::diagnose::effects::candidates::sig;
         let where_ = |w: &Option<(usize, usize, f64)>| match w {
             Some((a, b, m)) if *m > 2.0 => format!(
-                "; it concentrates at {}–{} Hz ({}× the noise there)",
+                "; it concentrates at {}–{} Hz (V per datum {} there, 1 at the stated noise)",
                 sig(hz(*a)),
                 sig(hz(*b)),
                 sig(*m)
