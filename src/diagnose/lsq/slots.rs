@@ -226,13 +226,14 @@ pub(crate) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> 
 }
 
 /// `(lo, hi, typ)` of a nonlinear slot bounded around `x0` (see [`anchor_value`]); `ζ`
-/// from the record's floor `zeta_lo` ([`super::resolution::band_floor`]) to 0.7.
+/// from the record's floor at the mode, `zeta_lo(ω_n)` ([`super::resolution::zeta_range`]:
+/// below it the lines around the mode do not see its damping), to 0.7.
 pub(crate) fn bounds(
     m: &PhysicalModel,
     s: Nl,
     x0: f64,
     (w_min, w_max): (f64, f64),
-    zeta_lo: f64,
+    zeta_lo: &dyn Fn(f64) -> f64,
 ) -> (f64, f64, f64) {
     match s {
         Nl::ModeW(i) => {
@@ -247,7 +248,7 @@ pub(crate) fn bounds(
             }
             (lo, hi, 1.0)
         }
-        Nl::ModeZ(_) => (zeta_lo.ln(), 0.7f64.ln(), 1.0),
+        Nl::ModeZ(i) => (zeta_lo(m.mode[i].omega_n).ln(), 0.7f64.ln(), 1.0),
         Nl::RigidPole(_) | Nl::LogEffect(_) => (x0 - 10f64.ln(), x0 + 10f64.ln(), 1.0),
         Nl::In(..) => {
             let (a, b) = (x0 / 100.0, 100.0 * x0);
