@@ -15,6 +15,10 @@
 //!   `apply_chosen` repeated (default settings: up to three effects a step) until nothing
 //!   more is chosen or six steps ran; the six modes must be found.
 //!
+//! * `one_step_free_beam_1664x9`: one step (default settings) from the rigid body on the
+//!   generated roving-hammer beam of issue 33 (`support/free_beam.rs`: 1664 lines × 9
+//!   channels, four modes with ζ 1.0–1.5e-4 and dense lines at the peaks); target ≤ 5 s.
+//!
 //! Run: `cargo bench --bench diagnose -- --sample-count 3`.
 use num_complex::Complex64;
 use rshape::diagnose::{
@@ -23,6 +27,9 @@ use rshape::diagnose::{
 use rshape::model::physical::{
     EffectKind, EffectSpec, Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec,
 };
+
+#[path = "support/free_beam.rs"]
+mod free_beam;
 
 fn main() {
     divan::main();
@@ -297,4 +304,11 @@ fn complete_discovery_1000x3(bencher: divan::Bencher) {
         }
         model
     });
+}
+
+#[divan::bench(sample_count = 3)]
+fn one_step_free_beam_1664x9(bencher: divan::Bencher) {
+    let b = free_beam::free_beam(1, true);
+    assert_eq!((b.data.omega.len(), b.data.n_ch()), (1664, 9));
+    bencher.bench(|| diagnose_channels(&b.rigid, &b.data, &SearchSettings::default()).unwrap());
 }

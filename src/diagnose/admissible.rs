@@ -37,7 +37,7 @@ use serde::Serialize;
 /// A mode above this damping is a broad term.
 pub const BROAD_ZETA: f64 = 0.2;
 /// Fewest data lines in a mode's half-power band.
-pub const MIN_LINES_IN_BAND: usize = 3;
+pub use super::lsq::resolution::MIN_LINES_IN_BAND;
 /// A mode's peak may exceed the data's magnitude there by at most this factor.
 pub const MAX_PEAK_OVER_DATA: f64 = 10.0;
 /// Residues of overlapping modes cancel when `‖ρ_a + ρ_b‖` is below this share of the larger.

@@ -204,9 +204,14 @@ pub fn diagnose_channels(
         DiagnoseVerdict::NoEffectFound
     };
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
-        + &unreached_modes(&peaks);
+        + &unreached_modes(&peaks, &res.peak_modes_hz);
     if verdict == DiagnoseVerdict::NoEffectFound {
-        message += &stop_explanation(&res.refused, after.v, n as f64 - node.n_params as f64 / 2.0);
+        let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
+        let white =
+            crate::diagnose::lsq::whiteness::whiteness(&z, node.n_params, (data.len() / 50).max(5));
+        message += &stop_explanation(&res.refused, &white, |k| {
+            data.omega[k] / std::f64::consts::TAU
+        });
     }
     Ok(Diagnosis {
         verdict,
@@ -333,39 +338,60 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
 
 /// A note for the verdict when the per-peak account ([`crate::diagnose::search::peaks`]) found peaks where one
 /// mode fitted at the peak would pass the screen although no candidate of the run was
-/// fitted there: the modes the search's proposals did not reach (empty when none).
-fn unreached_modes(peaks: &[crate::diagnose::report::Peak]) -> String {
+/// fitted there: the modes the search's proposals did not reach (empty when none).  A peak
+/// where the search did refit a mode of its own ([`crate::diagnose::search::peak_modes`],
+/// frequencies `proposed_hz`) is named apart: proposed, not chosen.
+fn unreached_modes(peaks: &[crate::diagnose::report::Peak], proposed_hz: &[f64]) -> String {
     let mut f: Vec<f64> = Vec::new();
+    let mut refit: Vec<f64> = Vec::new();
     for p in peaks {
         if p.fate != crate::diagnose::report::PeakFate::NotProposed {
             continue;
         }
         if let Some(pr) = &p.probe {
             let inside = (p.window_hz[0]..=p.window_hz[1]).contains(&pr.frequency_hz);
-            if pr.would_pass && inside && !f.iter().any(|x| (x - pr.frequency_hz).abs() < 1e-3 * x)
-            {
-                f.push(pr.frequency_hz);
+            let seen = |v: &[f64]| v.iter().any(|x| (x - pr.frequency_hz).abs() < 1e-3 * x);
+            if pr.would_pass && inside && !seen(&f) && !seen(&refit) {
+                let was_refit = proposed_hz
+                    .iter()
+                    .any(|x| (p.window_hz[0]..=p.window_hz[1]).contains(x));
+                if was_refit {
+                    refit.push(pr.frequency_hz);
+                } else {
+                    f.push(pr.frequency_hz);
+                }
             }
         }
     }
-    if f.is_empty() {
-        return String::new();
+    let list = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.iter().map(|x| sig(*x)).collect::<Vec<_>>().join(", ")
+    };
+    let mut out = String::new();
+    if !f.is_empty() {
+        out += &format!(
+            "; one mode fitted at a peak of the residual would pass the screen at {} Hz, where the search proposed none (see the peaks)",
+            list(&mut f)
+        );
     }
-    f.sort_by(f64::total_cmp);
-    format!(
-        "; one mode fitted at a peak of the residual would pass the screen at {} Hz, where the search proposed none (see the peaks)",
-        f.iter().map(|x| sig(*x)).collect::<Vec<_>>().join(", ")
-    )
+    if !refit.is_empty() {
+        out += &format!(
+            "; at {} Hz the search refit a mode proposed at the residual's peak but did not choose it (see the refusals; another step may add it)",
+            list(&mut refit)
+        );
+    }
+    out
 }
 
 /// Why nothing was added, for a stop: the effects the likelihood wanted but admissibility
-/// refused (with their rules), and the size of the remaining misfit against the stated
-/// noise (`V / E V`; above 1 either dynamics are missing or the data's own scatter exceeds
-/// the stated σ, and `std_factor × √(V/E V)` is the radius that would cover it).
+/// refused (with their rules), and what the remaining misfit is
+/// ([`crate::diagnose::lsq::whiteness`]): white at the stated noise (nothing more to find),
+/// white above it (the data's own scatter exceeds the stated σ: `std_factor × √(V/E V)`
+/// would cover it), or structured (missing dynamics, and where).
 fn stop_explanation(
     refused: &[(usize, crate::diagnose::admissible::Refusal)],
-    v: f64,
-    ev: f64,
+    white: &crate::diagnose::lsq::whiteness::Whiteness,
+    hz: impl Fn(usize) -> f64,
 ) -> String {
     let mut out = String::new();
     if !refused.is_empty() {
@@ -381,20 +407,9 @@ fn stop_explanation(
             names.join(", ")
         );
     }
-    if ev > 0.0 && v.is_finite() {
-        let ratio = v / ev;
-        if ratio > 1.5 {
-            out += &format!(
-                "; the residual is {}× the stated noise (V/E[V]): if no dynamics are missing, the data scatter more than the stated σ and std_factor × {} would cover it",
-                sig(ratio),
-                sig(ratio.sqrt())
-            );
-        } else {
-            out += &format!(
-                "; the residual is at the stated noise (V/E[V] = {}): nothing more to find",
-                sig(ratio)
-            );
-        }
+    if white.level.is_finite() {
+        out += "; ";
+        out += &white.explain(hz);
     }
     out
 }

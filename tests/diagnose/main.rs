@@ -13,6 +13,8 @@ mod diagnose_apply;
 mod diagnose_backward;
 mod diagnose_band;
 mod diagnose_close_modes;
+mod diagnose_ema_reference;
+mod diagnose_free_beam;
 mod diagnose_give_up;
 mod diagnose_hidden;
 mod diagnose_hidden_accelerance;

@@ -61,10 +61,11 @@ impl Cand {
 
     /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`
     /// (docs/design/effects.md step 3): an added mode resonates inside the band (an out-of-band one is a
-    /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [1e-4, 0.7]`,
+    /// compliance or mass line: the feedthrough and rigid-body candidates), `ζ ∈ [ζ_lo, 0.7]` (`ζ_lo` the
+    /// record's floor, `lsq::resolution::band_floor`),
     /// corners and zeros within two decades of the band, a delay below 100/ω_min.
-    pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
-        with_effect!(self, e => e.bounds(n_ch, w_min, w_max))
+    pub fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
+        with_effect!(self, e => e.bounds(n_ch, w_min, w_max, zeta_lo))
     }
 
     /// The parameters [`Cand::modify_natural`] uses, from the internal ones `th` (appended

@@ -37,7 +37,7 @@ impl Effect for Delay {
     }
 
     /// A delay below 100/ω_min.
-    fn bounds(&self, _: usize, w_min: f64, _: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, w_min: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
         vec![(-100.0 / w_min, 100.0 / w_min)]
     }
 

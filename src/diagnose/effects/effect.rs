@@ -45,8 +45,10 @@ impl Sel {
     }
 }
 
-/// Lower and upper bound of a damping ratio.
-pub const ZETA_BOUNDS: (f64, f64) = (1e-4, 0.7);
+/// Lower and upper bound of a damping ratio in any model (the fits' lower bound is the
+/// record's floor, `lsq::resolution::band_floor`, above this; the model refuses
+/// `ζ < 1e-12`).
+pub const ZETA_BOUNDS: (f64, f64) = (1e-9, 0.7);
 
 pub(crate) fn clamp_zeta(z: f64) -> f64 {
     z.clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1)
@@ -85,8 +87,10 @@ pub trait Effect: Copy {
     /// Typical magnitude of each internal parameter (for finite differences).
     fn typ(&self, theta: &[f64], omega_max: f64) -> Vec<f64>;
 
-    /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`.
-    fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)>;
+    /// Box bounds `(lo, hi)` of each internal parameter for data over `[ω_min, ω_max]`;
+    /// a damping ratio's lower bound is `zeta_lo`, the record's floor
+    /// (`lsq::resolution::band_floor`).
+    fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)>;
 
     /// The natural parameters [`Effect::modify`] uses, from the internal ones `th`: `nat`
     /// holds a copy of `th` to change in place (`exp` of the log-parameters, `|τ|`, `ζ`
@@ -177,6 +181,8 @@ pub struct Band {
     pub w_min: f64,
     /// Highest measured frequency (rad/s).
     pub w_max: f64,
+    /// The record's lower bound on a damping ratio (`lsq::resolution::band_floor`).
+    pub zeta_lo: f64,
     /// The measured quantity (receptance, mobility, accelerance).
     pub quantity: Quantity,
 }

@@ -34,7 +34,7 @@ impl Effect for Gain {
         theta.iter().map(|x| x.abs().max(1e-300)).collect()
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
         let _ = (w_min, w_max);
         vec![(-1e3, 1e3)]
     }

@@ -32,7 +32,7 @@ impl Effect for Integrator {
         theta.iter().map(|x| x.abs().max(1e-300)).collect()
     }
 
-    fn bounds(&self, n_ch: usize, _: f64, _: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, n_ch: usize, _: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
         vec![(f64::NEG_INFINITY, f64::INFINITY); n_ch]
     }
 

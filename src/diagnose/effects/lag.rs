@@ -31,7 +31,7 @@ impl Effect for Lag {
         vec![1.0]
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
         vec![((w_min / 100.0).ln(), (w_max * 100.0).ln())]
     }
 

@@ -42,9 +42,9 @@ impl Effect for Mode {
     }
 
     /// The mode resonates inside the band (an out-of-band one is a compliance or mass line:
-    /// the feedthrough and rigid-body candidates), `ζ ∈ [1e-4, 0.7]`, residues free.
-    fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
-        let lz = (ZETA_BOUNDS.0.ln(), ZETA_BOUNDS.1.ln());
+    /// the feedthrough and rigid-body candidates), `ζ ∈ [ζ_lo, 0.7]` (`ζ_lo` the record's floor), residues free.
+    fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
+        let lz = (zeta_lo.max(ZETA_BOUNDS.0).ln(), ZETA_BOUNDS.1.ln());
         let mut v = vec![(w_min.ln(), w_max.ln()), lz];
         v.extend(std::iter::repeat_n((f64::NEG_INFINITY, f64::INFINITY), n_ch));
         v
@@ -162,7 +162,7 @@ impl Effect for Mode {
             ));
         }
         if at(1) {
-            let z = th[1].exp().clamp(ZETA_BOUNDS.0, ZETA_BOUNDS.1);
+            let z = th[1].exp().clamp(band.zeta_lo, ZETA_BOUNDS.1);
             out.push(format!(
                 "ζ at its {} bound {}: not identified",
                 if z < 0.01 { "lower" } else { "upper" },

@@ -33,7 +33,7 @@ impl Effect for ModeShift {
         vec![1.0]
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
         vec![(w_min.ln(), w_max.ln())]
     }
 

@@ -32,7 +32,7 @@ impl Effect for Sign {
         vec![]
     }
 
-    fn bounds(&self, _: usize, _: f64, _: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, _: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
         vec![]
     }
 

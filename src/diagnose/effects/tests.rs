@@ -45,7 +45,7 @@ fn every_candidate(base: &PhysicalModel) -> Vec<Cand> {
 
 /// Parameters inside the candidate's box (37 % of the way up), residues of a few thousand.
 fn theta(c: &Cand, n_ch: usize, w: (f64, f64)) -> Vec<f64> {
-    c.bounds(n_ch, w.0, w.1)
+    c.bounds(n_ch, w.0, w.1, 1e-4)
         .iter()
         .enumerate()
         .map(|(i, (lo, hi))| {
@@ -80,7 +80,7 @@ fn every_effect_is_registered_once_with_consistent_parameters() {
     for c in &all {
         let n = c.n_params(2);
         let th = theta(c, 2, (10.0, 3000.0));
-        assert_eq!(c.bounds(2, 10.0, 3000.0).len(), n, "{c:?} bounds");
+        assert_eq!(c.bounds(2, 10.0, 3000.0, 1e-4).len(), n, "{c:?} bounds");
         assert_eq!(c.typ(&th, 3000.0).len(), n, "{c:?} typ");
         let mut nat = Vec::new();
         c.natural(&th, &mut nat);

@@ -36,7 +36,7 @@ impl Effect for Zoh {
         vec![1.0]
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64) -> Vec<(f64, f64)> {
+    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
         vec![((0.01 / w_max).ln(), (100.0 / w_min).ln())]
     }
 

@@ -25,6 +25,8 @@ pub struct Problem<'a> {
     mode_rho: Vec<Vec<f64>>,
     /// Residue of each rigid body at each channel, `[ch][body]`.
     rigid_rho: Vec<Vec<f64>>,
+    /// The record's lower bound on ζ ([`super::resolution::band_floor`]).
+    pub(crate) zeta_floor: f64,
 }
 
 /// A model: the base plus effects with their internal parameters (concatenated).
@@ -96,6 +98,7 @@ impl<'a> Problem<'a> {
                 .collect(),
             core0,
             path0,
+            zeta_floor: super::resolution::band_floor(data),
         })
     }
 
@@ -265,7 +268,12 @@ impl<'a> Problem<'a> {
     pub(crate) fn bounds(&self, mods: &Mods) -> (Vec<f64>, Vec<f64>) {
         let (mut lo, mut hi) = (Vec::new(), Vec::new());
         for c in &mods.cands {
-            for (a, b) in c.bounds(self.n_ch(), self.omega_min(), self.omega_max()) {
+            for (a, b) in c.bounds(
+                self.n_ch(),
+                self.omega_min(),
+                self.omega_max(),
+                self.zeta_floor,
+            ) {
                 lo.push(a);
                 hi.push(b);
             }

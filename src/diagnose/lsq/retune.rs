@@ -10,7 +10,7 @@
 //!
 //! | term | nonlinear parameters | box |
 //! |---|---|---|
-//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.3 … 1.3ω_n₀` (inside the band for a mode `diagnose` added), `ζ ∈ [1e-4, 0.7]` |
+//! | mode | `ln ω_n`, `ln ζ` | `ω_n₀/1.3 … 1.3ω_n₀` (inside the band for a mode `diagnose` added), `ζ` from the record's floor at the mode ([`super::resolution::zeta_range`]) to 0.7 |
 //! | rigid body with friction | `ln p` | a decade either side |
 //! | input gains (several inputs) | `b_i`, `i ≥ 2` | two decades, sign kept |
 //! | delay | `τ` | `[0, 10 τ₀ + 1/ω_max]` |
@@ -235,9 +235,10 @@ pub(crate) fn retune_or_give_up(
     }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
+    let zeta_lo = |w: f64| super::resolution::zeta_range(data, w).floor;
     for s in &nl {
         // Bounds around the configured value, so a rough start may not wander further.
-        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), (w_min, w_max), &zeta_lo);
         lo.push(a);
         hi.push(b);
         typ.push(t);

@@ -225,8 +225,16 @@ pub(crate) fn anchor_value(anchor: &PhysicalModel, m: &PhysicalModel, s: Nl) -> 
     get_nl(if configured { anchor } else { m }, s)
 }
 
-/// `(lo, hi, typ)` of a nonlinear slot bounded around `x0` (see [`anchor_value`]).
-pub(crate) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) -> (f64, f64, f64) {
+/// `(lo, hi, typ)` of a nonlinear slot bounded around `x0` (see [`anchor_value`]); `ζ`
+/// from the record's floor at the mode, `zeta_lo(ω_n)` ([`super::resolution::zeta_range`]:
+/// below it the lines around the mode do not see its damping), to 0.7.
+pub(crate) fn bounds(
+    m: &PhysicalModel,
+    s: Nl,
+    x0: f64,
+    (w_min, w_max): (f64, f64),
+    zeta_lo: &dyn Fn(f64) -> f64,
+) -> (f64, f64, f64) {
     match s {
         Nl::ModeW(i) => {
             let (mut lo, mut hi) = (x0 - MODE_BOX.ln(), x0 + MODE_BOX.ln());
@@ -240,7 +248,7 @@ pub(crate) fn bounds(m: &PhysicalModel, s: Nl, x0: f64, w_min: f64, w_max: f64) 
             }
             (lo, hi, 1.0)
         }
-        Nl::ModeZ(_) => (1e-4f64.ln(), 0.7f64.ln(), 1.0),
+        Nl::ModeZ(i) => (zeta_lo(m.mode[i].omega_n).ln(), 0.7f64.ln(), 1.0),
         Nl::RigidPole(_) | Nl::LogEffect(_) => (x0 - 10f64.ln(), x0 + 10f64.ln(), 1.0),
         Nl::In(..) => {
             let (a, b) = (x0 / 100.0, 100.0 * x0);

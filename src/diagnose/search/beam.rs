@@ -75,6 +75,8 @@ type Refit = (PhysicalModel, Measures, f64, usize);
 /// against.
 struct Expansion {
     screened: Vec<Screened>,
+    /// `screened[..n_screen]` is the catalogue's screen, the rest peaks' mode proposals.
+    n_screen: usize,
     refit: Vec<bool>,
     ref_v: f64,
 }
@@ -89,7 +91,7 @@ fn expand(
     screened: Option<Vec<Screened>>,
 ) -> Result<Expansion> {
     let node = &nodes[ni];
-    let screened = match screened {
+    let mut screened = match screened {
         Some(sc) => sc,
         None => {
             let p = Problem::new(&node.model, data)?;
@@ -101,14 +103,31 @@ fn expand(
             p.screen(&cands, node.measures)
         }
     };
+    // Every peak proposed ([`super::peak_modes`]): the modes at the residual's other peaks
+    // that would pass the screen, each refit (beyond the beam's share), so that one refused
+    // mode candidate does not hide the others.
+    let n_screen = screened.len();
+    let taken: Vec<f64> = screened
+        .iter()
+        .filter(|sc| sc.cand == Cand::Mode && sc.no_fit.is_none())
+        .map(|sc| sc.mods.theta[0].exp())
+        .collect();
+    screened.extend(super::peak_modes::peak_modes(
+        &node.model,
+        data,
+        node.measures,
+        &taken,
+        s.min_delta_bic,
+    )?);
     let mut tried = 0;
     let refit = screened
         .iter()
-        .map(|sc| {
+        .enumerate()
+        .map(|(i, sc)| {
             let promising =
                 sc.no_fit.is_none() && sc.flags.is_empty() && sc.delta_bic > s.min_delta_bic;
-            let go = promising && tried <= s.beam;
-            tried += usize::from(go);
+            let go = promising && (tried <= s.beam || i >= n_screen);
+            tried += usize::from(go && i < n_screen);
             go
         })
         .collect();
@@ -120,6 +139,7 @@ fn expand(
     };
     Ok(Expansion {
         screened,
+        n_screen,
         refit,
         ref_v,
     })
@@ -189,6 +209,9 @@ pub struct SearchResult {
     pub gave_up: usize,
     /// Wall time of the screens and of the joint refits.
     pub phases: Phases,
+    /// Frequencies (Hz) of the modes proposed at residual peaks and refit jointly
+    /// ([`super::peak_modes`]), whatever became of them.
+    pub peak_modes_hz: Vec<f64>,
 }
 
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {
@@ -245,6 +268,7 @@ pub fn search(
     let mut nodes = roots;
     let mut first_level = Vec::new();
     let mut refused: Vec<(usize, Refusal)> = Vec::new();
+    let mut peak_modes_hz: Vec<f64> = Vec::new();
     let (mut expanded, mut joint_refits, mut gave_up) = (0, 0, 0);
     let mut phases = Phases::default();
     for depth in 1..=s.max_effects {
@@ -307,14 +331,20 @@ pub fn search(
         for (&ni, e) in level.iter().zip(&expansions) {
             let node = nodes[ni].clone();
             let ref_v = e.ref_v;
-            for (sc, go) in e.screened.iter().zip(&e.refit) {
+            for (j, (sc, go)) in e.screened.iter().zip(&e.refit).enumerate() {
+                // A peak's own mode proposal is a search child only (the first-level
+                // candidates stay the screen's).
+                let extra = j >= e.n_screen;
+                if extra && *go {
+                    peak_modes_hz.push(sc.mods.theta[0].exp() / std::f64::consts::TAU);
+                }
                 let mut child_node = None;
                 let mut first_refusal = None;
                 if let Some(refit) = go.then(|| done.next()).flatten() {
                     joint_refits += 1;
                     let Some((model, m, v_fit, n_refit)) = refit? else {
                         gave_up += 1;
-                        if depth == 1 && ni == 0 {
+                        if depth == 1 && ni == 0 && !extra {
                             first_level.push((sc.clone(), None, None));
                         }
                         continue;
@@ -420,7 +450,7 @@ pub fn search(
                         children.push(child);
                     }
                 }
-                if depth == 1 && ni == 0 {
+                if depth == 1 && ni == 0 && !extra {
                     first_level.push((sc.clone(), child_node, first_refusal));
                 }
             }
@@ -492,5 +522,6 @@ pub fn search(
         joint_refits,
         gave_up,
         phases,
+        peak_modes_hz,
     })
 }

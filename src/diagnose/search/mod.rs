@@ -11,6 +11,7 @@
 //! * `holdout`: the final set checked on held-out data;
 //! * `backward`: backward elimination;
 //! * `peaks`: every peak of the residual and its fate;
+//! * `peak_modes`: a mode proposed at every peak that would pass the screen;
 //! * `assign`: configured and added modes matched to the refit's;
 //! * `final_effects`: the effects the written model has and the input did not.
 pub(crate) mod assign;
@@ -20,6 +21,7 @@ pub(crate) mod final_effects;
 pub(crate) mod first_level;
 pub(crate) mod holdout;
 pub(crate) mod node;
+pub(crate) mod peak_modes;
 pub(crate) mod peaks;
 pub(crate) mod polish;
 pub(crate) mod rank;

@@ -120,7 +120,7 @@ pub fn find_peaks(omega: &[f64], s: &[f64], e: &[f64]) -> Vec<RawPeak> {
 
 /// `(s, e)` of model `m` per line: `max_ch |G_d − Ĝ|` over the channel's median radius, and
 /// over the radius itself.
-fn residual(m: &PhysicalModel, data: &Channels) -> Result<(Vec<f64>, Vec<f64>)> {
+pub(super) fn residual(m: &PhysicalModel, data: &Channels) -> Result<(Vec<f64>, Vec<f64>)> {
     let gm = Problem::new(m, data)?.response(&Mods::default());
     let (mut s, mut e) = (vec![0.0f64; data.len()], vec![0.0f64; data.len()]);
     for ((g, gm), radius) in data.g.iter().zip(&gm).zip(&data.radius) {
@@ -306,21 +306,7 @@ fn probe_mode(
     p: &RawPeak,
     data: &Channels,
 ) -> Option<PeakProbe> {
-    let w = data.omega[p.k];
-    let all: Vec<usize> = (0..data.len()).collect();
-    let z0 = ((p.hi - p.lo) / (2.0 * 3f64.sqrt() * w)).clamp(2e-4, 0.3);
-    let empty = Mods::default();
-    let resp = pb.response(&empty);
-    let mut best: Option<(Mods, f64)> = None;
-    for z in [z0, 3.0 * z0, z0 / 3.0] {
-        let th = pb.mode_theta(&empty, &resp, w, z, &all);
-        let m = empty.with(Cand::Mode, &th);
-        let (fit, v, _) = pb.refit(&m, &all);
-        if v.is_finite() && best.as_ref().is_none_or(|b| v < b.1) {
-            best = Some((fit, v));
-        }
-    }
-    let (fit, v) = best?;
+    let (fit, v, _) = fit_at(pb, p, data)?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let delta_bic = 2.0 * (cur.v - v) - Cand::Mode.n_params(data.n_ch()) as f64 * ln2f;
     let (mut flags, no_fit) = plausibility(
@@ -328,8 +314,8 @@ fn probe_mode(
         &fit.theta,
         v,
         &data.entries,
-        data.omega[0],
-        *data.omega.last().expect("data"),
+        (data.omega[0], *data.omega.last().expect("data")),
+        pb.zeta_floor,
         pb.base.quantity,
     );
     flags.extend(no_fit);
@@ -342,6 +328,30 @@ fn probe_mode(
         flags,
         improves: better,
     })
+}
+
+/// One mode started at peak `p` and fitted on top of the model of `pb` (see
+/// [`probe_mode`]): the fit, its cost and `JᵀJ`.
+pub(super) fn fit_at(
+    pb: &Problem<'_>,
+    p: &RawPeak,
+    data: &Channels,
+) -> Option<(Mods, f64, nalgebra::DMatrix<f64>)> {
+    let w = data.omega[p.k];
+    let all: Vec<usize> = (0..data.len()).collect();
+    let z0 = ((p.hi - p.lo) / (2.0 * 3f64.sqrt() * w)).clamp(2e-4, 0.3);
+    let empty = Mods::default();
+    let resp = pb.response(&empty);
+    let mut best: Option<(Mods, f64, nalgebra::DMatrix<f64>)> = None;
+    for z in [z0, 3.0 * z0, z0 / 3.0] {
+        let th = pb.mode_theta(&empty, &resp, w, z, &all);
+        let m = empty.with(Cand::Mode, &th);
+        let (fit, v, jtj) = pb.refit(&m, &all);
+        if v.is_finite() && best.as_ref().is_none_or(|b| v < b.1) {
+            best = Some((fit, v, jtj));
+        }
+    }
+    best
 }
 
 impl PeakProbe {

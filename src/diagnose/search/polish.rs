@@ -105,8 +105,9 @@ pub fn polish(m: &PhysicalModel, anchor: &PhysicalModel, data: &Channels) -> Opt
         return None;
     }
     let (mut lo, mut hi, mut typ) = (Vec::new(), Vec::new(), Vec::new());
+    let zeta_lo = |w: f64| crate::diagnose::lsq::resolution::zeta_range(data, w).floor;
     for (s, x) in par.nl.iter().zip(&theta) {
-        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), w_min, w_max);
+        let (a, b, t) = bounds(m, *s, anchor_value(anchor, m, *s), (w_min, w_max), &zeta_lo);
         lo.push(a.min(*x));
         hi.push(b.max(*x));
         typ.push(t);

@@ -106,8 +106,8 @@ pub fn plausibility(
     th: &[f64],
     v: f64,
     entries: &[(usize, usize)],
-    w_min: f64,
-    w_max: f64,
+    (w_min, w_max): (f64, f64),
+    zeta_lo: f64,
     quantity: Quantity,
 ) -> (Vec<String>, Option<String>) {
     if !v.is_finite() || th.iter().any(|x| !x.is_finite()) {
@@ -140,7 +140,7 @@ pub fn plausibility(
             return (vec![], Some(format!("{name} is not finite")));
         }
     }
-    let bounds = c.bounds(entries.len(), w_min, w_max);
+    let bounds = c.bounds(entries.len(), w_min, w_max, zeta_lo);
     let at = |i: usize| {
         let (lo, hi) = bounds[i];
         let tol = 1e-3 * (1.0 + th[i].abs());
@@ -153,6 +153,7 @@ pub fn plausibility(
         Band {
             w_min,
             w_max,
+            zeta_lo,
             quantity,
         },
         &mut flags,
@@ -218,8 +219,8 @@ impl Problem<'_> {
                     &mods.theta,
                     v,
                     &self.data.entries,
-                    self.omega_min(),
-                    self.omega_max(),
+                    (self.omega_min(), self.omega_max()),
+                    self.zeta_floor,
                     self.base.quantity,
                 );
                 Screened {
