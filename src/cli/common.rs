@@ -279,10 +279,7 @@ pub fn fit_bound_in_memory(
     let outcome = crate::fit::run_fit(
         env,
         Some(&a1),
-        &crate::fit::FitSettings {
-            a1_dips: f.a1_dips(),
-            ..Default::default()
-        },
+        &crate::fit::FitSettings::default().with_a1_model(f),
         crate::fit::OrderChoice::Auto { max: 8 },
         Some(&progress),
     );

@@ -454,6 +454,7 @@ fn a1_notch_of_a_lightly_damped_mode_fails_the_certificate() {
         a1: Some(&a1),
         a1_data: None,
         a1_dips: dips,
+        a1_proof: &rshape::fit::A1Proof::Sampled,
         margin: 0.0,
         floor: 1e-12,
         per_decade: 100,

@@ -7,6 +7,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod a1_proof;
 mod a1_verdict;
 mod bad_input;
 mod bad_input_batch;
