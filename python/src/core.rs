@@ -278,10 +278,7 @@ pub fn fit_envelope(env: &Envelope, order: OrderChoice) -> PyResult<FitHandle> {
         .config
         .as_deref()
         .and_then(closed_loop::a1_factorization);
-    let a1 = f.map(|f| move |w: f64| f.a1_limit(w));
-    let a1: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
-    let dips = f.map(|f| f.a1_dips()).unwrap_or_default();
-    let fitted = integration::fit_r(&env.inner, a1, dips, order, None)
+    let fitted = integration::fit_r(&env.inner, f, order, None)
         .map_err(|e| FitError::new_err(crate::errors::message(&e)))?;
     let json = serde_json::to_string(&fitted.json).map_err(|e| input(e.to_string()))?;
     Ok(FitHandle { r: fitted.r, json })

@@ -223,10 +223,7 @@ pub fn finish(
 ) -> Result<BatchReport> {
     let mut timings = inp.timings_ms;
     let t = std::time::Instant::now();
-    let a1 = inp.factorization.map(|f| move |w: f64| f.a1_limit(w));
-    let a1_dyn: Option<&dyn Fn(f64) -> f64> = a1.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
-    let dips = inp.factorization.map(|f| f.a1_dips()).unwrap_or_default();
-    let fit = combined.map(|env| integration::fit_r(env, a1_dyn, dips, inp.order, None));
+    let fit = combined.map(|env| integration::fit_r(env, inp.factorization, inp.order, None));
     timings.insert("fit".into(), t.elapsed().as_secs_f64() * 1e3);
     let t = std::time::Instant::now();
     if let Some(env) = combined {

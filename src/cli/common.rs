@@ -99,7 +99,10 @@ pub use crate::report::fmt::{fmt_g, fmt_omegas};
 
 /// Checks `--out DIR` before any work and clears the previous run's files there (see
 /// [`OutputManifest`]).  `DIR` must not be an existing file, nor the folder of an input
-/// (outputs would mix with inputs).  Keep the guard alive while the run writes.
+/// (outputs would mix with inputs): of the given paths and of every file they make the run
+/// read (a config's data, noise std or coherence and plant files, [`config_files`]; the
+/// noise files beside a data file, [`data_and_siblings`]).  Keep the guard alive while the
+/// run writes.
 pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result<OutputManifest> {
     if out.exists() && !out.is_dir() {
         return Err(anyhow!(
@@ -107,8 +110,17 @@ pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result
             out.display()
         ));
     }
+    let mut every: Vec<PathBuf> = Vec::new();
+    for input in inputs {
+        every.push(input.to_path_buf());
+        match input.extension().and_then(|e| e.to_str()) {
+            Some("toml") if input.is_file() => every.extend(config_files(input)),
+            Some("csv") => every.extend(data_and_siblings(input)),
+            _ => {}
+        }
+    }
     if let Ok(o) = out.canonicalize() {
-        for input in inputs {
+        for input in &every {
             let folder = match input.canonicalize() {
                 Ok(p) if p.is_dir() => p,
                 Ok(p) => p.parent().map(|p| p.to_path_buf()).unwrap_or(p),
@@ -279,10 +291,7 @@ pub fn fit_bound_in_memory(
     let outcome = crate::fit::run_fit(
         env,
         Some(&a1),
-        &crate::fit::FitSettings {
-            a1_dips: f.a1_dips(),
-            ..Default::default()
-        },
+        &crate::fit::FitSettings::default().with_a1_model(f),
         crate::fit::OrderChoice::Auto { max: 8 },
         Some(&progress),
     );

@@ -85,10 +85,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let (inputs, env) = input.envelope()?;
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
-            let settings = FitSettings {
-                a1_dips: f.a1_dips(),
-                ..settings
-            };
+            let settings = settings.with_a1_model(f);
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             run_fit(&env, Some(&a1), &settings, a.order, Some(progress))
         }

@@ -163,7 +163,12 @@ pub fn main() -> i32 {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", capped(&one_line(&format!("{e:#}"))));
+            eprintln!(
+                "error: {}",
+                capped(&crate::report::fmt::short_numbers(&one_line(&format!(
+                    "{e:#}"
+                ))))
+            );
             2
         }
     }

@@ -58,6 +58,16 @@ impl FitProgressView {
         ));
     }
 
+    /// Announces a long stage at once (a line even when stderr is not a terminal): a large
+    /// model's loop, whose dense eigenvalue problems give no report while they run.
+    pub fn stage(&self, what: &str) {
+        let msg = format!("{}: {what}", self.stage_label());
+        match &self.bar {
+            Some(b) => b.set_message(msg),
+            None => eprintln!("{msg} ({:.0} s)", self.start.elapsed().as_secs_f64()),
+        }
+    }
+
     /// `run: fit` → `run` (the label of the whole command, for its other stages).
     fn stage_label(&self) -> &str {
         self.label.split(':').next().unwrap_or(&self.label)

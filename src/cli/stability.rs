@@ -30,6 +30,10 @@ pub struct StabilityArgs {
     pub json: bool,
 }
 
+/// From this many states on, `stability` announces its long stage (issue 34: a 200-mode
+/// model ran minutes without output).
+const LARGE_MODEL_STATES: usize = 200;
+
 /// Runs `rshape stability`.
 pub fn run(a: &StabilityArgs) -> Result<i32> {
     let config = Config::load(&a.config)?;
@@ -39,8 +43,9 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
             "--fit writes r.json and its exports: give --out DIR"
         ));
     }
-    // The controller's size is checked before anything is written.
-    stability::check_controller(&config, &controller)?;
+    // The controller's size is checked before anything is written (the loop itself, dear on
+    // a large model, is built once, by `stability::run`).
+    crate::stability::controller_fits(&config.factorization, &controller)?;
     // With --fit, the data are read and the envelope computed before the folder is touched.
     let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
@@ -60,7 +65,22 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         fit_text = text;
         rs.push(("fitted".into(), r));
     }
+    // A large model's loop is a dense eigenvalue problem of O(n³) (and the H∞ iteration a
+    // few of twice its size), silent while it runs: say what is going on.
+    let f = &config.factorization;
+    let states = f
+        .realization
+        .as_ref()
+        .map_or(2 * f.states(), |n| n.plant.states());
+    let view = (states >= LARGE_MODEL_STATES).then(|| {
+        let v = super::progress::FitProgressView::new("stability");
+        v.stage(&format!(
+            "the loop of a model with about {states} states: closed-loop poles, then the exact H∞ norms (dense, O(n³))"
+        ));
+        v
+    });
     let outcome = stability::run(&config, &controller, &rs, a.bounds.data.as_deref())?;
+    drop(view);
     let written = match &a.out {
         Some(out) => {
             let k = a

@@ -2,13 +2,18 @@
 //! poles and zeros (not from the LP variables), at every datum and on a dense grid
 //! (`≥ 50` points per decade over the band widened by two decades each side).  The no-dip
 //! bound between data is *proved* on every interval ([`super::between`]: interval
-//! branch-and-bound, no sampling); the floor is checked on the dense grid and at `ω = ∞`, and
-//! A1 on the dense grid refined by golden-section search where its margin is small.
+//! branch-and-bound, no sampling); the floor is checked on the dense grid and at `ω = ∞`.
+//! A1 is *proved* on the band `[ω_lo, ∞]` (`ω_lo` the lowest datum two decades down, where
+//! the fit enforces it) when a realization of `M̃⁻¹` is given ([`super::a1_proof`]: an `L∞`
+//! norm by the Hamiltonian iteration), and checked by a second, cheap route that must
+//! agree: the dense grid refined by golden-section search where its margin is small and at
+//! each lightly damped zero of `M̃`. Without a realization, that second route alone decides.
 //!
 //! If coverage fails (LP tolerance, or a dip between data), the gain is rescaled by the
 //! worst under-coverage, as MATLAB's `ucover` does, and everything is checked again; a
 //! failure that remains (for example A1 broken by the rescaling) is reported, never hidden.
 
+use super::a1_proof::{prove, A1Proof};
 use super::spectral::Zpk;
 use serde::Serialize;
 
@@ -43,8 +48,14 @@ pub struct Certificate {
     pub worst_a1_margin: Option<f64>,
     /// Where it is.
     pub worst_a1_omega: Option<f64>,
-    /// How A1 was checked: `function` (dense grid), `data` (only at the data), `none`.
+    /// How A1 was checked: `proved` (the `L∞` proof on `[a1_band_lo, ∞]`, cross-checked by
+    /// the grid), `function` (dense grid and dips only), `data` (only at the data), `none`.
     pub a1_checked_on: String,
+    /// Proven lower bound of `σ_min(M̃(jω))/|r(jω)|` on `[a1_band_lo, ∞]` (must be > 1),
+    /// when `a1_checked_on` is `proved`.
+    pub a1_lower_bound: Option<f64>,
+    /// Lower edge (rad/s) of the band on which A1 is checked.
+    pub a1_band_lo: Option<f64>,
     /// `min |r(jω)|` over the dense grid and `ω = ∞` (strict positivity).
     pub min_abs_r: f64,
     /// `|r(∞)|` (biproper: nonzero).
@@ -77,6 +88,8 @@ pub struct CertInput<'a> {
     /// Where `σ_min(M̃)` may dip between grid points (lightly damped zeros of `M̃`, rad/s):
     /// A1 is evaluated there and refined around each.
     pub a1_dips: &'a [f64],
+    /// Realizations of `M̃⁻¹` for the A1 proof (with `a1`), or [`A1Proof::Sampled`].
+    pub a1_proof: &'a A1Proof,
     /// Required relative margin over `r_min`.
     pub margin: f64,
     /// Floor on `|r|` everywhere.
@@ -190,6 +203,7 @@ pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
     }
     // A1.
     let (mut a1m, mut a1w, a1_on) = (None, None, String::from("none"));
+    let (mut a1_lower, mut a1_lo) = (None, None);
     let a1_on = if let Some(a1) = inp.a1 {
         let f = |w: f64| a1(w) / r.mag(w);
         let mut all = grid.clone();
@@ -217,7 +231,56 @@ pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
         };
         a1m = Some(v);
         a1w = Some(w);
-        "function".to_string()
+        let band_lo = lo / ext;
+        a1_lo = Some(band_lo);
+        match inp.a1_proof {
+            A1Proof::Sampled => "function".to_string(),
+            A1Proof::Impossible(why) => {
+                failures.push(format!("A1 fails: {why}"));
+                "proved".to_string()
+            }
+            // A failure already found at a real frequency needs no proof.
+            A1Proof::Blocks(_) if !(v > 1.0) => "function".to_string(),
+            A1Proof::Blocks(blocks) => {
+                match prove(blocks, r, band_lo) {
+                    Ok(p) => {
+                        a1_lower = Some(p.lower);
+                        // The second route must agree: nothing sampled below the proved
+                        // bound, and the proof's worst frequency evaluated directly (the
+                        // factors' own SVD, not the realization of M̃⁻¹) gives its value.
+                        let direct = if p.omega.is_finite() {
+                            a1(p.omega) / r.mag(p.omega)
+                        } else {
+                            far
+                        };
+                        let agree = v >= p.lower * (1.0 - 1e-6)
+                            && (direct - p.attained).abs() <= 1e-3 * p.attained.max(1e-300);
+                        if !agree {
+                            failures.push(format!(
+                                "A1 not proved: the L∞ proof (σ_min/|r| ≥ {:.9} on [{band_lo:.3e}, ∞], {:.9} at ω = {:.6e} rad/s) and the direct evaluation ({v:.9} sampled, {direct:.9} at that frequency) disagree",
+                                p.lower, p.attained, p.omega
+                            ));
+                        } else if p.attained < v {
+                            a1m = Some(p.attained);
+                            a1w = Some(p.omega);
+                        }
+                        if agree && !(p.attained > 1.0) {
+                            failures.push(format!(
+                                "A1 fails: |r| ≥ σ_min(M̃) at ω = {:.6e} rad/s (σ_min/|r| = {:.9}, found by the L∞ proof on [{band_lo:.3e}, ∞])",
+                                p.omega, p.attained
+                            ));
+                        } else if agree && !(p.lower > 1.0) {
+                            failures.push(format!(
+                                "A1 not proved: σ_min/|r| = {:.9} at ω = {:.6e} rad/s, proved only ≥ {:.9}",
+                                p.attained, p.omega, p.lower
+                            ));
+                        }
+                    }
+                    Err(e) => failures.push(format!("A1 not proved: {e}")),
+                }
+                "proved".to_string()
+            }
+        }
     } else if let Some(d) = inp.a1_data {
         let mut m = (f64::NAN, f64::INFINITY);
         for (w, a) in inp.omega.iter().zip(d) {
@@ -233,7 +296,8 @@ pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
         a1_on
     };
     if let (Some(m), Some(w)) = (a1m, a1w) {
-        if !(m > 1.0) {
+        // (A proved failure is reported above with its band.)
+        if !(m > 1.0) && a1_lower.is_none() {
             failures.push(format!(
                 "A1 fails: |r| ≥ σ_min(M̃) at ω = {w:.6e} rad/s (σ_min/|r| = {m:.9})"
             ));
@@ -279,6 +343,8 @@ pub fn certify(r: &Zpk, inp: &CertInput) -> Certificate {
         worst_a1_margin: a1m,
         worst_a1_omega: a1w,
         a1_checked_on: a1_on,
+        a1_lower_bound: a1_lower,
+        a1_band_lo: a1_lo,
         min_abs_r: min_abs,
         r_at_infinity: r.gain.abs(),
         min_axis_distance_pole: dp,

@@ -160,6 +160,7 @@ impl Context<'_> {
             a1: self.a1,
             a1_data: self.env.a1_limit.as_deref(),
             a1_dips: &set.a1_dips,
+            a1_proof: &set.a1_proof,
             margin: set.margin,
             floor: self.floor,
             per_decade: set.cert_per_decade,

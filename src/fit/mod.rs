@@ -11,6 +11,7 @@
 //! * `engine`: one order — candidates, failures recorded and skipped;
 //! * `between`: the no-dip rule between data, proved by interval branch-and-bound;
 //! * `context`: input checks, prescaling, and the choice among certified candidates;
+//! * `a1_proof`: assumption A1 proved on the certificate's band (an `L∞` norm of `M̃⁻¹·r`);
 //! * `certificate`: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
 //! * `realization`: a balanced cascade state-space realization of `r` for the exports;
 //! * `order`: the order sweep and the automatic order choice;
@@ -23,6 +24,7 @@
 //! Comparisons are written `!(x > y)` on purpose throughout: a NaN must fail a check.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub(crate) mod a1_proof;
 pub(crate) mod basis;
 pub(crate) mod between;
 pub(crate) mod certificate;
@@ -41,6 +43,7 @@ pub(crate) mod run;
 mod settings_check;
 pub(crate) mod spectral;
 
+pub use a1_proof::A1Proof;
 pub use basis::Scaling;
 pub use certificate::{certify, CertInput, Certificate};
 pub use order::format_table;
@@ -126,6 +129,11 @@ pub struct FitSettings {
     /// ζ = 1e-7) is not missed. Empty: the grid alone.
     #[serde(skip)]
     pub a1_dips: Vec<f64>,
+    /// Realizations of `M̃⁻¹` with which the certificate proves A1 on its band
+    /// ([`crate::model::Factorization::a1_inverse_blocks`], converted with `.into()`);
+    /// [`A1Proof::Sampled`]: the grid and the dips alone.
+    #[serde(skip)]
+    pub a1_proof: A1Proof,
 }
 
 impl Default for FitSettings {
@@ -149,6 +157,7 @@ impl Default for FitSettings {
             auto_tolerance: 0.01,
             thorough: false,
             a1_dips: Vec::new(),
+            a1_proof: A1Proof::Sampled,
         }
     }
 }

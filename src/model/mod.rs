@@ -20,6 +20,7 @@
 //!   [`Feedback`]);
 //! * models described by their physics: the [`physical`] folder; the closed-loop model of
 //!   Crowder & de Callafon: the [`closed_loop`] folder.
+pub(crate) mod a1_inverse;
 pub mod closed_loop;
 pub(crate) mod config;
 pub(crate) mod controller;

@@ -125,19 +125,20 @@ pub struct FittedR {
 
 /// Fits the smallest unit `r` above the envelope with the defaults of `rshape fit`
 /// (minimax objective; `order` fixed or chosen automatically), keeping `|r| < σ_min(M̃)`
-/// (A1) when `a1` is given.
+/// (A1) when the factorization `a1_model` is given (the certificate proves A1 against it).
 ///
 /// `progress` hears of each order as it starts (see [`crate::fit::FitProgress`]).
 pub fn fit_r(
     env: &Envelope,
-    a1: Option<&dyn Fn(f64) -> f64>,
-    a1_dips: Vec<f64>,
+    a1_model: Option<&crate::model::Factorization>,
     order: OrderChoice,
     progress: Option<ProgressFn<'_>>,
 ) -> std::result::Result<FittedR, FitFailure> {
-    let base = FitSettings {
-        a1_dips,
-        ..FitSettings::default()
+    let a1_fn = a1_model.map(|f| move |w: f64| f.a1_limit(w));
+    let a1: Option<&dyn Fn(f64) -> f64> = a1_fn.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
+    let base = match a1_model {
+        Some(f) => FitSettings::default().with_a1_model(f),
+        None => FitSettings::default(),
     };
     let (result, table) = match order {
         OrderChoice::Auto { max } => {

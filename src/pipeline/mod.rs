@@ -89,7 +89,6 @@ pub fn run(
     options: &RunOptions<'_>,
 ) -> Result<RunOutcome> {
     let mut timings = Timings::default();
-    let f = &config.factorization;
     let envelope::EnvelopeOutcome {
         envelope,
         noise_radii: radii,
@@ -98,17 +97,12 @@ pub fn run(
     } = timings.time("envelope", || envelope::envelope(config, data, options))?;
     let check = timings.time("check", || config.r.as_ref().map(|r| check(r, &envelope)));
     let fit = timings.time("fit", || {
-        let a1 = |w: f64| f.a1_limit(w);
-        let a1: Option<&dyn Fn(f64) -> f64> = match closed_loop::a1_factorization(config) {
-            Some(_) => Some(&a1),
-            None => None,
-        };
-        let dips = if a1.is_some() {
-            f.a1_dips()
-        } else {
-            Vec::new()
-        };
-        integration::fit_r(&envelope, a1, dips, order, options.fit_progress)
+        integration::fit_r(
+            &envelope,
+            closed_loop::a1_factorization(config),
+            order,
+            options.fit_progress,
+        )
     });
     if let Err(e) = &fit {
         warnings.push(format!(

@@ -6,6 +6,51 @@ pub fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// The message with every decimal number of more than 17 digits (a `1e300` printed in full
+/// by `{}`: 301 digits) written in short scientific form (`1e300`, `1.234568e-300`); other
+/// text, and digit runs inside words (hashes, file names), unchanged.
+pub fn short_numbers(msg: &str) -> String {
+    let chars: Vec<char> = msg.chars().collect();
+    let mut out = String::with_capacity(msg.len());
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let in_word = i > 0 && (chars[i - 1].is_alphanumeric() || chars[i - 1] == '_');
+        if !c.is_ascii_digit() || in_word {
+            out.push(c);
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < chars.len() && chars[i].is_ascii_digit() {
+            i += 1;
+        }
+        if i + 1 < chars.len() && chars[i] == '.' && chars[i + 1].is_ascii_digit() {
+            i += 1;
+            while i < chars.len() && chars[i].is_ascii_digit() {
+                i += 1;
+            }
+        }
+        let token: String = chars[start..i].iter().collect();
+        let digits = token.chars().filter(char::is_ascii_digit).count();
+        let followed_by_word = i < chars.len() && (chars[i].is_alphabetic() || chars[i] == '_');
+        match token.parse::<f64>() {
+            Ok(x) if digits > 17 && !followed_by_word => {
+                let sci = format!("{x:.6e}");
+                let (mant, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
+                let mant = if mant.contains('.') {
+                    mant.trim_end_matches('0').trim_end_matches('.')
+                } else {
+                    mant
+                };
+                out.push_str(&format!("{mant}e{exp}"));
+            }
+            _ => out.push_str(&token),
+        }
+    }
+    out
+}
+
 /// Formats a frequency for tables.
 pub fn fmt_g(x: f64) -> String {
     if x.is_infinite() {
@@ -145,6 +190,16 @@ pub fn ellipsize_middle(s: &str, max: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_numbers_are_shortened() {
+        let big = format!("x = {} rad/s", 1e300);
+        assert_eq!(short_numbers(&big), "x = 1e300 rad/s");
+        let small = format!("y = {}; z = 12.5", 1.25e-300);
+        assert_eq!(short_numbers(&small), "y = 1.25e-300; z = 12.5");
+        let kept = "file run_12345678901234567890.csv, line 12345678901234567890x";
+        assert_eq!(short_numbers(kept), kept);
+    }
 
     #[test]
     fn numbers_print_with_sensible_digits_and_never_as_inf() {

@@ -133,14 +133,16 @@ fn complex_list<S: serde::Serializer>(
     seq.end()
 }
 
-/// Runs the Theorem 1 test of `controller` on `f` for each labelled `r`, with grid curves
-/// on `grid`.
-pub fn analyze(
-    f: &Factorization,
-    controller: &Controller,
-    rs: &[(String, TransferFunction)],
-    grid: &[f64],
-) -> Result<(RobustStability, GridCurve)> {
+/// The closed-loop poles of `controller` on `f` (the eigenvalues of the Theorem 1 system's
+/// `A`), without the norms [`analyze`] computes: what a caller needs to choose its grid.
+pub fn closed_loop_poles(f: &Factorization, controller: &Controller) -> Result<Vec<Complex64>> {
+    let k = controller_fits(f, controller)?;
+    eigenvalues(&theorem1_system(f, &k)?.a, "closed-loop poles")
+}
+
+/// The controller as the negative-feedback gain `K`, checked to be `m×p` (plant inputs ×
+/// plant outputs): the cheap test a command makes before it writes anything.
+pub fn controller_fits(f: &Factorization, controller: &Controller) -> Result<StateSpace> {
     let k = controller.negative_feedback_gain();
     if k.d.shape() != (f.inputs(), f.outputs()) {
         return Err(Error::Input {
@@ -154,6 +156,18 @@ pub fn analyze(
             ),
         });
     }
+    Ok(k)
+}
+
+/// Runs the Theorem 1 test of `controller` on `f` for each labelled `r`, with grid curves
+/// on `grid`.
+pub fn analyze(
+    f: &Factorization,
+    controller: &Controller,
+    rs: &[(String, TransferFunction)],
+    grid: &[f64],
+) -> Result<(RobustStability, GridCurve)> {
+    let k = controller_fits(f, controller)?;
     let t = theorem1_system(f, &k)?;
     let poles = eigenvalues(&t.a, "closed-loop poles")?;
     let abscissa = spectral_abscissa(&poles);

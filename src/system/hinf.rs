@@ -70,9 +70,10 @@ fn polish(
     gamma: f64,
     omega: f64,
     level: f64,
+    lo: f64,
     iterations: usize,
 ) -> std::result::Result<HinfNorm, (f64, f64)> {
-    let (g2, w2) = refine_peak(ev, omega);
+    let (g2, w2) = refine_peak(ev, omega, lo);
     if g2 > level {
         return Err((g2, w2));
     }
@@ -84,14 +85,15 @@ fn polish(
     })
 }
 
-/// Golden-section search for a local maximum of `σ_max` in `[ω/(1+η), ω(1+η)]`, `η = 1e-3`.
+/// Golden-section search for a local maximum of `σ_max` in `[ω/(1+η), ω(1+η)]`, `η = 1e-3`
+/// (cut at the band's lower edge `lo`).
 /// Near a sharp peak two crossing eigenvalues of `H(γ)` nearly coalesce and round-off can
 /// push them off the axis; this local search recovers the last digits.
-fn refine_peak(ev: &FreqEvaluator, omega: f64) -> (f64, f64) {
+fn refine_peak(ev: &FreqEvaluator, omega: f64, lo: f64) -> (f64, f64) {
     if !(omega.is_finite() && omega > 0.0) {
         return (sigma_max(ev, omega), omega);
     }
-    let (a, b) = ((omega / 1.001).ln(), (omega * 1.001).ln());
+    let (a, b) = ((omega / 1.001).max(lo).ln(), (omega * 1.001).ln());
     let (x, neg) = super::golden::golden_section_min(|x| -sigma_max(ev, x.exp()), a, b, 80);
     (-neg, x.exp())
 }
@@ -219,6 +221,25 @@ fn pencil_crossings(ss: &StateSpace, level: f64, shift: f64) -> Result<Vec<f64>>
 /// `‖G‖∞` of a stable system; errors when `A` is not Hurwitz (the norm is infinite) or an
 /// eigenvalue computation fails.
 pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
+    peak_gain(ss, 0.0, true)
+}
+
+/// `sup σ_max(G(jω))` over `ω ∈ [omega_lo, ∞]` for any `A` (stable or not): the `L∞` norm of
+/// `G` on that band, by the same Hamiltonian iteration ([`HinfNorm::upper`] is proven). The
+/// relation "γ is a singular value of `G(jω)` iff `jω` is an eigenvalue of `H(γ)`" needs
+/// only that `jω` is not an eigenvalue of `A`, so unstable poles are allowed; an eigenvalue
+/// of `A` on the axis below the band only adds a crossing outside it, which is ignored. A
+/// pole on the axis inside the band gives `gamma = upper = inf` at its frequency.
+pub fn peak_gain_above(ss: &StateSpace, omega_lo: f64) -> Result<HinfNorm> {
+    if !(omega_lo >= 0.0 && omega_lo.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "peak gain: band edge {omega_lo} must be finite and ≥ 0"
+        )));
+    }
+    peak_gain(ss, omega_lo, false)
+}
+
+fn peak_gain(ss: &StateSpace, lo: f64, require_stable: bool) -> Result<HinfNorm> {
     ss.validate("H∞ norm")?;
     // An exact similarity that keeps the Hamiltonian's eigenvalues accurate when the
     // realization has widely spread entries (companion forms of high-order weights).
@@ -239,7 +260,7 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
     }
     let poles = eigenvalues(&ss.a, "H∞ norm: poles")?;
     let abscissa = spectral_abscissa(&poles);
-    if abscissa.is_nan() || abscissa >= 0.0 {
+    if abscissa.is_nan() || (require_stable && abscissa >= 0.0) {
         return Err(Error::Invalid(format!(
             "H∞ norm: the system is not stable (pole with real part {abscissa:.3e}); the norm is infinite"
         )));
@@ -258,7 +279,7 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         .filter(|w| *w > 0.0)
         .fold(f64::INFINITY, f64::min)
         .min(wmax);
-    let mut candidates = vec![0.0];
+    let mut candidates = vec![lo];
     candidates.extend(poles.iter().map(|z| z.im.abs()));
     candidates.extend(poles.iter().map(|z| z.norm()));
     // Around each lightly damped pole, σ_max peaks within a few |Re λ| of |Im λ|.
@@ -271,12 +292,21 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         }
     }
     candidates.extend(logspace(wmin * 1e-2, wmax * 1e2, 200));
-    for w in candidates {
+    for w in candidates.into_iter().filter(|w| *w >= lo) {
         let s = sigma_max(&ev, w);
         if s > gamma {
             gamma = s;
             omega = w;
         }
+    }
+    if !require_stable && gamma == f64::INFINITY {
+        // A pole on the axis inside the band: the gain is unbounded there.
+        return Ok(HinfNorm {
+            gamma,
+            omega,
+            upper: gamma,
+            iterations: 0,
+        });
     }
     if !gamma.is_finite() {
         return Err(Error::Invalid(
@@ -304,10 +334,11 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
             };
             pencil_crossings(ss, level, shift)?
         };
+        ws.retain(|w| *w >= lo);
         ws.sort_by(f64::total_cmp);
         ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs().max(1e-300));
         if ws.is_empty() {
-            match polish(&ev, gamma, omega, level, it) {
+            match polish(&ev, gamma, omega, level, lo, it) {
                 Ok(done) => return Ok(done),
                 Err((g2, w2)) => {
                     (gamma, omega) = (g2, w2);
@@ -317,8 +348,9 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         }
         let mut improved = false;
         // σ_max exceeds the level on intervals bounded by consecutive crossings (and on
-        // [0, ω₁] when σ_max(G(0)) is above it): probe ω = 0 and every geometric midpoint.
-        let mut probe = vec![0.0];
+        // [lo, ω₁] when σ_max(G(j·lo)) is above it): probe the band's edge and every
+        // geometric midpoint.
+        let mut probe = vec![lo];
         probe.extend(ws.windows(2).map(|p| {
             if p[0] > 0.0 {
                 (p[0] * p[1]).sqrt()
@@ -337,7 +369,7 @@ pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
         if !improved {
             // The candidates bound no interval above γ: round-off touches of the peak (or
             // lightly damped eigenvalues near the axis). Polish the peak locally.
-            match polish(&ev, gamma, omega, level, it) {
+            match polish(&ev, gamma, omega, level, lo, it) {
                 Ok(done) => return Ok(done),
                 Err((g2, w2)) => {
                     (gamma, omega) = (g2, w2);

@@ -31,7 +31,8 @@ use num_complex::Complex64;
 /// A plant with its normalized left coprime factors in state space.
 #[derive(Debug, Clone)]
 pub struct NormalizedLcf {
-    /// The plant `G = (A, B, C, D)`.
+    /// The plant `G = (A, B, C, D)`, in the state coordinates of the factors (`C = [C₁ 0]`,
+    /// an orthogonal similarity of the plant as given).
     pub plant: StateSpace,
     /// The output injection `L`.
     pub l: DMatrix<f64>,
@@ -76,16 +77,49 @@ fn rescaled(plant: &StateSpace, w: f64) -> Option<StateSpace> {
     })
 }
 
+/// The same plant after the orthogonal similarity `x ↦ Qᵀx` that puts the row space of `C`
+/// on the first coordinates: `C·Q = [C₁ 0]` with exact zeros (`QR = [Cᵀ 0]`, Householder).
+///
+/// Why: when the output gain is large, the filter Riccati solution is `Y = Y₀ + Y₁/k + …`
+/// with `C·Y₀ = 0` (the direction a zero in the right half-plane keeps unseen), and the
+/// slow closed-loop pole of `A + LC` lives in the `1/k²` tail of `Y`. In the plant's own
+/// coordinates that tail is mixed into every entry of `Y` with `Y₀` and lost below its
+/// rounding (`k = 10⁷`: a closed-loop pole at +0.71 instead of −1.60, the factors refused;
+/// `k = 10⁹`: −0.25, accepted and wrong). With `C = [C₁ 0]`, `Y₀` has exact zeros in the
+/// rows and columns of `C₁`, and the tail keeps entries of its own.
+fn output_aligned(plant: &StateSpace) -> StateSpace {
+    let (n, p) = (plant.a.nrows(), plant.c.nrows());
+    if n == 0 || p == 0 {
+        return plant.clone();
+    }
+    let cols = n.max(p);
+    let mut m = DMatrix::<f64>::zeros(n, cols);
+    m.view_mut((0, 0), (n, p)).copy_from(&plant.c.transpose());
+    let qr = m.qr();
+    let q = qr.q(); // n×n
+    let r = qr.r(); // n×cols, upper triangular: exact zeros below the diagonal
+    let c = r.view((0, 0), (n, p)).transpose();
+    StateSpace {
+        a: q.transpose() * &plant.a * &q,
+        b: q.transpose() * &plant.b,
+        c,
+        d: plant.d.clone(),
+    }
+}
+
 impl NormalizedLcf {
     /// Computes the factors; fails with a one-line error when the filter Riccati equation
     /// has no stabilizing solution (an unstable mode that the output does not see, or a
     /// mode on the imaginary axis that the input does not reach).
     ///
-    /// The plant is tried as given; when the Riccati equation fails, it is retried in two
-    /// rescaled state coordinates (see `rescaled`) before the failure is reported, so that
-    /// the verdict does not depend on the plant's gain scale.
+    /// The plant is first brought to coordinates with `C = [C₁ 0]` (see `output_aligned`:
+    /// an orthogonal similarity, so `plant` holds the same transfer function in those
+    /// coordinates); when the Riccati equation fails, it is retried in two rescaled state
+    /// coordinates (see `rescaled`) before the failure is reported, so that the verdict
+    /// does not depend on the plant's gain scale.
     pub fn new(plant: StateSpace) -> Result<Self> {
         plant.validate("plant")?;
+        let plant = output_aligned(&plant);
         match Self::in_coordinates(plant.clone()) {
             Ok(f) => Ok(f),
             Err(e) => {

@@ -253,11 +253,60 @@ pub fn care(
             newton_steps: 0,
         });
     }
+    match care_in_coordinates(a, g, q, what) {
+        Ok(s) => Ok(s),
+        Err(e) => care_balanced(a, g, q, what).ok_or(e),
+    }
+}
+
+/// The Hamiltonian `[A −G; −Q −Aᵀ]`.
+fn hamiltonian(a: &DMatrix<f64>, g: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
     let mut h = DMatrix::zeros(2 * n, 2 * n);
     h.view_mut((0, 0), (n, n)).copy_from(a);
     h.view_mut((0, n), (n, n)).copy_from(&(-g));
     h.view_mut((n, 0), (n, n)).copy_from(&(-q));
     h.view_mut((n, n), (n, n)).copy_from(&(-a.transpose()));
+    h
+}
+
+/// The second try of [`care`]: the same equation after a symplectic diagonal scaling
+/// `T = diag(D, D⁻¹)` of the Hamiltonian (`A ↦ D⁻¹AD`, `G ↦ D⁻¹GD⁻¹`, `Q ↦ DQD`,
+/// `X = D⁻¹X'D⁻¹`), `D` from the Parlett–Reinsch balancing `diag(D₁, D₂)` of `H` as
+/// `D = (D₁/D₂)^(1/2)` rounded to powers of two (exact in floating point; it keeps the
+/// Hamiltonian structure that a plain balancing would break). A Hamiltonian whose blocks
+/// span many decades (a large output gain in coordinates that mix the states) makes the
+/// sign function's invariant subspace inaccurate; balanced, its entries are comparable.
+fn care_balanced(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    what: &str,
+) -> Option<CareSolution> {
+    let n = a.nrows();
+    let d2 = super::eig::balancing(&hamiltonian(a, g, q));
+    let d: Vec<f64> = (0..n)
+        .map(|i| 2f64.powi((0.5 * (d2[i] / d2[n + i]).log2()).round() as i32))
+        .collect();
+    if d.iter().all(|v| *v == 1.0) || d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+        return None;
+    }
+    let ab = DMatrix::from_fn(n, n, |i, j| a[(i, j)] * d[j] / d[i]);
+    let gb = DMatrix::from_fn(n, n, |i, j| g[(i, j)] / (d[i] * d[j]));
+    let qb = DMatrix::from_fn(n, n, |i, j| q[(i, j)] * d[i] * d[j]);
+    let mut s = care_in_coordinates(&ab, &gb, &qb, what).ok()?;
+    s.x = DMatrix::from_fn(n, n, |i, j| s.x[(i, j)] / (d[i] * d[j]));
+    Some(s)
+}
+
+fn care_in_coordinates(
+    a: &DMatrix<f64>,
+    g: &DMatrix<f64>,
+    q: &DMatrix<f64>,
+    what: &str,
+) -> Result<CareSolution> {
+    let n = a.nrows();
+    let h = hamiltonian(a, g, q);
     let (w, sign_iterations) = sign(h, what)?;
     // [W12; W22 + I] X = −[W11 + I; W21]
     let mut lhs = DMatrix::zeros(2 * n, n);

@@ -7,6 +7,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod a1_proof;
 mod a1_verdict;
 mod bad_input;
 mod bad_input_batch;
@@ -20,6 +21,7 @@ mod figures_extreme;
 mod figures_glance;
 mod fuzz_inputs;
 mod hardening_iii;
+mod hardening_iii_minor;
 mod kill_safety;
 mod output_modes;
 mod output_policy;

@@ -28,6 +28,7 @@ fn input<'a>(omega: &'a [f64], r_min: &'a [f64], margin: f64) -> CertInput<'a> {
         a1: None,
         a1_data: None,
         a1_dips: &[],
+        a1_proof: &rshape::fit::A1Proof::Sampled,
         margin,
         floor: 1e-12,
         per_decade: 100,
