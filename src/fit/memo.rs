@@ -55,9 +55,7 @@ pub(super) fn solve(lp: &Lp, max_iter: u32, refine: bool) -> (LpOut, bool) {
     let hit = MEMO.with(|m| {
         m.borrow()
             .iter()
-            .find(|e| {
-                e.hash == key && e.max_iter == max_iter && e.refine == refine && e.lp == *lp
-            })
+            .find(|e| e.hash == key && e.max_iter == max_iter && e.refine == refine && e.lp == *lp)
             .map(|e| e.out.clone())
     });
     if let Some(out) = hit {
@@ -69,7 +67,8 @@ pub(super) fn solve(lp: &Lp, max_iter: u32, refine: bool) -> (LpOut, bool) {
         let new = size(lp);
         if new <= MAX_COEFFS {
             while m.len() >= ENTRIES
-                || (!m.is_empty() && m.iter().map(|e| size(&e.lp)).sum::<usize>() + new > MAX_COEFFS)
+                || (!m.is_empty()
+                    && m.iter().map(|e| size(&e.lp)).sum::<usize>() + new > MAX_COEFFS)
             {
                 m.remove(0);
             }
