@@ -104,7 +104,7 @@ pub(crate) struct LpOut {
 }
 
 impl Lp {
-    /// [`Self::solve`] through the [`memo`] of recent solves: the same LP with the same
+    /// [`Self::solve`] through the memo of recent solves ([`super::memo`]): the same LP with the same
     /// settings (compared exactly) gives the same answer without a second solve.  Returns
     /// whether Clarabel ran.
     pub fn solve_memo(&self, max_iter: u32, refine: bool) -> (LpOut, bool) {
