@@ -104,9 +104,9 @@ pub(crate) struct LpOut {
 }
 
 impl Lp {
-    /// [`Self::solve`] through the memo of recent solves ([`super::memo`]): the same LP with the same
-    /// settings (compared exactly) gives the same answer without a second solve.  Returns
-    /// whether Clarabel ran.
+    /// [`Self::solve`] through the memo of recent solves ([`super::memo`]): the same LP
+    /// with the same settings (compared exactly) gives the same answer without a second
+    /// solve.  Returns whether Clarabel ran.
     pub fn solve_memo(&self, max_iter: u32, refine: bool) -> (LpOut, bool) {
         super::memo::solve(self, max_iter, refine)
     }
