@@ -7,7 +7,8 @@
 //! Heavy (a few minutes in release): `cargo test --release --test fit fit_sweep:: -- --ignored
 //! --nocapture`.  It prints LPs and seconds per envelope.  `RSHAPE_SWEEP_WRITE=1` rewrites
 //! the reference table instead of checking it (only on the code the table is meant to record);
-//! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`.
+//! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`;
+//! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing).
 
 #[path = "../../benches/support/random_envelopes.rs"]
 mod random_envelopes;
