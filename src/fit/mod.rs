@@ -32,6 +32,7 @@ pub(crate) mod chebseries;
 mod context;
 pub(crate) mod engine;
 mod levelsearch;
+mod memo;
 pub(crate) mod order;
 pub(crate) mod polyfit;
 mod polylevel;

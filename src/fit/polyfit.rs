@@ -26,6 +26,7 @@ use super::problem::{SolverEvent, SolverStatus};
 use super::provenance::{EventKind, Origin};
 use super::spectral::Zpk;
 use super::FitSettings;
+use rayon::prelude::*;
 
 /// Rows (summed over the retries with every row) that doubtful levels may cost one order
 /// of the global candidate before the remaining disk centres are skipped: about 140
@@ -68,18 +69,30 @@ pub(crate) fn minimax(
     let mut t_best = t_known;
     let cs = centres(prep);
     // The centre 1 with both cut floors first, then the other centres.
-    let attempts = B_CUTS
+    let attempts: Vec<(f64, f64)> = B_CUTS
         .iter()
         .map(|b| (cs[0], *b))
-        .chain(cs[1..].iter().map(|x| (*x, B_CUTS[0])));
-    let mut b_cut_used = false;
+        .chain(cs[1..].iter().map(|x| (*x, B_CUTS[0])))
+        .collect();
     // The doubts an order may spend on other centres, from a budget in rows: a doubt costs
     // a retry with every row (3 per grid point), cheap at 1000 data and about 2 s each at
     // 100,000 (where every centre's LP ends `InsufficientProgress` alike: order 6 took
     // 200 s with all five centres).
     let allowed = (DOUBT_BUDGET_ROWS / (3 * prep.grid.len()).max(1)).max(2);
     let first = events.len();
-    for (i, attempt) in attempts.enumerate() {
+    // The attempts in order: the band centre with the first cut floor, the second cut floor
+    // only when the first attempt cut on `B` (order 10 on 1000 data: 2.6 → 2.0 s, the
+    // reference sweep unchanged), the other centres.
+    let mut pending: std::collections::VecDeque<(f64, f64)> = attempts.iter().copied().collect();
+    let mut b_cut_used = None;
+    // The band centre runs alone (most orders end there without a doubt); after a doubt the
+    // next two attempts run at once on two cores (`rayon`) from the level known then.  The
+    // loop takes their results in order, exactly as if they had run one after the other: an
+    // attempt is run again when the one before it lowered the level it started from, and
+    // dropped when the one before it was decisive.  So the fit is that of the sequential
+    // search, and at most one attempt is run for nothing.
+    let mut ready: std::collections::VecDeque<Attempt> = std::collections::VecDeque::new();
+    loop {
         if events.len() - first >= allowed {
             events.push(SolverEvent {
                 order: n,
@@ -94,23 +107,37 @@ pub(crate) fn minimax(
             });
             break;
         }
-        // The second cut floor changes nothing when the first attempt never cut on `B`
-        // (order 10 on 1000 data: 2.6 → 2.0 s, the reference sweep unchanged).
-        if i == 1 && !b_cut_used {
-            continue;
+        let mut a = match ready.pop_front() {
+            Some(a) if a.t_start == t_best => a,
+            Some(a) => attempt_at(prep, n, a.attempt, t_best, set),
+            None => {
+                let Some(next) = pending.pop_front() else {
+                    break;
+                };
+                if b_cut_used.is_none() {
+                    attempt_at(prep, n, next, t_best, set)
+                } else {
+                    let pair: Vec<(f64, f64)> =
+                        std::iter::once(next).chain(pending.pop_front()).collect();
+                    let mut done: Vec<Attempt> = pair
+                        .par_iter()
+                        .map(|p| attempt_at(prep, n, *p, t_best, set))
+                        .collect();
+                    ready.extend(done.drain(1..));
+                    done.pop().expect("one attempt")
+                }
+            }
+        };
+        if b_cut_used.is_none() {
+            b_cut_used = Some(a.b_cut_used);
+            if !a.b_cut_used {
+                pending.retain(|p| *p != attempts[1]);
+            }
         }
-        let before = events.len();
-        let found = minimax_at(
-            prep,
-            n,
-            attempt,
-            t_best,
-            set,
-            events,
-            lp_solves,
-            &mut b_cut_used,
-        );
-        if let Some(c) = found {
+        let decisive = a.events.is_empty();
+        events.append(&mut a.events);
+        *lp_solves += a.lp_solves;
+        if let Some(c) = a.found {
             // A candidate at (or a hair above) the level already known is kept too: it
             // is exact between the data where the known one may need repair.
             if best.as_ref().is_none_or(|b: &Scored| c.t < b.t) {
@@ -121,11 +148,50 @@ pub(crate) fn minimax(
         // Every doubt (a solve short of `Solved`, cuts that did not converge, a failed
         // factorization) is an event; a search without one decided every level exactly
         // at this centre, and the other centres are not needed.
-        if events.len() == before {
+        if decisive {
             break;
         }
     }
     best
+}
+
+/// One attempt of [`minimax`] (a disk-map centre and cut floor) from the known level
+/// `t_start`, with its own events and LP count.
+struct Attempt {
+    attempt: (f64, f64),
+    t_start: f64,
+    found: Option<Scored>,
+    events: Vec<SolverEvent>,
+    lp_solves: usize,
+    b_cut_used: bool,
+}
+
+fn attempt_at(
+    prep: &Prepared,
+    n: usize,
+    attempt: (f64, f64),
+    t_start: f64,
+    set: &FitSettings,
+) -> Attempt {
+    let (mut events, mut lp_solves, mut b_cut_used) = (Vec::new(), 0, false);
+    let found = minimax_at(
+        prep,
+        n,
+        attempt,
+        t_start,
+        set,
+        &mut events,
+        &mut lp_solves,
+        &mut b_cut_used,
+    );
+    Attempt {
+        attempt,
+        t_start,
+        found,
+        events,
+        lp_solves,
+        b_cut_used,
+    }
 }
 
 /// [`minimax`] with the disk map centred at `x₀`: bracket the level, bisect it, and
