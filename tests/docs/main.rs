@@ -10,3 +10,4 @@ mod architecture;
 mod docs_commands;
 mod docs_figures;
 mod docs_snippets;
+mod docs_tables;
