@@ -45,7 +45,9 @@ fn alpha_row(out: &str, label: &str) -> Option<f64> {
 
 /// Bandwidth from the `closed loop:` line (None where it prints `none`).
 fn bandwidth(out: &str) -> Option<f64> {
-    let l = out.lines().find(|l| l.starts_with("closed loop: bandwidth"))?;
+    let l = out
+        .lines()
+        .find(|l| l.starts_with("closed loop: bandwidth"))?;
     let rest = &l[l.find(" dB) ")? + 5..];
     if rest.starts_with("none") {
         None
@@ -66,10 +68,7 @@ fn agrees(cell: &str, got: Option<f64>) -> bool {
             // Half a unit in the last digit shown (mantissa digits after the point).
             let mantissa = c.split(['e', 'E']).next().unwrap();
             let decimals = mantissa.split('.').nth(1).map_or(0, str::len) as i32;
-            let exp10: i32 = c
-                .split(['e', 'E'])
-                .nth(1)
-                .map_or(0, |e| e.parse().unwrap());
+            let exp10: i32 = c.split(['e', 'E']).nth(1).map_or(0, |e| e.parse().unwrap());
             (v - doc).abs() <= 0.5 * 10f64.powi(exp10 - decimals) * (1.0 + 1e-9)
         }
     }
@@ -101,6 +100,7 @@ fn config_of(cell: &str) -> String {
 }
 
 fn check_cells(what: &str, row: &[String], got: &[Option<f64>]) {
+    eprintln!("table {what}, {}: measured {got:?}", row[0]);
     for (k, (cell, g)) in row[1..].iter().zip(got).enumerate() {
         assert!(
             agrees(cell, *g),
@@ -148,14 +148,18 @@ fn parser_reads_the_digits_shown() {
 #[test]
 fn synthesize_configured_table_is_current() {
     let rows = table(&doc(), "configured");
-    assert_eq!(rows.len(), 3, "the configured table has the three examples with an r");
+    assert_eq!(
+        rows.len(),
+        3,
+        "the configured table has the three examples with an r"
+    );
     for row in rows.iter().filter(|r| !r[0].contains("robot")) {
         check_configured_row(row);
     }
 }
 
 #[test]
-#[ignore = "minutes in a debug build: the robot's proof and four fits; run with --release"]
+#[ignore = "about 75 s in a debug build: the robot's proofs and four fits"]
 fn synthesize_robot_and_fitted_tables_are_current() {
     let d = doc();
     for row in table(&d, "configured")
