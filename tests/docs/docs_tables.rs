@@ -1,7 +1,7 @@
 //! The figures tables of the user guide are rerun and compared: docs/guide/synthesize.md's
 //! "What a tighter r buys" tables (marked `<!-- table: NAME -->`), each cell against what
 //! `rshape synthesize` prints now, to the digits the table shows.  The cheap rows run in every
-//! `cargo test`; the robot's configured row and the fitted-r table (a fit each, minutes in a
+//! `cargo test`; the robot's configured row and the fitted-r table (a fit each, about 75 s in a
 //! debug build) in the ignored test.
 use crate::common::{repo, rshape, stdout};
 
