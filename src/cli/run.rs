@@ -40,7 +40,7 @@ pub fn fit_tag(j: &serde_json::Value) -> String {
     )
 }
 
-/// At most 8 frequencies, then how many in all.
+/// At most 8 frequencies with their unit, then how many in all.
 fn list(v: &[f64]) -> String {
     let head = v
         .iter()
@@ -49,9 +49,9 @@ fn list(v: &[f64]) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     if v.len() > 8 {
-        format!("{head}, … ({} in all)", v.len())
+        format!("{head}, … rad/s ({} in all)", v.len())
     } else {
-        head
+        format!("{head} rad/s")
     }
 }
 
