@@ -97,7 +97,7 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
         };
         if rep.verdict == Verdict::NotAdmissible && !rep.failing_omegas.is_empty() {
             println!(
-                "|{w}| <= r_min at {} of {} data: omega = {} rad/s",
+                "|{w}| <= r_min at {} of {} data: omega = {}",
                 rep.failing_omegas.len(),
                 rep.rows.len(),
                 list(&rep.failing_omegas)
@@ -108,13 +108,13 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
                 println!("consistent: {w} explains all {} data", rep.rows.len())
             }
             Verdict::Inconsistent => println!(
-                "inconsistent at {} of {} data: omega = {} rad/s",
+                "inconsistent at {} of {} data: omega = {}",
                 rep.failing_omegas.len(),
                 rep.rows.len(),
                 list(&rep.failing_omegas)
             ),
             Verdict::NotAdmissible => println!(
-                "not admissible: A1 fails (|{w}| >= sigma_min(M~)) at {} of {} data: omega = {} rad/s; the perturbed family then holds unstable plants and Theorems 2-4 give no verdict: make |{w}| smaller there",
+                "not admissible: A1 fails (|{w}| >= sigma_min(M~)) at {} of {} data: omega = {}; the perturbed family then holds unstable plants and Theorems 2-4 give no verdict: make |{w}| smaller there",
                 rep.a1_violations.len(),
                 rep.rows.len(),
                 list(&rep.a1_violations)

@@ -55,7 +55,7 @@ pub fn run(a: &EnvelopeArgs) -> Result<i32> {
     let beyond = env.beyond_a1();
     if !beyond.is_empty() {
         println!(
-            "warning: r_min reaches the A1 limit at {} datum(s) (omega = {} rad/s): no admissible r explains them; the nominal model must change",
+            "warning: r_min reaches the A1 limit at {} datum(s) (omega = {}): no admissible r explains them; the nominal model must change",
             beyond.len(),
             fmt_omegas(&env.omega, &beyond)
         );

@@ -40,7 +40,7 @@ pub fn fit_tag(j: &serde_json::Value) -> String {
     )
 }
 
-/// At most 8 frequencies, then how many in all.
+/// At most 8 frequencies with their unit, then how many in all.
 fn list(v: &[f64]) -> String {
     let head = v
         .iter()
@@ -49,9 +49,9 @@ fn list(v: &[f64]) -> String {
         .collect::<Vec<_>>()
         .join(", ");
     if v.len() > 8 {
-        format!("{head}, … ({} in all)", v.len())
+        format!("{head}, … rad/s ({} in all)", v.len())
     } else {
-        head
+        format!("{head} rad/s")
     }
 }
 
@@ -103,7 +103,7 @@ pub fn run(a: &RunArgs) -> Result<i32> {
     );
     if !rep.beyond_a1.is_empty() {
         outln!(
-            "            r_min reaches the A1 limit at omega = {} rad/s: no admissible r explains these data",
+            "            r_min reaches the A1 limit at omega = {}: no admissible r explains these data",
             list(&rep.beyond_a1)
         );
     }
@@ -113,13 +113,13 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             rep.n_data
         ),
         Some(Verdict::Inconsistent) => outln!(
-            "  check     INCONSISTENT at {} of {} data: omega = {} rad/s",
+            "  check     INCONSISTENT at {} of {} data: omega = {}",
             rep.failing_omegas.len(),
             rep.n_data,
             list(&rep.failing_omegas)
         ),
         Some(Verdict::NotAdmissible) => outln!(
-            "  check     NOT ADMISSIBLE: A1 fails for the configured {w} (|{w}| ≥ σ_min(M̃)) at {} of {} data: omega = {} rad/s; no verdict on consistency there",
+            "  check     NOT ADMISSIBLE: A1 fails for the configured {w} (|{w}| ≥ σ_min(M̃)) at {} of {} data: omega = {}; no verdict on consistency there",
             rep.a1_violations.len(),
             rep.n_data,
             list(&rep.a1_violations)

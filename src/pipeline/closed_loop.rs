@@ -66,7 +66,7 @@ pub(super) fn envelope_by_kind(
     let un = rep.uninformative();
     if !un.is_empty() {
         warnings.push(format!(
-            "{} datum(s) are uninformative (the experiment's sensitivity I − Φ·C̄ is below 1e-8: Φ ≈ C̄⁻¹ whatever the plant): omega = {} rad/s",
+            "{} datum(s) are uninformative (the experiment's sensitivity I − Φ·C̄ is below 1e-8: Φ ≈ C̄⁻¹ whatever the plant): omega = {}",
             un.len(),
             crate::report::fmt::fmt_omegas(&rep.envelope.omega, &un)
         ));

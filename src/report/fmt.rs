@@ -67,16 +67,18 @@ pub fn fmt_g(x: f64) -> String {
     }
 }
 
-/// A list of flagged frequencies for the terminal: every value when there are few, else the
-/// bands of consecutive data (`lo–hi`) with their counts.  `all` are the data frequencies
-/// (sorted), `flagged` a subset of them.
+/// A list of flagged frequencies for the terminal, with its unit: every value when there are
+/// few (`1, 2.5 rad/s`), else the bands of consecutive data with their counts
+/// (`1–56.8 rad/s (205 data), 60 rad/s`).  `all` are the data frequencies (sorted), `flagged`
+/// a subset of them.
 pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
     if flagged.len() <= 12 {
         return flagged
             .iter()
             .map(|w| fmt_g(*w))
             .collect::<Vec<_>>()
-            .join(", ");
+            .join(", ")
+            + " rad/s";
     }
     let mut bands: Vec<(f64, f64, usize)> = Vec::new();
     let mut prev_idx: Option<usize> = None;
@@ -103,9 +105,9 @@ pub fn fmt_omegas(all: &[f64], flagged: &[f64]) -> String {
         .iter()
         .map(|(lo, hi, n)| {
             if n == &1 {
-                fmt_g(*lo)
+                format!("{} rad/s", fmt_g(*lo))
             } else {
-                format!("{}–{} ({n} data)", fmt_g(*lo), fmt_g(*hi))
+                format!("{}–{} rad/s ({n} data)", fmt_g(*lo), fmt_g(*hi))
             }
         })
         .collect::<Vec<_>>()

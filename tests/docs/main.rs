@@ -11,3 +11,4 @@ mod diagnose_layers;
 mod docs_commands;
 mod docs_figures;
 mod docs_snippets;
+mod docs_tables;
