@@ -80,7 +80,7 @@ fn judge(
 ) -> Vec<String> {
     let mut bad = Vec::new();
     for (k, s) in steps.iter().enumerate() {
-        if !(s[1] < s[0]) || s[3] > s[2] {
+        if s[1].is_nan() || s[1] >= s[0] || s[3] > s[2] {
             bad.push(format!(
                 "step {}: misfit_rms {} → {}, invalid {} → {}",
                 k + 1,

@@ -57,8 +57,8 @@ fn the_generated_beam_is_a_free_free_beam() {
         );
     }
     // Dense lines: at least three in each in-band half-power band.
-    for r in 0..IN_BAND {
-        let (w, z) = (omega_n(r), ZETA[r]);
+    for (r, &z) in ZETA.iter().enumerate().take(IN_BAND) {
+        let w = omega_n(r);
         let n_in = b
             .data
             .omega
@@ -120,8 +120,8 @@ fn discovery_finds_the_four_modes_and_nothing_else() {
         "found (Hz, ζ): {:?}",
         found.iter().map(|(w, z)| (w / tau, *z)).collect::<Vec<_>>()
     );
-    for r in 0..IN_BAND {
-        let (w, z) = (omega_n(r), ZETA[r]);
+    for (r, &z) in ZETA.iter().enumerate().take(IN_BAND) {
+        let w = omega_n(r);
         let hit = found
             .iter()
             .find(|(wf, _)| (wf / w - 1.0).abs() < 1e-3)
