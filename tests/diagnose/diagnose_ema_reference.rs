@@ -3,7 +3,8 @@
 //! script that made them).  `rshape diagnose --apply chosen` repeated from a rigid body on
 //! pyfrf 20–1200 Hz and the pyuff 1×3 beam 10–990 Hz must end with every mode the diagram
 //! finds stable at half of its orders or more (0.1 % in frequency, ζ within 2×), no other
-//! in-band mode (a weaker mode of the diagram may be found), no mains mode, no cancelling pair
+//! in-band mode (a weaker mode of the diagram may be found), no mains mode (other than a mode
+//! the diagram finds, as pyfrf's 900 Hz = 18 × 50 Hz), no cancelling pair
 //! and no mode far above the data, with `misfit_rms` and the invalid fraction falling at every
 //! applied step.
 //!
@@ -114,6 +115,14 @@ fn judge(
         if !refs.iter().any(|(f, _, _)| (fm / f - 1.0).abs() < 1e-3) {
             bad.push(format!("{fm} Hz (ζ {zm}): not in the reference"));
         }
+        // A mode the diagram finds stable at half its orders is the structure's, even at a
+        // mains harmonic (pyfrf's 900 Hz = 18 × 50 Hz).
+        if refs
+            .iter()
+            .any(|(f, _, must)| *must && (fm / f - 1.0).abs() < 1e-3)
+        {
+            continue;
+        }
         for f0 in [50.0, 60.0] {
             let h = (fm / f0).round().max(1.0);
             if (fm - h * f0).abs() < 0.5 && zm * fm < 1.0 {
@@ -165,8 +174,12 @@ fn pyfrf_chain_ends_with_the_stabilization_diagram_modes() {
     assert!(bad.is_empty(), "{bad:#?}");
 }
 
+/// Fails today (issue 33 open): the chain ends with the 51.5 Hz mode at ζ 7.6e-5 (the
+/// record's floor: its 0.06 Hz half-power band falls between the 1 Hz lines), 7.4× below
+/// the diagram's 5.7e-4, and with the diagram's weak 900.5 Hz pole at ζ 1.17e-3 (2.3× its
+/// 5.1e-4); a 4.9 µs input delay is added at step 3.
 #[test]
-#[ignore = "heavy: a discovery chain on real data (minutes)"]
+#[ignore = "heavy (minutes), and fails today: 51.5 Hz ζ 7.4× below the reference, 900.8 Hz ζ 2.3× above"]
 fn pyuff_chain_ends_with_the_stabilization_diagram_modes() {
     let dir = tempfile::tempdir().unwrap();
     let (last, steps) = chain(&repo("tests/data/pyuff_rigid.toml"), dir.path(), 6);
