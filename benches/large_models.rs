@@ -1,0 +1,69 @@
+//! Issue 34 item 9: where the time of a large modal model goes. The model is the issue-21
+//! structure of `benches/support/modes.rs` (`K` lightly damped modes, special factorization
+//! with a diagonal `M̃`), `K` = 25, 50, 100 (200 and 1000 are minutes: see the report of
+//! issue 34), with a static controller `K = 10⁻³`.
+//!
+//! * `load`: `Config::load` (what `compare` and every command pays first);
+//! * `theorem1_system`: the realization of the loop (`modal_system` = `M̃⁻¹·[Ñ·J  I]`, the
+//!   minimal realizations, the feedback);
+//! * `closed_loop_poles`: that plus the eigenvalues (the internal-stability verdict);
+//! * `stability_run`: `pipeline::stability::run` (poles, the grid, the exact H∞ norms).
+//!
+//! Run: `cargo bench --bench large_models -- --sample-count 1`.
+
+#[path = "support/modes.rs"]
+#[allow(dead_code)]
+mod modes;
+
+use divan::Bencher;
+use rshape::model::{Config, Controller};
+
+fn main() {
+    divan::main();
+}
+
+const SIZES: &[usize] = &[25, 50, 100];
+
+fn inputs(k: usize) -> (Config, Controller, tempfile::TempDir) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let cfg = modes::write(dir.path(), k, 200);
+    let kp = dir.path().join("k.toml");
+    std::fs::write(&kp, "[controller]\ntf = [[1e-3]]\n").expect("controller");
+    let config = Config::load(&cfg).expect("config");
+    let controller = Controller::load(&kp).expect("controller");
+    (config, controller, dir)
+}
+
+#[divan::bench(args = SIZES, sample_count = 2)]
+fn load(bencher: Bencher, k: usize) {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let cfg = modes::write(dir.path(), k, 200);
+    bencher.bench(|| Config::load(&cfg).expect("config"));
+}
+
+#[divan::bench(args = SIZES, sample_count = 2)]
+fn theorem1_system(bencher: Bencher, k: usize) {
+    let (config, controller, _dir) = inputs(k);
+    let kk = controller.negative_feedback_gain();
+    bencher.bench(|| rshape::stability::theorem1_system(&config.factorization, &kk).expect("T"));
+}
+
+#[divan::bench(args = SIZES, sample_count = 2)]
+fn closed_loop_poles(bencher: Bencher, k: usize) {
+    let (config, controller, _dir) = inputs(k);
+    bencher.bench(|| {
+        rshape::stability::closed_loop_poles(&config.factorization, &controller).expect("poles")
+    });
+}
+
+#[divan::bench(args = SIZES, sample_count = 1)]
+fn stability_run(bencher: Bencher, k: usize) {
+    let (config, controller, _dir) = inputs(k);
+    let r = vec![(
+        "configured".to_string(),
+        rshape::system::TransferFunction::gain(1e-3),
+    )];
+    bencher.bench(|| {
+        rshape::pipeline::stability::run(&config, &controller, &r, None).expect("stability")
+    });
+}
