@@ -99,19 +99,29 @@ fn config_of(cell: &str) -> String {
     cell.trim_matches('`').to_string()
 }
 
-fn check_cells(what: &str, row: &[String], got: &[Option<f64>]) {
+/// The cells of `row` that disagree with `got`, each as a line naming table, row and column.
+fn stale_cells(what: &str, row: &[String], got: &[Option<f64>]) -> Vec<String> {
     eprintln!("table {what}, {}: measured {got:?}", row[0]);
-    for (k, (cell, g)) in row[1..].iter().zip(got).enumerate() {
-        assert!(
-            agrees(cell, *g),
-            "docs/guide/synthesize.md, table {what}, row {}, column {}: the doc says {cell}, synthesize now gives {g:?}",
-            row[0],
-            k + 2
-        );
-    }
+    row[1..]
+        .iter()
+        .zip(got)
+        .enumerate()
+        .filter(|(_, (cell, g))| !agrees(cell, **g))
+        .map(|(k, (cell, g))| {
+            format!(
+                "docs/guide/synthesize.md, table {what}, row {}, column {}: the doc says {cell}, synthesize now gives {g:?}",
+                row[0],
+                k + 2
+            )
+        })
+        .collect()
 }
 
-fn check_configured_row(row: &[String]) {
+fn assert_current(stale: &[String]) {
+    assert!(stale.is_empty(), "stale figures:\n{}", stale.join("\n"));
+}
+
+fn configured_row(row: &[String]) -> Vec<String> {
     let config = config_of(&row[0]);
     let gm = synthesize(&config, &[]);
     let hinf = synthesize(&config, &["--method", "hinf"]);
@@ -124,7 +134,7 @@ fn check_configured_row(row: &[String]) {
         bandwidth(&hinf),
         after(&hinf, "Ms ="),
     ];
-    check_cells("configured", row, &got);
+    stale_cells("configured", row, &got)
 }
 
 fn doc() -> String {
@@ -153,21 +163,23 @@ fn synthesize_configured_table_is_current() {
         3,
         "the configured table has the three examples with an r"
     );
-    for row in rows.iter().filter(|r| !r[0].contains("robot")) {
-        check_configured_row(row);
-    }
+    let stale: Vec<String> = rows
+        .iter()
+        .filter(|r| !r[0].contains("robot"))
+        .flat_map(|r| configured_row(r))
+        .collect();
+    assert_current(&stale);
 }
 
 #[test]
 #[ignore = "about 75 s in a debug build: the robot's proofs and four fits"]
 fn synthesize_robot_and_fitted_tables_are_current() {
     let d = doc();
-    for row in table(&d, "configured")
+    let mut stale: Vec<String> = table(&d, "configured")
         .iter()
         .filter(|r| r[0].contains("robot"))
-    {
-        check_configured_row(row);
-    }
+        .flat_map(|r| configured_row(r))
+        .collect();
     let rows = table(&d, "fitted");
     assert_eq!(rows.len(), 4);
     for row in &rows {
@@ -195,6 +207,7 @@ fn synthesize_robot_and_fitted_tables_are_current() {
             after(&hinf, "Ms ="),
             alpha_row(&gm, "fitted"),
         ];
-        check_cells("fitted", row, &got);
+        stale.extend(stale_cells("fitted", row, &got));
     }
+    assert_current(&stale);
 }
