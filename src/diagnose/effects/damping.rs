@@ -33,8 +33,7 @@ impl Effect for Damping {
         vec![1.0]
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
-        let _ = (w_min, w_max);
+    fn bounds(&self, _: usize, _: f64, _: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
         vec![(zeta_lo.max(ZETA_BOUNDS.0).ln(), ZETA_BOUNDS.1.ln())]
     }
 

@@ -6,7 +6,7 @@ use crate::diagnose::effects::mode::mode_term;
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
-/// ModeShift of mode `i` (0-based) of the configured model.
+/// A shifted frequency of mode `i` (0-based) of the configured model.
 #[derive(Debug, Clone, Copy)]
 pub struct ModeShift(pub usize);
 
