@@ -11,7 +11,9 @@
 //! and `ζ` shared by every channel and a residue per channel.  Positive parameters are fitted
 //! in logarithms.
 
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    Band, Effect, Explain, Param, Resolution, Site, Stands, Writer,
+};
 use crate::diagnose::effects::with_effect;
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
@@ -185,5 +187,30 @@ impl Cand {
     /// body, or a changed mode, that a holdout or elimination set left out).
     pub fn lacks_its_term(&self, m: &PhysicalModel) -> bool {
         with_effect!(self, e => e.lacks_its_term(m))
+    }
+
+    /// The mode the candidate adds or changes in its refit model `m` ([`Effect::its_mode`]).
+    pub(crate) fn its_mode(&self, m: &PhysicalModel) -> Option<usize> {
+        with_effect!(self, e => e.its_mode(m))
+    }
+
+    /// Its term alone in a bare copy of `m` ([`Effect::term_alone`]).
+    pub(crate) fn term_alone(&self, m: &PhysicalModel) -> Option<PhysicalModel> {
+        with_effect!(self, e => e.term_alone(m))
+    }
+
+    /// Why it is below what the noise resolves ([`Effect::below_resolution`]).
+    pub(crate) fn below_resolution(&self, m: &PhysicalModel, r: &Resolution) -> Option<String> {
+        with_effect!(self, e => e.below_resolution(m, r))
+    }
+
+    /// The parameters of its refit model `m` it owns ([`Effect::owns`]).
+    pub(crate) fn owns(&self, m: &PhysicalModel) -> Vec<Param> {
+        with_effect!(self, e => e.owns(m))
+    }
+
+    /// How far apart two fits of the candidate are ([`Effect::apart`]).
+    pub(crate) fn apart(&self, a: &[f64], b: &[f64]) -> f64 {
+        with_effect!(self, e => e.apart(a, b))
     }
 }

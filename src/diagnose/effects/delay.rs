@@ -1,8 +1,9 @@
 //! A pure delay `e^{−sτ}` on a path (transport or computation delay): θ = \[τ\] (s, `|τ|`
 //! used).
 
-use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, one, pick, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
-use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::diagnose::effects::effect::{fmt_w, pick, sig, Band, Explain, Sel, Site};
+use crate::diagnose::effects::path::{on_path, OnPath};
+use crate::model::physical::{EffectKind, EffectSpec};
 use num_complex::Complex64;
 
 /// A delay of more than this phase (rad) at the band top is implausible: more than half a
@@ -13,68 +14,63 @@ pub const MAX_DELAY_PHASE: f64 = std::f64::consts::PI;
 #[derive(Debug, Clone, Copy)]
 pub struct Delay(pub Sel);
 
-impl Effect for Delay {
+impl OnPath for Delay {
     const NAME: &'static str = "delay";
+    const KIND: EffectKind = EffectKind::Delay;
+    const SI: &'static str = "tau_s";
+    const LOG: bool = false;
+    const ON_SENSOR: bool = true;
 
-    fn tried_on(sel: Sel) -> Vec<Self> {
-        vec![Delay(sel)]
+    fn on(sel: Sel) -> Self {
+        Delay(sel)
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Self> {
-        vec![]
-    }
-
-    fn sel(&self) -> Option<Sel> {
-        Some(self.0)
-    }
-
-    fn n_params(&self, _: usize) -> usize {
-        1
-    }
-
-    fn typ(&self, _: &[f64], omega_max: f64) -> Vec<f64> {
-        vec![1.0 / omega_max]
+    fn channels(&self) -> Sel {
+        self.0
     }
 
     /// A delay below 100/ω_min.
-    fn bounds(&self, _: usize, w_min: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
-        vec![(-100.0 / w_min, 100.0 / w_min)]
+    fn bounds_in(w_min: f64, _: f64) -> (f64, f64) {
+        (-100.0 / w_min, 100.0 / w_min)
     }
 
-    fn natural(&self, th: &[f64], nat: &mut [f64]) {
-        nat[0] = th[0].abs();
+    fn apply(tau: f64, omega: f64, path: &mut Complex64) {
+        *path *= (-Complex64::new(0.0, omega) * tau).exp();
     }
 
-    fn base_residue(&self, _: &PhysicalModel, _: (usize, usize)) -> f64 {
-        0.0
+    fn set(e: &mut EffectSpec, v: f64) {
+        e.tau_s = Some(v);
     }
 
-    fn modify(
-        &self,
-        nat: &[f64],
-        _: f64,
-        _: &PhysicalModel,
-        omega: f64,
-        _: usize,
-        entry: (usize, usize),
-        _: &mut Complex64,
-        path: &mut Complex64,
-    ) {
-        if self.0.hits(entry) {
-            *path *= (-Complex64::new(0.0, omega) * nat[0]).exp();
-        }
+    /// `ω_max |τ|`.
+    fn top_phase(e: &EffectSpec, w_hi: f64) -> Option<(f64, String)> {
+        let tau = e.tau_s?.abs();
+        let phase = w_hi * tau;
+        Some((
+            phase,
+            format!(
+                "a delay of {} s lags {}°",
+                sig(tau),
+                sig(phase.to_degrees())
+            ),
+        ))
     }
 
-    fn si_params(&self, th: &[f64], _: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        one("tau_s", th[0].abs(), 1.0)
+    /// More than half a cycle of lag at the band top is not a transport or computation
+    /// delay a servo loop works with; it fits the slope of dynamics the model lacks.
+    fn implausible(tau: f64, band: Band) -> Option<String> {
+        (tau * band.w_max > MAX_DELAY_PHASE).then(|| {
+            format!(
+                "implausible: a delay of {} s lags {:.0}° at the band top {} (more than {:.0}°): the phase slope is unmodelled dynamics, not a delay",
+                sig(tau),
+                (tau * band.w_max).to_degrees(),
+                fmt_w(band.w_max),
+                MAX_DELAY_PHASE.to_degrees()
+            )
+        })
     }
 
-    fn write(&self, w: &mut Writer) {
-        let v = w.get("tau_s");
-        w.path_effect(EffectKind::Delay, &self.0, &|e| e.tau_s = Some(v));
-    }
-
-    fn explain(&self, x: &Explain) -> String {
+    fn says(&self, x: &Explain) -> String {
         format!(
             "phase falls linearly with frequency while magnitude matches: a pure delay{} of {} ms ({}° of extra lag at {})",
             self.0.suffix(),
@@ -84,39 +80,17 @@ impl Effect for Delay {
         )
     }
 
-    fn prior(&self) -> usize {
+    fn rank() -> usize {
         2
     }
 
     /// The best points of a grid of `τ` in steps of 0.05 rad of phase at the band top, over
     /// six half cycles.
-    fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
+    fn grid(&self, site: &dyn Site) -> Vec<Vec<f64>> {
         let step = 0.05 / site.band().1;
         let n = (6.0 * std::f64::consts::PI / 0.05) as usize + 1;
         pick(site.delay_costs(self.0, step, n), 3)
     }
-
-    fn flags(&self, th: &[f64], at: &dyn Fn(usize) -> bool, si: &Si, band: Band, out: &mut Vec<String>) {
-        // More than half a cycle of lag at the band top is not a transport or computation
-        // delay a servo loop works with; it fits the slope of dynamics the model lacks.
-        if th[0].abs() * band.w_max > MAX_DELAY_PHASE {
-            out.push(format!(
-                "implausible: a delay of {} s lags {:.0}° at the band top {} (more than {:.0}°): the phase slope is unmodelled dynamics, not a delay",
-                sig(th[0].abs()),
-                (th[0].abs() * band.w_max).to_degrees(),
-                fmt_w(band.w_max),
-                MAX_DELAY_PHASE.to_degrees()
-            ));
-        } else if at(0) {
-            out.push(at_bound_flag(si));
-        }
-    }
-
-    fn stands(&self) -> Stands {
-        Stands::AddedPathEffect
-    }
-
-    fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
-        false
-    }
 }
+
+on_path!(Delay);

@@ -150,6 +150,91 @@ pub trait Effect: Copy {
     /// True when `m` lacks the configured term the effect acts on (a holdout or elimination
     /// set left out the effect that added it): then the effect is not written.
     fn lacks_its_term(&self, m: &PhysicalModel) -> bool;
+
+    /// The index of the mode the effect adds (the last) or changes in its jointly refit
+    /// model `m`, for the mode rules of `diagnose::admissible`; `None` when it has no mode.
+    fn its_mode(&self, m: &PhysicalModel) -> Option<usize>;
+
+    /// Its rigid-body, integrator or friction term alone (in a [`bare`] copy of `m`, its
+    /// refit model), whose own size `diagnose::admissible` compares with the data; `None`
+    /// for an effect without such a term.
+    fn term_alone(&self, m: &PhysicalModel) -> Option<PhysicalModel>;
+
+    /// The negligible-size rule of `diagnose::admissible` for the effect as refit in `m`:
+    /// why it is below what the noise resolves `r` (its phase at the band top, a pole's
+    /// relative effect at the band bottom), or `None` (also for effects without a size rule).
+    fn below_resolution(&self, m: &PhysicalModel, r: &Resolution) -> Option<String>;
+
+    /// The parameters of its refit model `m` that are the effect's own (the covariance rules
+    /// of `diagnose::admissible` judge these, and not their correlation with each other).
+    fn owns(&self, m: &PhysicalModel) -> Vec<Param>;
+
+    /// How far apart two fits `a`, `b` of this effect are for the hold-out's "same set"
+    /// (|Δ ln ω_n| of an added mode; 0 when the target alone tells the effect).
+    fn apart(&self, a: &[f64], b: &[f64]) -> f64;
+}
+
+/// A parameter of a physical model, by the term it belongs to (0-based indices into the
+/// model's lists), as [`Effect::owns`] names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Param {
+    /// `ω_n` of mode `i`.
+    ModeOmega(usize),
+    /// `ζ` of mode `i`.
+    ModeZeta(usize),
+    /// The input gains of mode `i`.
+    ModeInputs(usize),
+    /// The output gains (residues) of mode `i`.
+    ModeResidues(usize),
+    /// The input gains of rigid body `i`.
+    RigidInputs(usize),
+    /// The output gains (residues) of rigid body `i`.
+    RigidResidues(usize),
+    /// The input gains of integrator `i`.
+    IntegratorInputs(usize),
+    /// The output gains (residues) of integrator `i`.
+    IntegratorResidues(usize),
+    /// The friction pole of rigid body `i`.
+    FrictionPole(usize),
+    /// The parameter (delay, corner, zero, hold time) of path effect `i`.
+    PathEffect(usize),
+    /// Any entry of the feedthrough `D`.
+    Feedthrough,
+}
+
+/// What the noise resolves at the ends of the band (`diagnose::admissible`'s negligible
+/// rule): the median `r/|G|` over the top or bottom `n` lines (5 % of them, at most 20),
+/// divided by √n (an effect acts coherently on every line there).
+#[derive(Debug, Clone, Copy)]
+pub struct Resolution {
+    /// Lowest data frequency (rad/s).
+    pub w_lo: f64,
+    /// Highest data frequency (rad/s).
+    pub w_hi: f64,
+    /// The phase resolution at the band top, `asin(r/|G|)` (rad).
+    pub phase_top: f64,
+    /// The relative resolution `r/|G|` at the band bottom.
+    pub rel_bottom: f64,
+}
+
+/// A copy of `m` without terms or path effects (its inputs, outputs and quantity kept): the
+/// frame in which one term is evaluated alone.
+pub fn bare(m: &PhysicalModel) -> PhysicalModel {
+    PhysicalModel {
+        mode: vec![],
+        rigid_body: vec![],
+        integrator: vec![],
+        feedthrough: None,
+        effect: vec![],
+        inputs: Some(m.n_inputs()),
+        outputs: Some(m.n_outputs()),
+        ..m.clone()
+    }
+}
+
+/// The index of the last element of a list of `n` (the term an effect added last).
+pub fn last(n: usize) -> Option<usize> {
+    n.checked_sub(1)
 }
 
 /// Where an effect stands in a written model: the kind of term its refit parameters are

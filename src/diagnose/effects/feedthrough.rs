@@ -1,6 +1,8 @@
 //! An added feedthrough `D` (the upper residual of modes above the band); θ = [d_1 … d_C].
 
-use crate::diagnose::effects::effect::{per_channel, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
+};
 use crate::model::physical::{Feedthrough as Spec, PhysicalModel, Quantity};
 use num_complex::Complex64;
 
@@ -112,5 +114,25 @@ impl Effect for Feedthrough {
 
     fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
         false
+    }
+
+    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+        None
+    }
+
+    fn term_alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
+        None
+    }
+
+    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
+        None
+    }
+
+    fn owns(&self, _: &PhysicalModel) -> Vec<Param> {
+        vec![Param::Feedthrough]
+    }
+
+    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
+        0.0
     }
 }

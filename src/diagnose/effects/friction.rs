@@ -1,7 +1,10 @@
 //! Viscous friction on rigid body `i` of the configured model: `1/s²` becomes
 //! `1/(s (s + p))`; θ = [ln p].  Tried on each rigid body without a friction pole.
 
-use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, residue, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    at_bound_flag, bare, fmt_w, grid_best, log_grid, one, residue, sig, Band, Effect, Explain,
+    Param, Resolution, Sel, Si, Site, Stands, Writer,
+};
 use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
@@ -94,7 +97,14 @@ impl Effect for Friction {
         grid_best(site, &log_grid(wmin / 1000.0, wmax, 40), 3)
     }
 
-    fn flags(&self, _: &[f64], at: &dyn Fn(usize) -> bool, si: &Si, _: Band, out: &mut Vec<String>) {
+    fn flags(
+        &self,
+        _: &[f64],
+        at: &dyn Fn(usize) -> bool,
+        si: &Si,
+        _: Band,
+        out: &mut Vec<String>,
+    ) {
         if at(0) {
             out.push(at_bound_flag(si));
         }
@@ -106,5 +116,39 @@ impl Effect for Friction {
 
     fn lacks_its_term(&self, m: &PhysicalModel) -> bool {
         self.0 >= m.rigid_body.len()
+    }
+
+    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+        None
+    }
+
+    /// The rigid body with its friction pole.
+    fn term_alone(&self, m: &PhysicalModel) -> Option<PhysicalModel> {
+        let mut alone = bare(m);
+        alone.rigid_body.push(m.rigid_body.get(self.0)?.clone());
+        Some(alone)
+    }
+
+    /// A pole whose relative effect at the band bottom, `p/ω_min`, is below the noise's
+    /// relative resolution there.
+    fn below_resolution(&self, m: &PhysicalModel, r: &Resolution) -> Option<String> {
+        let p = m.rigid_body.get(self.0)?.friction_pole?;
+        (p / r.w_lo < r.rel_bottom).then(|| {
+            format!(
+                "a friction pole at {} rad/s changes the response at the band bottom ({} rad/s) by {}, below the noise's relative resolution there ({})",
+                sig(p),
+                sig(r.w_lo),
+                sig(p / r.w_lo),
+                sig(r.rel_bottom)
+            )
+        })
+    }
+
+    fn owns(&self, _: &PhysicalModel) -> Vec<Param> {
+        vec![Param::FrictionPole(self.0)]
+    }
+
+    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
+        0.0
     }
 }

@@ -2,7 +2,9 @@
 //! model's own gains); `compare` revisions and library users name it.
 
 use crate::diagnose::effects::candidates::fmt_change;
-use crate::diagnose::effects::effect::{one, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    one, sig, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
+};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -39,9 +41,7 @@ impl Effect for Gain {
         vec![(-1e3, 1e3)]
     }
 
-    fn natural(&self, _: &[f64], _: &mut [f64]) {
-        
-    }
+    fn natural(&self, _: &[f64], _: &mut [f64]) {}
 
     fn base_residue(&self, _: &PhysicalModel, _: (usize, usize)) -> f64 {
         0.0
@@ -93,7 +93,14 @@ impl Effect for Gain {
         ]]
     }
 
-    fn flags(&self, th: &[f64], at: &dyn Fn(usize) -> bool, si: &Si, band: Band, out: &mut Vec<String>) {
+    fn flags(
+        &self,
+        th: &[f64],
+        at: &dyn Fn(usize) -> bool,
+        si: &Si,
+        band: Band,
+        out: &mut Vec<String>,
+    ) {
         let _ = (th, at, si, band, out);
     }
 
@@ -103,5 +110,25 @@ impl Effect for Gain {
 
     fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
         false
+    }
+
+    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+        None
+    }
+
+    fn term_alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
+        None
+    }
+
+    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
+        None
+    }
+
+    fn owns(&self, _: &PhysicalModel) -> Vec<Param> {
+        vec![]
+    }
+
+    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
+        0.0
     }
 }

@@ -1,7 +1,10 @@
 //! An added `c_ch/s^order`: order 1 an integrator, order 2 a rigid body (or the lower
 //! residual of modes below the band); θ = [c_1 … c_C].
 
-use crate::diagnose::effects::effect::{one, per_channel, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    bare, last, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands,
+    Writer,
+};
 use crate::model::physical::{PhysicalModel, PoleAtZeroSpec, Quantity};
 use num_complex::Complex64;
 
@@ -117,7 +120,14 @@ impl Effect for Integrator {
             .collect()]
     }
 
-    fn flags(&self, _: &[f64], _: &dyn Fn(usize) -> bool, _: &Si, band: Band, out: &mut Vec<String>) {
+    fn flags(
+        &self,
+        _: &[f64],
+        _: &dyn Fn(usize) -> bool,
+        _: &Si,
+        band: Band,
+        out: &mut Vec<String>,
+    ) {
         // On a mobility or an accelerance, c/s (displacement) is a constant mobility or an
         // accelerance rising as ω: no structural term (a rigid body or the lower residual is
         // c/s², the upper residual a constant D).
@@ -137,5 +147,39 @@ impl Effect for Integrator {
 
     fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
         false
+    }
+
+    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+        None
+    }
+
+    /// The rigid body or integrator it added (the last).
+    fn term_alone(&self, m: &PhysicalModel) -> Option<PhysicalModel> {
+        let mut alone = bare(m);
+        if self.0 == 2 {
+            alone.rigid_body.push(m.rigid_body.last()?.clone());
+        } else {
+            alone.integrator.push(m.integrator.last()?.clone());
+        }
+        Some(alone)
+    }
+
+    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
+        None
+    }
+
+    /// The residues of the term it added.
+    fn owns(&self, m: &PhysicalModel) -> Vec<Param> {
+        if self.0 == 2 {
+            last(m.rigid_body.len()).map(Param::RigidResidues)
+        } else {
+            last(m.integrator.len()).map(Param::IntegratorResidues)
+        }
+        .into_iter()
+        .collect()
+    }
+
+    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
+        0.0
     }
 }

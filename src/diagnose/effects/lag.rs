@@ -1,75 +1,53 @@
 //! A first-order lag `1/(1 + s/ω_c)` on a path (an actuator or a sensor): θ = [ln ω_c].
 
-use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
-use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::diagnose::effects::effect::{fmt_w, grid_best, log_grid, Band, Explain, Sel, Site};
+use crate::diagnose::effects::path::{on_path, shifts_phase, OnPath};
+use crate::model::physical::{EffectKind, EffectSpec};
 use num_complex::Complex64;
 
-/// lag on the channels it selects.
+/// A lag on the channels it selects.
 #[derive(Debug, Clone, Copy)]
 pub struct Lag(pub Sel);
 
-impl Effect for Lag {
+impl OnPath for Lag {
     const NAME: &'static str = "lag";
+    const KIND: EffectKind = EffectKind::Lag;
+    const SI: &'static str = "omega_c";
+    const LOG: bool = true;
+    const ON_SENSOR: bool = true;
 
-    fn tried_on(sel: Sel) -> Vec<Self> {
-        vec![Lag(sel)]
+    fn on(sel: Sel) -> Self {
+        Lag(sel)
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Self> {
-        vec![]
+    fn channels(&self) -> Sel {
+        self.0
     }
 
-    fn sel(&self) -> Option<Sel> {
-        Some(self.0)
+    /// A corner within two decades of the band.
+    fn bounds_in(w_min: f64, w_max: f64) -> (f64, f64) {
+        ((w_min / 100.0).ln(), (w_max * 100.0).ln())
     }
 
-    fn n_params(&self, _: usize) -> usize {
-        1
+    fn apply(omega_c: f64, omega: f64, path: &mut Complex64) {
+        let s = Complex64::new(0.0, omega);
+        *path /= Complex64::new(1.0, 0.0) + s / omega_c;
     }
 
-    fn typ(&self, _: &[f64], _: f64) -> Vec<f64> {
-        vec![1.0]
+    fn set(e: &mut EffectSpec, v: f64) {
+        e.omega_c = Some(v);
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
-        vec![((w_min / 100.0).ln(), (w_max * 100.0).ln())]
+    /// `order · atan(ω_max/ω_c)`.
+    fn top_phase(e: &EffectSpec, w_hi: f64) -> Option<(f64, String)> {
+        shifts_phase((w_hi / e.omega_c?).atan() * e.order.unwrap_or(1) as f64)
     }
 
-    fn natural(&self, th: &[f64], nat: &mut [f64]) {
-        nat[0] = th[0].exp();
+    fn implausible(_: f64, _: Band) -> Option<String> {
+        None
     }
 
-    fn base_residue(&self, _: &PhysicalModel, _: (usize, usize)) -> f64 {
-        0.0
-    }
-
-    fn modify(
-        &self,
-        nat: &[f64],
-        _: f64,
-        _: &PhysicalModel,
-        omega: f64,
-        _: usize,
-        entry: (usize, usize),
-        _: &mut Complex64,
-        path: &mut Complex64,
-    ) {
-        if self.0.hits(entry) {
-            let s = Complex64::new(0.0, omega);
-            *path /= Complex64::new(1.0, 0.0) + s / nat[0];
-        }
-    }
-
-    fn si_params(&self, th: &[f64], _: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        one("omega_c", th[0].exp(), th[0].exp())
-    }
-
-    fn write(&self, w: &mut Writer) {
-        let v = w.get("omega_c");
-        w.path_effect(EffectKind::Lag, &self.0, &|e| e.omega_c = Some(v));
-    }
-
-    fn explain(&self, x: &Explain) -> String {
+    fn says(&self, x: &Explain) -> String {
         format!(
             "magnitude droops and phase lags towards −90° above the corner, with no linear phase: a first-order lag{} ({}) at ω_c = {}",
             self.0.suffix(),
@@ -82,27 +60,14 @@ impl Effect for Lag {
         )
     }
 
-    fn prior(&self) -> usize {
+    fn rank() -> usize {
         3
     }
 
-    fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
+    fn grid(&self, site: &dyn Site) -> Vec<Vec<f64>> {
         let (wmin, wmax) = site.band();
         grid_best(site, &log_grid(wmin / 3.0, wmax * 30.0, 40), 3)
     }
-
-    fn flags(&self, th: &[f64], at: &dyn Fn(usize) -> bool, si: &Si, band: Band, out: &mut Vec<String>) {
-        let _ = (th, band);
-        if at(0) {
-            out.push(at_bound_flag(si));
-        }
-    }
-
-    fn stands(&self) -> Stands {
-        Stands::AddedPathEffect
-    }
-
-    fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
-        false
-    }
 }
+
+on_path!(Lag);

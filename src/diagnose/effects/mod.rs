@@ -12,9 +12,11 @@
 //! Adding an effect is one file implementing [`effect::Effect`] and one line in the
 //! registration list below (docs/design/effects.md, "Adding an effect").
 pub(crate) mod candidates;
+pub(crate) mod configured;
 pub(crate) mod effect;
 pub(crate) mod explain;
 pub(crate) mod lscf;
+pub(crate) mod path;
 mod tests;
 
 /// The registration list: declares each effect's module, makes [`Cand`] (one variant per

@@ -2,7 +2,10 @@
 //! one `ω_n` and `ζ` shared by every channel and a residue per channel; θ = [ln ω_n, ln ζ,
 //! ρ_1 … ρ_C].
 
-use crate::diagnose::effects::effect::{clamp_zeta, fmt_w, log_grid, one, per_channel, sig, Band, Effect, Explain, Sel, Si, Site, Stands, Writer, ZETA_BOUNDS};
+use crate::diagnose::effects::effect::{
+    clamp_zeta, fmt_w, last, log_grid, one, per_channel, sig, Band, Effect, Explain, Param,
+    Resolution, Sel, Si, Site, Stands, Writer, ZETA_BOUNDS,
+};
 use crate::model::physical::{ModeSpec, PhysicalModel};
 use num_complex::Complex64;
 
@@ -46,7 +49,10 @@ impl Effect for Mode {
     fn bounds(&self, n_ch: usize, w_min: f64, w_max: f64, zeta_lo: f64) -> Vec<(f64, f64)> {
         let lz = (zeta_lo.max(ZETA_BOUNDS.0).ln(), ZETA_BOUNDS.1.ln());
         let mut v = vec![(w_min.ln(), w_max.ln()), lz];
-        v.extend(std::iter::repeat_n((f64::NEG_INFINITY, f64::INFINITY), n_ch));
+        v.extend(std::iter::repeat_n(
+            (f64::NEG_INFINITY, f64::INFINITY),
+            n_ch,
+        ));
         v
     }
 
@@ -148,7 +154,14 @@ impl Effect for Mode {
         trials.into_iter().take(4).map(|t| t.1).collect()
     }
 
-    fn flags(&self, th: &[f64], at: &dyn Fn(usize) -> bool, _: &Si, band: Band, out: &mut Vec<String>) {
+    fn flags(
+        &self,
+        th: &[f64],
+        at: &dyn Fn(usize) -> bool,
+        _: &Si,
+        band: Band,
+        out: &mut Vec<String>,
+    ) {
         if at(0) {
             let w = th[0].exp();
             let edge = if w < (band.w_min * band.w_max).sqrt() {
@@ -177,5 +190,37 @@ impl Effect for Mode {
 
     fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
         false
+    }
+
+    /// The added mode is the last.
+    fn its_mode(&self, m: &PhysicalModel) -> Option<usize> {
+        last(m.mode.len())
+    }
+
+    fn term_alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
+        None
+    }
+
+    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
+        None
+    }
+
+    /// Its `ω_n`, `ζ`, input gains and residues.
+    fn owns(&self, m: &PhysicalModel) -> Vec<Param> {
+        last(m.mode.len())
+            .map(|i| {
+                vec![
+                    Param::ModeOmega(i),
+                    Param::ModeZeta(i),
+                    Param::ModeInputs(i),
+                    Param::ModeResidues(i),
+                ]
+            })
+            .unwrap_or_default()
+    }
+
+    /// `|Δ ln ω_n|`: two added modes are the same when their frequencies are.
+    fn apart(&self, a: &[f64], b: &[f64]) -> f64 {
+        (a[0] - b[0]).abs()
     }
 }

@@ -1,81 +1,55 @@
 //! A real non-minimum-phase zero as an all-pass `(1 − s/z)/(1 + s/z)` on a path: θ = [ln z].
 //! Tried on every channel and on each input (an actuator-side effect), not on a sensor.
 
-use crate::diagnose::effects::effect::{at_bound_flag, fmt_w, grid_best, log_grid, one, Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
-use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::diagnose::effects::effect::{fmt_w, grid_best, log_grid, Band, Explain, Sel, Site};
+use crate::diagnose::effects::path::{on_path, shifts_phase, OnPath};
+use crate::model::physical::{EffectKind, EffectSpec};
 use num_complex::Complex64;
 
-/// nmp_zero on the channels it selects.
+/// An NMP zero on the channels it selects.
 #[derive(Debug, Clone, Copy)]
 pub struct NmpZero(pub Sel);
 
-impl Effect for NmpZero {
+impl OnPath for NmpZero {
     const NAME: &'static str = "nmp_zero";
+    const KIND: EffectKind = EffectKind::NmpZero;
+    const SI: &'static str = "z";
+    const LOG: bool = true;
+    const ON_SENSOR: bool = false;
 
-    fn tried_on(sel: Sel) -> Vec<Self> {
-        if matches!(sel, Sel::Output(_)) {
-            vec![]
-        } else {
-            vec![NmpZero(sel)]
-        }
+    fn on(sel: Sel) -> Self {
+        NmpZero(sel)
     }
 
-    fn tried(_: &PhysicalModel) -> Vec<Self> {
-        vec![]
+    fn channels(&self) -> Sel {
+        self.0
     }
 
-    fn sel(&self) -> Option<Sel> {
-        Some(self.0)
+    /// A zero within two decades of the band.
+    fn bounds_in(w_min: f64, w_max: f64) -> (f64, f64) {
+        ((w_min / 100.0).ln(), (w_max * 100.0).ln())
     }
 
-    fn n_params(&self, _: usize) -> usize {
-        1
+    fn apply(z: f64, omega: f64, path: &mut Complex64) {
+        let s = Complex64::new(0.0, omega);
+        let one = Complex64::new(1.0, 0.0);
+        *path *= (one - s / z) / (one + s / z)
     }
 
-    fn typ(&self, _: &[f64], _: f64) -> Vec<f64> {
-        vec![1.0]
+    fn set(e: &mut EffectSpec, v: f64) {
+        e.z = Some(v);
     }
 
-    fn bounds(&self, _: usize, w_min: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
-        vec![((w_min / 100.0).ln(), (w_max * 100.0).ln())]
+    /// `2 atan(ω_max/z)`.
+    fn top_phase(e: &EffectSpec, w_hi: f64) -> Option<(f64, String)> {
+        shifts_phase(2.0 * (w_hi / e.z?).atan())
     }
 
-    fn natural(&self, th: &[f64], nat: &mut [f64]) {
-        nat[0] = th[0].exp();
+    fn implausible(_: f64, _: Band) -> Option<String> {
+        None
     }
 
-    fn base_residue(&self, _: &PhysicalModel, _: (usize, usize)) -> f64 {
-        0.0
-    }
-
-    fn modify(
-        &self,
-        nat: &[f64],
-        _: f64,
-        _: &PhysicalModel,
-        omega: f64,
-        _: usize,
-        entry: (usize, usize),
-        _: &mut Complex64,
-        path: &mut Complex64,
-    ) {
-        if self.0.hits(entry) {
-            let s = Complex64::new(0.0, omega);
-            let (one, z) = (Complex64::new(1.0, 0.0), nat[0]);
-            *path *= (one - s / z) / (one + s / z)
-        }
-    }
-
-    fn si_params(&self, th: &[f64], _: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        one("z", th[0].exp(), th[0].exp())
-    }
-
-    fn write(&self, w: &mut Writer) {
-        let v = w.get("z");
-        w.path_effect(EffectKind::NmpZero, &self.0, &|e| e.z = Some(v));
-    }
-
-    fn explain(&self, x: &Explain) -> String {
+    fn says(&self, x: &Explain) -> String {
         format!(
             "magnitude matches but phase falls and saturates towards −180° (−90° at {}): a non-minimum-phase zero{} at z = {}",
             fmt_w(x.p("z")),
@@ -84,27 +58,14 @@ impl Effect for NmpZero {
         )
     }
 
-    fn prior(&self) -> usize {
+    fn rank() -> usize {
         9
     }
 
-    fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
+    fn grid(&self, site: &dyn Site) -> Vec<Vec<f64>> {
         let (wmin, wmax) = site.band();
         grid_best(site, &log_grid(wmin / 3.0, wmax * 30.0, 40), 3)
     }
-
-    fn flags(&self, th: &[f64], at: &dyn Fn(usize) -> bool, si: &Si, band: Band, out: &mut Vec<String>) {
-        let _ = (th, band);
-        if at(0) {
-            out.push(at_bound_flag(si));
-        }
-    }
-
-    fn stands(&self) -> Stands {
-        Stands::AddedPathEffect
-    }
-
-    fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
-        false
-    }
 }
+
+on_path!(NmpZero);

@@ -1,7 +1,9 @@
 //! A sign flip `−1` on a path: no parameter.  Not tried by the search (the retune refits the
 //! model's own gains, signs included); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::effect::{Band, Effect, Explain, Sel, Si, Site, Stands, Writer};
+use crate::diagnose::effects::effect::{
+    Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
+};
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
 
@@ -86,5 +88,25 @@ impl Effect for Sign {
 
     fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
         false
+    }
+
+    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+        None
+    }
+
+    fn term_alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
+        None
+    }
+
+    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
+        None
+    }
+
+    fn owns(&self, _: &PhysicalModel) -> Vec<Param> {
+        vec![]
+    }
+
+    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
+        0.0
     }
 }

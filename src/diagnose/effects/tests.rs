@@ -4,6 +4,7 @@
 //! evaluated by `model::physical`) is the model its `modify` computes (two routes).
 
 use crate::diagnose::effects::candidates::{Cand, Sel};
+use crate::diagnose::effects::effect::Param;
 use crate::diagnose::effects::{tried, EFFECT_NAMES};
 use crate::model::physical::{Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec};
 use num_complex::Complex64;
@@ -131,4 +132,77 @@ fn the_written_model_is_the_modified_model() {
             }
         }
     }
+}
+
+/// True when parameter `p` exists in the written model `w` and is new or changed against
+/// the base `b` (read from the two models, not from the effect).
+fn new_or_changed(p: Param, b: &PhysicalModel, w: &PhysicalModel) -> bool {
+    let mode = |m: &PhysicalModel, i: usize| m.mode.get(i).cloned();
+    let rigid = |m: &PhysicalModel, i: usize| m.rigid_body.get(i).cloned();
+    let int = |m: &PhysicalModel, i: usize| m.integrator.get(i).cloned();
+    match p {
+        Param::ModeOmega(i) => {
+            mode(w, i).is_some_and(|x| mode(b, i).is_none_or(|y| x.omega_n != y.omega_n))
+        }
+        Param::ModeZeta(i) => {
+            mode(w, i).is_some_and(|x| mode(b, i).is_none_or(|y| x.zeta != y.zeta))
+        }
+        Param::ModeInputs(i) | Param::ModeResidues(i) => {
+            mode(w, i).is_some() && mode(b, i).is_none()
+        }
+        Param::RigidInputs(i) | Param::RigidResidues(i) => {
+            rigid(w, i).is_some() && rigid(b, i).is_none()
+        }
+        Param::IntegratorInputs(i) | Param::IntegratorResidues(i) => {
+            int(w, i).is_some() && int(b, i).is_none()
+        }
+        Param::FrictionPole(i) => rigid(w, i).is_some_and(|x| {
+            x.friction_pole.is_some() && rigid(b, i).is_some_and(|y| y.friction_pole.is_none())
+        }),
+        Param::PathEffect(i) => i < w.effect.len() && i >= b.effect.len(),
+        Param::Feedthrough => w.feedthrough.is_some() && b.feedthrough.is_none(),
+    }
+}
+
+/// What the admissibility rules and the hold-out read of an effect (`its_mode`,
+/// `term_alone`, `owns`, `apart`) is what the effect wrote: read again from the difference
+/// between the written and the base model.
+#[test]
+fn what_admissibility_reads_is_what_the_effect_wrote() {
+    let b = base();
+    let entries = [(0, 0), (0, 1)];
+    for c in every_candidate(&b) {
+        let th = theta(&c, 2, (10.0, 3000.0));
+        let mut w = b.clone();
+        c.apply_to(&th, &entries, &mut w, "added by rshape diagnose: test");
+        // The mode it added or changed, from the models.
+        let changed = (0..w.mode.len()).find(|i| b.mode.get(*i) != Some(&w.mode[*i]));
+        assert_eq!(c.its_mode(&w), changed, "{c:?}");
+        for p in c.owns(&w) {
+            assert!(
+                new_or_changed(p, &b, &w),
+                "{c:?} owns {p:?}, which it did not write"
+            );
+        }
+        // Every effect with a refit parameter owns one (gain and sign have none the refit
+        // moves: `lsq::slots` has no slot for them).
+        let refit_free = matches!(c, Cand::Gain(_) | Cand::Sign(_));
+        assert_eq!(c.owns(&w).is_empty(), refit_free, "{c:?}");
+        // Its term alone: the rigid body, integrator or friction it wrote, and nothing else.
+        let term_changed = w.rigid_body != b.rigid_body || w.integrator != b.integrator;
+        match c.term_alone(&w) {
+            Some(alone) => {
+                assert!(term_changed, "{c:?}");
+                assert_eq!(alone.mode.len() + alone.effect.len(), 0, "{c:?}");
+                assert_eq!(alone.rigid_body.len() + alone.integrator.len(), 1, "{c:?}");
+                let g = alone.eval(50.0)[(0, 0)];
+                assert!(g.is_finite() && g.norm() > 0.0, "{c:?}: {g}");
+            }
+            None => assert!(!term_changed, "{c:?} wrote a term it does not give alone"),
+        }
+        assert_eq!(c.apart(&th, &th), 0.0, "{c:?}");
+    }
+    // Two added modes are apart by their |Δ ln ω_n|; other effects by their target alone.
+    assert_eq!(Cand::Mode.apart(&[5.0, -3.0], &[5.5, -3.0]), 0.5);
+    assert_eq!(Cand::Lag(Sel::All).apart(&[5.0], &[7.0]), 0.0);
 }

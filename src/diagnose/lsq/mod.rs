@@ -9,12 +9,14 @@
 //! * `lm`: Levenberg–Marquardt;
 //! * `slots`: the configured model's parameters `retune` refits;
 //! * `varpro`: the variable-projection Jacobian;
+//! * `mode_grid`: the cost as one mode moves (the retune's rough placement);
 //! * `retune`: the joint refit of the configured model's own parameters;
 //! * `resolution`: what the record resolves of a mode's damping (ζ's floor from the lines);
 //! * `whiteness`: is the normalized residual the stated noise (level, Ljung–Box).
 pub(crate) mod channels;
 pub(crate) mod lm;
 pub(crate) mod measures;
+pub(crate) mod mode_grid;
 pub(crate) mod problem;
 pub(crate) mod resolution;
 pub(crate) mod retune;

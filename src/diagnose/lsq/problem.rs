@@ -4,6 +4,7 @@
 //! the bounded Levenberg–Marquardt refit of every candidate parameter.
 
 use crate::diagnose::effects::candidates::Cand;
+use crate::diagnose::effects::effect::Stands;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
 use crate::diagnose::lsq::measures::{measures_of, Measures};
@@ -175,12 +176,15 @@ impl<'a> Problem<'a> {
         let n_ch = self.n_ch();
         for c in &mods.cands {
             let n = c.n_params(n_ch);
-            let rho = match c {
-                Cand::ModeShift(i) | Cand::Damping(i) => self.mode_rho[ch][*i],
-                Cand::Friction(i) => self.rigid_rho[ch][*i],
-                // The others' residues are not cached (0 for every effect that changes no
-                // configured term).
-                _ => c.base_residue(self.base, entry),
+            // The residues of the configured terms are cached; the others' are not (0 for
+            // every effect that changes no configured term).
+            let rho = match c.stands() {
+                Stands::ConfiguredMode(i) => self.mode_rho[ch][i],
+                Stands::FrictionPole(i) => self.rigid_rho[ch][i],
+                Stands::AddedMode
+                | Stands::AddedPoleAtZero(_)
+                | Stands::Feedthrough
+                | Stands::AddedPathEffect => c.base_residue(self.base, entry),
             };
             c.modify_natural(
                 &nat[off..off + n],

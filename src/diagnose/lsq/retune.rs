@@ -207,10 +207,10 @@ pub(crate) fn retune_or_give_up(
                 })
                 .collect();
             // The other columns factored once, each grid point's cost from the mode's own
-            // columns projected off them ([`crate::diagnose::lsq::varpro::ModeGrid`]); the full least
+            // columns projected off them ([`crate::diagnose::lsq::mode_grid::ModeGrid`]); the full least
             // squares at every point where they are rank-deficient.  The points are
             // independent: costed in parallel, the best taken in grid order as before.
-            let fast = crate::diagnose::lsq::varpro::ModeGrid::new(&start, i, &lin, data, mask);
+            let fast = crate::diagnose::lsq::mode_grid::ModeGrid::new(&start, i, &lin, data, mask);
             let costs: Vec<f64> = grid
                 .par_iter()
                 .map(|&(w, z)| match &fast {

@@ -21,7 +21,7 @@
 //! the forward-difference Jacobian of the whole residual.
 
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::shapes::{mode_den, mode_log_slope};
+use crate::diagnose::lsq::shapes::mode_log_slope;
 use crate::diagnose::lsq::slots::{block_matrix, blocks, design, gains_of, set_nl, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
 use nalgebra::{DMatrix, DVector};
@@ -51,7 +51,7 @@ pub(crate) struct VarPro<'a> {
 /// The column-scaled Householder QR of `a` (`a S = Q R`, thin): `(Q, R, scale)`, or `None`
 /// when it is rank-deficient (a pivot below `1e-12` of the largest, where the least squares
 /// drops a column) or has more columns than rows.
-fn factor_block(mut a: DMatrix<f64>) -> Option<(DMatrix<f64>, DMatrix<f64>, Vec<f64>)> {
+pub(super) fn factor_block(mut a: DMatrix<f64>) -> Option<(DMatrix<f64>, DMatrix<f64>, Vec<f64>)> {
     let n = a.ncols();
     if a.nrows() < n {
         return None;
@@ -279,108 +279,8 @@ impl VarPro<'_> {
     }
 }
 
-/// The cost of the least squares as one mode's `ω_n`, `ζ` move (the rough placement of
-/// [`crate::diagnose::lsq::retune`]): the other columns `A_o` are factored once (`A_o S = Q R`), and at
-/// each point the mode's columns `a` are projected off them,
-/// `V(ω_n, ζ) = ‖r_o − Q_b Q_bᵀ r_o‖²`, `r_o = P⊥_o y`, `b = P⊥_o a = Q_b R_b`: the cost of
-/// the full least squares, in `O(m n)` per point instead of `O(m n²)`.
-pub(crate) struct ModeGrid<'a> {
-    data: &'a Channels,
-    mask: &'a [usize],
-    /// The mode's columns with its denominator left out: `a_{row,j} = coef_{row,j}/d(s_k)`
-    /// (`path · gain/m · weight`, zero where the column does not act), one complex number per
-    /// row pair, column-major.
-    coef: Vec<Complex64>,
-    n_own: usize,
-    q: DMatrix<f64>,
-    r_o: DVector<f64>,
-}
-
-impl<'a> ModeGrid<'a> {
-    /// `None` when the mode has no column or the other columns are rank-deficient.
-    pub fn new(
-        m: &PhysicalModel,
-        mode: usize,
-        lin: &[Lin],
-        data: &'a Channels,
-        mask: &'a [usize],
-    ) -> Option<Self> {
-        let is_own = |l: &Lin| matches!(l, Lin::Out(Term::Mode(i), _) if *i == mode);
-        let own: Vec<Lin> = lin.iter().copied().filter(is_own).collect();
-        let others: Vec<Lin> = lin.iter().copied().filter(|l| !is_own(l)).collect();
-        if own.is_empty() {
-            return None;
-        }
-        let (a, y) = design(m, &others, data, mask);
-        let (q, r_o) = if others.is_empty() {
-            (DMatrix::zeros(y.len(), 0), y)
-        } else {
-            // One factorization over every row (the blocks change nothing in the span).
-            let (q, _, _) = factor_block(a)?;
-            let r_o = &y - &q * q.tr_mul(&y);
-            (q, r_o)
-        };
-        // The mode's own columns times its denominator: what does not move on the grid.
-        let (own_a, _) = design(m, &own, data, mask);
-        let (w, z) = (m.mode[mode].omega_n, m.mode[mode].zeta);
-        let rows_per_ch = 2 * mask.len();
-        let mut coef = Vec::with_capacity(own_a.len() / 2);
-        for j in 0..own.len() {
-            for row in (0..own_a.nrows()).step_by(2) {
-                let s = Complex64::new(0.0, data.omega[mask[(row % rows_per_ch) / 2]]);
-                coef.push(Complex64::new(own_a[(row, j)], own_a[(row + 1, j)]) * mode_den(s, w, z));
-            }
-        }
-        if coef.iter().any(|c| !c.is_finite()) {
-            return None;
-        }
-        Some(Self {
-            data,
-            mask,
-            coef,
-            n_own: own.len(),
-            q,
-            r_o,
-        })
-    }
-
-    /// The least-squares cost with the mode at `(ω_n, ζ)`.
-    pub fn cost(&self, w: f64, z: f64) -> f64 {
-        let inv_d: Vec<Complex64> = self
-            .mask
-            .iter()
-            .map(|k| mode_den(Complex64::new(0.0, self.data.omega[*k]), w, z).inv())
-            .collect();
-        let rows = self.r_o.len();
-        let pairs = rows / 2;
-        let a = DMatrix::from_fn(rows, self.n_own, |row, j| {
-            let v = self.coef[j * pairs + row / 2] * inv_d[(row / 2) % inv_d.len()];
-            if row % 2 == 0 {
-                v.re
-            } else {
-                v.im
-            }
-        });
-        let b = if self.q.ncols() == 0 {
-            a
-        } else {
-            &a - &self.q * self.q.tr_mul(&a)
-        };
-        // The residual itself, not ‖r_o‖² − ‖Q_bᵀ r_o‖² (no cancellation on a close fit).
-        let v = match factor_block(b) {
-            Some((qb, _, _)) => (&self.r_o - &qb * qb.tr_mul(&self.r_o)).norm_squared(),
-            None => self.r_o.norm_squared(),
-        };
-        if v.is_finite() {
-            v
-        } else {
-            f64::INFINITY
-        }
-    }
-}
-
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::diagnose::lsq::retune::solve_linear_res;
     use crate::diagnose::lsq::slots::{get_nl, slots};
@@ -401,7 +301,7 @@ mod tests {
 
     /// One output, three inputs: a rigid body with friction, two light modes, a
     /// feedthrough, an input delay and a lag on input 2.
-    fn model(scale: f64) -> PhysicalModel {
+    pub(in crate::diagnose::lsq) fn model(scale: f64) -> PhysicalModel {
         let mut delay = EffectSpec::new(EffectKind::Delay);
         delay.tau_s = Some(1.0e-4 * scale);
         let mut lag = EffectSpec::new(EffectKind::Lag);
@@ -425,7 +325,7 @@ mod tests {
         }
     }
 
-    fn channels(truth: &PhysicalModel) -> Channels {
+    pub(in crate::diagnose::lsq) fn channels(truth: &PhysicalModel) -> Channels {
         let omega = crate::system::logspace(100.0, 3000.0, 150);
         Channels::of_model(
             truth,
@@ -436,34 +336,30 @@ mod tests {
         )
     }
 
-    /// The variable-projection Jacobian against central differences of the residual with
-    /// the linear slots solved by the refit's own least squares (an independent route:
-    /// no derivative formula, one QR per point).
-    #[test]
-    fn the_jacobian_matches_central_differences_of_the_projected_residual() {
-        let data = channels(&model(1.07));
-        let start = model(1.0);
-        let (lin, nl) = slots(&start, &data);
-        assert!(nl.len() >= 10, "{nl:?}");
+    /// Asserts that the variable-projection Jacobian of `start` on `data` matches fourth-order
+    /// central differences of the residual with the linear slots solved by the refit's own
+    /// least squares (an independent route: no derivative formula, one QR per point).
+    /// Returns the nonlinear slots.
+    fn assert_jacobian_matches(start: &PhysicalModel, data: &Channels) -> Vec<Nl> {
+        let (lin, nl) = slots(start, data);
         let mask: Vec<usize> = (0..data.len()).collect();
-        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
+        let th: Vec<f64> = nl.iter().map(|s| get_nl(start, *s)).collect();
         let typ: Vec<f64> = th.iter().map(|x| x.abs().max(1e-3)).collect();
         let vp = VarPro {
-            start: &start,
+            start,
             nl: &nl,
             lin: &lin,
-            data: &data,
+            data,
             mask: &mask,
             typ: &typ,
         };
         let resid = |t: &[f64]| {
             let mut m = vp.model(t);
-            solve_linear_res(&mut m, &lin, &data, &mask)
+            solve_linear_res(&mut m, &lin, data, &mask)
         };
-        let rows = resid(&th).len();
-        let mut jac = DMatrix::zeros(rows, nl.len());
-        assert!(vp.jacobian(&th, &mut jac));
         let r_norm = resid(&th).norm();
+        let mut jac = DMatrix::zeros(2 * data.n_ch() * data.len(), nl.len());
+        assert!(vp.jacobian(&th, &mut jac));
         for k in 0..nl.len() {
             // Fourth-order central differences (truncation ~(h/ζ)⁴, rounding ~ε‖r‖/h).
             let h = 1e-5 * th[k].abs().max(typ[k]);
@@ -481,6 +377,14 @@ mod tests {
                 cd.norm()
             );
         }
+        nl
+    }
+
+    /// One output, three inputs: every kind of nonlinear slot in one block.
+    #[test]
+    fn the_jacobian_matches_central_differences_of_the_projected_residual() {
+        let nl = assert_jacobian_matches(&model(1.0), &channels(&model(1.07)));
+        assert!(nl.len() >= 10, "{nl:?}");
     }
 
     /// Two copies of one mode make the design rank-deficient: the Jacobian declines (the
@@ -505,35 +409,6 @@ mod tests {
         };
         let mut jac = DMatrix::zeros(2 * 3 * data.len(), nl.len());
         assert!(!vp.jacobian(&th, &mut jac));
-    }
-
-    /// The rough placement's cost by projection equals the full least squares' cost (QR of
-    /// every column at every point) over a grid that crosses the mode's resonance.
-    #[test]
-    fn the_mode_grid_cost_is_the_full_least_squares_cost() {
-        use crate::diagnose::lsq::retune::solve_linear_res;
-        let data = channels(&model(1.07));
-        let start = model(1.0);
-        let (lin, _) = slots(&start, &data);
-        let mask: Vec<usize> = (0..data.len()).collect();
-        for i in 0..2 {
-            let g = ModeGrid::new(&start, i, &lin, &data, &mask).expect("full rank");
-            let w0 = start.mode[i].omega_n;
-            for j in 0..9 {
-                let w = w0 * 1.3f64.powf(-1.0 + j as f64 / 4.0);
-                for z in [1e-3, 0.01, 0.1] {
-                    let mut t = start.clone();
-                    t.mode[i].omega_n = w;
-                    t.mode[i].zeta = z;
-                    let full = solve_linear_res(&mut t, &lin, &data, &mask).norm_squared();
-                    let fast = g.cost(w, z);
-                    assert!(
-                        (fast - full).abs() <= 1e-9 * full,
-                        "mode {i} at ({w}, {z}): {fast} vs {full}"
-                    );
-                }
-            }
-        }
     }
 
     /// Two outputs, one input: one least-squares block per output (the gather–scatter
@@ -572,41 +447,7 @@ mod tests {
         let omega = crate::system::logspace(100.0, 3000.0, 120);
         let data = Channels::of_model(&truth, omega, vec![(0, 0), (1, 0)], 1.0, (0.01, 1e-4));
         let start = two(1.0);
-        let (lin, nl) = slots(&start, &data);
-        assert_eq!(blocks(&lin, &data).len(), 2);
-        let mask: Vec<usize> = (0..data.len()).collect();
-        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
-        let typ: Vec<f64> = th.iter().map(|x| x.abs().max(1e-3)).collect();
-        let vp = VarPro {
-            start: &start,
-            nl: &nl,
-            lin: &lin,
-            data: &data,
-            mask: &mask,
-            typ: &typ,
-        };
-        let resid = |t: &[f64]| {
-            let mut m = vp.model(t);
-            solve_linear_res(&mut m, &lin, &data, &mask)
-        };
-        let r_norm = resid(&th).norm();
-        let mut jac = DMatrix::zeros(4 * data.len(), nl.len());
-        assert!(vp.jacobian(&th, &mut jac));
-        for k in 0..nl.len() {
-            let h = 1e-5 * th[k].abs().max(typ[k]);
-            let at = |d: f64| {
-                let mut t = th.clone();
-                t[k] += d;
-                resid(&t)
-            };
-            let cd = (8.0 * (at(h) - at(-h)) - (at(2.0 * h) - at(-2.0 * h))) / (12.0 * h);
-            let err = (jac.column(k) - &cd).norm();
-            assert!(
-                err <= 1e-6 * cd.norm() + 1e-9 * r_norm,
-                "{:?}: |J − CD| = {err:e}, |CD| = {:e}",
-                nl[k],
-                cd.norm()
-            );
-        }
+        assert_eq!(blocks(&slots(&start, &data).0, &data).len(), 2);
+        assert_jacobian_matches(&start, &data);
     }
 }

@@ -116,8 +116,9 @@ pub fn without(effects: &[(Cand, Vec<f64>)], j: usize) -> Vec<(Cand, Vec<f64>)> 
 pub const SAME_MODE_LN: f64 = 0.01;
 
 /// True when `a` and `b` hold the same effects in any order: each effect of `a` pairs with
-/// an equal candidate of `b`, and an added mode only with a mode at the same frequency
-/// (within `SAME_MODE_LN`).  Labels alone do not tell two added modes apart: a set
+/// an equal candidate of `b` whose fit is not apart from its own (`Cand::apart` within
+/// `SAME_MODE_LN`: an added mode only with a mode at the same frequency).  Labels alone do
+/// not tell two added modes apart: a set
 /// `{mode 900 Hz}` must not be taken for `{mode 810 Hz}` (issue 20 item 3).
 pub fn same_set(a: &[(Cand, Vec<f64>)], b: &[(Cand, Vec<f64>)]) -> bool {
     if a.len() != b.len() {
@@ -129,13 +130,7 @@ pub fn same_set(a: &[(Cand, Vec<f64>)], b: &[(Cand, Vec<f64>)]) -> bool {
             .iter()
             .enumerate()
             .filter(|(i, (cb, _))| !used[*i] && cb == ca)
-            .map(|(i, (_, tb))| {
-                let d = match ca {
-                    Cand::Mode => (ta[0] - tb[0]).abs(),
-                    _ => 0.0,
-                };
-                (i, d)
-            })
+            .map(|(i, (_, tb))| (i, ca.apart(ta, tb)))
             .filter(|(_, d)| *d <= SAME_MODE_LN)
             .min_by(|x, y| x.1.total_cmp(&y.1));
         match best {
