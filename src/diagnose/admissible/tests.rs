@@ -31,8 +31,19 @@ fn lines(lo: f64, hi: f64, step: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The response of `m` measured at `omega` (radius 1 % of |G|, floor 1e-9).
+fn data_of(m: &PhysicalModel, omega: Vec<f64>) -> Channels {
+    Channels::of_model(m, omega, vec![(0, 0)], 1.0, (0.01, 1e-9))
+}
+
+/// Dense lines: 50–200 rad/s, 0.25 rad/s apart.
+fn dense() -> Vec<f64> {
+    lines(50.0, 200.0, 0.25)
+}
+
+/// The truth measured at `omega`.
 fn data(omega: Vec<f64>) -> Channels {
-    Channels::of_model(&truth(), omega, vec![(0, 0)], 1.0, (0.01, 1e-9))
+    data_of(&truth(), omega)
 }
 
 const BEFORE: Measures = Measures {
@@ -46,13 +57,14 @@ const AFTER: Measures = Measures {
     invalid_fraction: 0.3,
 };
 
-fn rule_of(
+/// The refusal of `cand` refit as `m` on `d` with measures `after` (against `BEFORE`).
+fn refused(
     cand: Cand,
     m: &PhysicalModel,
     d: &Channels,
     after: &Measures,
     mains: bool,
-) -> Option<Rule> {
+) -> Option<Refusal> {
     check(
         &Child {
             cand,
@@ -63,7 +75,17 @@ fn rule_of(
         },
         d,
     )
-    .map(|r| r.rule)
+}
+
+/// The rule of [`refused`].
+fn rule_of(
+    cand: Cand,
+    m: &PhysicalModel,
+    d: &Channels,
+    after: &Measures,
+    mains: bool,
+) -> Option<Rule> {
+    refused(cand, m, d, after, mains).map(|r| r.rule)
 }
 
 fn with_mode(md: ModeSpec) -> PhysicalModel {
@@ -93,7 +115,7 @@ fn a_line_narrow_mode_at_50_hz_is_mains_unless_allowed() {
 
 #[test]
 fn a_mode_with_zeta_above_0_2_is_a_broad_term() {
-    let d = data(lines(50.0, 200.0, 0.25));
+    let d = data(dense());
     let m = with_mode(mode(150.0, 0.3, 1.0));
     assert_eq!(
         rule_of(Cand::Mode, &m, &d, &AFTER, false),
@@ -112,17 +134,7 @@ fn a_mode_between_lines_the_residual_does_not_show_is_unresolved() {
     // in it, and the data (the truth) have no peak there.
     let d = data(lines(50.0, 200.0, 1.0));
     let m = with_mode(mode(150.5, 1e-4, 1e-3));
-    let r = check(
-        &Child {
-            cand: Cand::Mode,
-            model: &m,
-            measures: &AFTER,
-            reference: &BEFORE,
-            allow_mains: false,
-        },
-        &d,
-    )
-    .unwrap();
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
     assert_eq!(r.rule, Rule::Unresolved);
     assert!(
         r.reason.contains("measure denser lines around"),
@@ -131,13 +143,7 @@ fn a_mode_between_lines_the_residual_does_not_show_is_unresolved() {
     );
     // The same mode present in the data: its flanks show it, so it is not "unresolved".
     let tr = with_mode(mode(150.5, 1e-4, 1.0));
-    let d2 = Channels::of_model(
-        &tr,
-        lines(50.0, 200.0, 1.0),
-        vec![(0, 0)],
-        1.0,
-        (0.01, 1e-9),
-    );
+    let d2 = data_of(&tr, lines(50.0, 200.0, 1.0));
     assert_ne!(
         rule_of(Cand::Mode, &tr, &d2, &AFTER, false),
         Some(Rule::Unresolved)
@@ -146,35 +152,16 @@ fn a_mode_between_lines_the_residual_does_not_show_is_unresolved() {
 
 #[test]
 fn overlapping_modes_with_cancelling_residues_are_an_artefact() {
-    let d = data(lines(50.0, 200.0, 0.25));
+    let d = data(dense());
     let mut m = with_mode(mode(150.0, 0.05, 100.0));
     m.mode.push(mode(150.5, 0.05, -99.0));
-    let r = check(
-        &Child {
-            cand: Cand::Mode,
-            model: &m,
-            measures: &AFTER,
-            reference: &BEFORE,
-            allow_mains: false,
-        },
-        &d,
-    )
-    .unwrap();
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
     assert_eq!(r.rule, Rule::Artefact);
     assert!(r.reason.contains("cancelling pair"), "{}", r.reason);
     // Same residue signs: no cancelling pair.
     let mut m = with_mode(mode(150.0, 0.05, 1e-3));
     m.mode.push(mode(150.5, 0.05, 1e-3));
-    let r = check(
-        &Child {
-            cand: Cand::Mode,
-            model: &m,
-            measures: &AFTER,
-            reference: &BEFORE,
-            allow_mains: false,
-        },
-        &d,
-    );
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false);
     assert!(
         r.as_ref().is_none_or(|r| !r.reason.contains("cancelling")),
         "{r:?}"
@@ -183,27 +170,17 @@ fn overlapping_modes_with_cancelling_residues_are_an_artefact() {
 
 #[test]
 fn a_mode_far_above_the_data_is_an_artefact() {
-    let d = data(lines(50.0, 200.0, 0.25));
+    let d = data(dense());
     // |data| near 150 rad/s ≈ 1/(150² − 100²) = 8e-5; the mode's ≈ ρ/(2ζω²) ≫ 10×.
     let m = with_mode(mode(150.0, 0.05, 10.0));
-    let r = check(
-        &Child {
-            cand: Cand::Mode,
-            model: &m,
-            measures: &AFTER,
-            reference: &BEFORE,
-            allow_mains: false,
-        },
-        &d,
-    )
-    .unwrap();
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
     assert_eq!(r.rule, Rule::Artefact);
     assert!(r.reason.contains("exceeds the data"), "{}", r.reason);
 }
 
 #[test]
 fn a_delay_below_the_phase_resolution_and_a_tiny_misfit_change_are_negligible() {
-    let d = data(lines(50.0, 200.0, 0.25));
+    let d = data(dense());
     let mut m = truth();
     let mut e = EffectSpec::new(EffectKind::Delay);
     e.tau_s = Some(1e-6); // 2e-4 rad at 200 rad/s, against asin(0.01) = 0.01 rad
@@ -234,29 +211,13 @@ fn a_delay_below_the_phase_resolution_and_a_tiny_misfit_change_are_negligible() 
 
 #[test]
 fn a_mode_the_covariance_does_not_determine_is_not_identified() {
-    let d = data(lines(50.0, 200.0, 0.25));
+    let d = data(dense());
     // A residue 1e-12 of the data's size: its ω_n and ζ have no information.
     let m = with_mode(mode(150.0, 0.01, 1e-16));
-    let r = check(
-        &Child {
-            cand: Cand::Mode,
-            model: &m,
-            measures: &AFTER,
-            reference: &BEFORE,
-            allow_mains: false,
-        },
-        &d,
-    )
-    .unwrap();
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
     assert_eq!(r.rule, Rule::NotIdentified, "{}", r.reason);
     // A real second mode of the data is identified.
     let tr = with_mode(mode(150.0, 0.01, 1.0));
-    let d2 = Channels::of_model(
-        &tr,
-        lines(50.0, 200.0, 0.25),
-        vec![(0, 0)],
-        1.0,
-        (0.01, 1e-9),
-    );
+    let d2 = data_of(&tr, dense());
     assert_eq!(rule_of(Cand::Mode, &tr, &d2, &AFTER, false), None);
 }
