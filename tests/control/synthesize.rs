@@ -92,8 +92,9 @@ fn hankel_norm(ss: &StateSpace) -> f64 {
     e.iter().map(|z| z.re).fold(0.0, f64::max).sqrt()
 }
 
-/// A random plant: stable or unstable, MIMO, with or without feedthrough.
-fn random_plant(seed: u64) -> StateSpace {
+/// A random plant: stable or unstable, MIMO, with or without feedthrough (also the plants of
+/// synthesize_hinf.rs's `small_b_opt_by_the_gamma_iteration`).
+pub(crate) fn random_plant(seed: u64) -> StateSpace {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let n = rng.gen_range(2..=6);
     let p = rng.gen_range(1..=3);

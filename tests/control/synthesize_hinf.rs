@@ -434,26 +434,6 @@ fn a_bound_that_is_not_a_unit_is_refused_in_one_line() {
     }
 }
 
-/// The plants of tests/control/synthesize.rs (same generator and seeds).
-fn gm_random_plant(seed: u64) -> StateSpace {
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let n = rng.gen_range(2..=6);
-    let p = rng.gen_range(1..=3);
-    let m = rng.gen_range(1..=3);
-    let mut r = |_, _| rng.gen_range(-1.0..1.0);
-    let a0 = DMatrix::from_fn(n, n, &mut r) * 2.0;
-    let shift = if seed.is_multiple_of(3) { 1.5 } else { -0.5 };
-    let a = a0 - DMatrix::identity(n, n) * shift;
-    let b = DMatrix::from_fn(n, m, &mut r);
-    let c = DMatrix::from_fn(p, n, &mut r);
-    let d = if seed.is_multiple_of(2) {
-        DMatrix::from_fn(p, m, &mut r) * 0.5
-    } else {
-        DMatrix::zeros(p, m)
-    };
-    StateSpace { a, b, c, d }
-}
-
 /// `b_opt < 0.02` (nearly unstabilizable plants, where tests/control/synthesize.rs's Hankel route
 /// is too inaccurate and only a sandwich pins b_opt): the γ-iteration of the weighted
 /// problem with r = 1 — a different formula (the X∞ Riccati of the generalized plant at each
@@ -462,7 +442,7 @@ fn gm_random_plant(seed: u64) -> StateSpace {
 fn small_b_opt_by_the_gamma_iteration() {
     let mut compared = 0;
     for seed in 0..64u64 {
-        let ncf = NormalizedLcf::new(gm_random_plant(seed)).unwrap();
+        let ncf = NormalizedLcf::new(crate::synthesize::random_plant(seed)).unwrap();
         let b_opt = optimum(&ncf).unwrap().b_opt;
         if b_opt >= 0.02 {
             continue;
