@@ -4,7 +4,9 @@
 //!
 //! The imports are read from the sources: every `crate::diagnose::a::b…` path (and
 //! `super::a` naming a sibling module) in the code of a file, before its `#[cfg(test)]`
-//! module, resolves to the longest module path it starts with.
+//! module, resolves to the longest module path it starts with; the registration list of the
+//! effects (`register! { … }`) names each effect's module by a relative path
+//! (`delay::Delay`), read as well.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -52,6 +54,36 @@ fn resolve(path: &[String], modules: &BTreeSet<String>) -> Option<String> {
         .rev()
         .map(|k| path[..k].join("::"))
         .find(|m| modules.contains(m))
+}
+
+/// The first segments of the relative paths (`delay::Delay` → `delay`) in the body of a
+/// `register! { … }` invocation of `code` (the effects' registration list).
+fn registry_paths(code: &str) -> Vec<String> {
+    let Some(start) = code.find("register! {") else {
+        return Vec::new();
+    };
+    let body = &code[start + "register! {".len()..];
+    let body = &body[..body.find("\n}").unwrap_or(body.len())];
+    let mut out = Vec::new();
+    for line in body.lines() {
+        let code = line.split("//").next().unwrap_or("");
+        for (at, _) in code.match_indices("::") {
+            let head = &code[..at];
+            let name: String = head
+                .chars()
+                .rev()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect();
+            let before = head[..head.len() - name.len()].chars().last();
+            if !name.is_empty() && !matches!(before, Some(':') | Some('$')) {
+                out.push(name);
+            }
+        }
+    }
+    out
 }
 
 /// Module → the diagnose modules its code names, and the lines that name diagnose in a form
@@ -106,6 +138,18 @@ fn imports() -> (BTreeMap<String, BTreeSet<String>>, Vec<String>) {
                 if let Some(m) = resolve(&path, &modules) {
                     deps.insert(m);
                 }
+            }
+        }
+        // The registry (`register! { … }` in effects/mod.rs) names each effect's module by a
+        // path relative to the file (`delay::Delay`): the module depends on each.
+        for name in registry_paths(&text) {
+            let child = if me.is_empty() {
+                name
+            } else {
+                format!("{me}::{name}")
+            };
+            if modules.contains(&child) {
+                deps.insert(child);
             }
         }
         deps.remove(&me);
@@ -210,6 +254,9 @@ fn diagnose_has_no_import_cycle_between_modules_or_layers() {
     // The reader sees the imports it must: a few known edges.
     for (from, to) in [
         ("lsq::problem", "effects::candidates"),
+        // Read from the registry's relative paths.
+        ("effects", "effects::delay"),
+        ("effects", "effects::damping"),
         ("search::beam", "lsq::retune"),
         ("engine", "search::beam"),
         ("lsq::channels", "lsq::measures"),

@@ -22,7 +22,7 @@ use std::collections::BTreeMap;
 pub use crate::diagnose::effects::{Cand, EFFECT_NAMES};
 
 pub use crate::diagnose::effects::effect::Sel;
-pub use crate::report::fmt::{fmt_change, fmt_w, sig};
+pub use crate::report::fmt::{fmt_w, sig};
 
 /// Names of modes and terms `diagnose` adds start with this.
 pub const ADDED_NOTE: &str = "added by rshape diagnose";

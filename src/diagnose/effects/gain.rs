@@ -1,9 +1,8 @@
 //! A gain error `k` on a path: θ = \[k\].  Not tried by the search (the retune refits the
 //! model's own gains); `compare` revisions and library users name it.
 
-use crate::diagnose::effects::candidates::fmt_change;
 use crate::diagnose::effects::effect::{
-    one, sig, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
+    fmt_change, one, sig, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
 };
 use crate::model::physical::{EffectKind, PhysicalModel};
 use num_complex::Complex64;
