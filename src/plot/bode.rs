@@ -1,7 +1,7 @@
 //! `bode.svg`: magnitude and phase of the data, with the noise disk of eq. (5) drawn as
 //! error bars, against the nominal model `G = C·M̃⁻¹·Ñ·J` (as in the paper's Fig. 7).
 
-use super::axis::{log_label, phase_tick, unwrap_deg, LogAxis, PhaseAxis};
+use super::axis::{log_label, phase_tick, LogAxis};
 use super::fine::{Look, Overlay, PixelMap};
 use super::style::*;
 use crate::error::Result;
@@ -27,51 +27,25 @@ pub struct BodeInput<'a> {
     pub symbol: &'a str,
 }
 
-fn phase_deg(z: Complex64) -> f64 {
-    z.arg().to_degrees()
-}
-
 /// The model's phase of channel `ch` on the grid, unwrapped along it (NaN where the model is
-/// unknown or zero): the convention of `compare`'s overlay.
+/// unknown or zero).
 fn model_phase(inp: &BodeInput, ch: (usize, usize)) -> Vec<f64> {
-    let g: Vec<Complex64> = inp
-        .model
-        .iter()
-        .map(|g| match g {
-            Some(g) if g[ch].norm() > 0.0 && g[ch].norm().is_finite() => g[ch],
-            _ => Complex64::new(f64::NAN, f64::NAN),
-        })
-        .collect();
-    unwrap_deg(&g)
+    super::bode_common::model_phase(inp.model.iter().map(|g| match g {
+        Some(g) => g[ch],
+        None => Complex64::new(f64::NAN, f64::NAN),
+    }))
 }
 
-/// Phase (degrees) of each datum of channel `ch`, on the branch of the model's unwrapped
-/// phase at the nearest grid point (data and model never sit 360° apart); unwrapped along the
-/// data where the model is unknown.
+/// Phase (degrees) of each datum of channel `ch` on the branch of the model's unwrapped
+/// phase `model` at its frequency ([`super::bode_common::data_phase`]).
 fn data_phases(inp: &BodeInput, ch: (usize, usize), model: &[f64]) -> Vec<f64> {
-    let near = super::phase::nearest_branch;
-    let mut out: Vec<f64> = Vec::with_capacity(inp.omega.len());
-    for (k, w) in inp.omega.iter().enumerate() {
-        let p = phase_deg(inp.data[k][ch]);
-        let j = inp.grid.partition_point(|g| *g < *w);
-        let reference = [j.saturating_sub(1), j]
-            .into_iter()
-            .filter(|&c| c < inp.grid.len() && model[c].is_finite())
-            .min_by(|&a, &b| {
-                (inp.grid[a] / w)
-                    .ln()
-                    .abs()
-                    .total_cmp(&(inp.grid[b] / w).ln().abs())
-            })
-            .map(|c| model[c]);
-        let prev = out.last().copied().filter(|v: &f64| v.is_finite());
-        out.push(match (reference, prev) {
-            (Some(m), _) if p.is_finite() => near(p, m),
-            (None, Some(q)) if p.is_finite() => near(p, q),
-            _ => p,
-        });
-    }
-    out
+    let reference: Vec<f64> = inp
+        .omega
+        .iter()
+        .map(|w| super::bode_common::interp(inp.grid, model, *w))
+        .collect();
+    let g: Vec<Complex64> = inp.data.iter().map(|d| d[ch]).collect();
+    super::bode_common::data_phase(&g, Some(&reference), inp.noise_radius)
 }
 
 /// Pixel size of one channel's panel (magnitude over phase) in a MIMO grid, and of the
@@ -231,14 +205,13 @@ fn panel<DB: DrawingBackend>(
     let model = model_phase(inp, (i, j));
     let data = data_phases(inp, (i, j), &model);
     let in_band = |w: &f64| *w >= xlo && *w <= xhi;
-    let axis = PhaseAxis::covering(
-        data.iter().copied().chain(
-            inp.grid
-                .iter()
-                .zip(&model)
-                .filter(|(w, _)| in_band(w))
-                .map(|(_, p)| *p),
-        ),
+    let axis = super::bode_common::phase_axis(
+        &data,
+        inp.grid
+            .iter()
+            .zip(&model)
+            .filter(|(w, _)| in_band(w))
+            .map(|(_, p)| *p),
     );
     let mut ph = ChartBuilder::on(&bottom)
         .margin(10)
@@ -267,8 +240,7 @@ fn panel<DB: DrawingBackend>(
         let r = radius(k);
         if r > 0.0 {
             // The disk of radius r around z subtends ±asin(r/|z|) (all angles if it holds 0).
-            let half = super::phase::disk_half_span_deg(r, z.norm());
-            let (lo, hi) = (axis.clamp(ang - half), axis.clamp(ang + half));
+            let (lo, hi) = super::bode_common::disk_phase_bar(ang, r, z.norm(), &axis);
             ph.draw_series(std::iter::once(PathElement::new(
                 vec![(*w, lo), (*w, hi)],
                 col.mix(0.6).stroke_width(1),

@@ -10,6 +10,7 @@
 
 use crate::error::Result;
 use crate::plot::axis::{LinAxis, LogAxis};
+use crate::plot::bode_common;
 use crate::plot::fine::{Look, Overlay, PixelMap};
 use crate::plot::style::{
     draw_x_labels, fmt_tick, log_axis_ticks, plot_err, Legend, C_GREY, C_RED, FONT, PALETTE, TICKS,
@@ -76,44 +77,6 @@ pub fn dense_grid(omega: &[f64]) -> Vec<f64> {
 
 pub use crate::plot::axis::unwrap_deg;
 
-/// The phase of each datum (degrees): on the branch nearest `reference` (the model's
-/// unwrapped phase at the same frequency) where the datum lies within 90° of it, else on the
-/// branch nearest the previous datum (a datum about 180° from the model has two equally near
-/// branches; continuity along the data picks one); unwrapped along the data without a
-/// reference.
-fn data_phase(g: &[Complex64], reference: Option<&[f64]>) -> Vec<f64> {
-    let Some(r) = reference else {
-        return unwrap_deg(g);
-    };
-    let near = crate::plot::phase::nearest_branch;
-    let mut out: Vec<f64> = Vec::with_capacity(g.len());
-    for (z, m) in g.iter().zip(r) {
-        let p = z.arg().to_degrees();
-        let prev = out.last().copied().filter(|v| v.is_finite());
-        let v = match (m.is_finite(), prev) {
-            (true, _) if (near(p, *m) - m).abs() <= 90.0 => near(p, *m),
-            (_, Some(q)) => near(p, q),
-            (true, None) => near(p, *m),
-            (false, None) => p,
-        };
-        out.push(v);
-    }
-    out
-}
-
-/// Linear interpolation of `y(x)` at `x0` (x increasing), NaN outside.
-fn interp(x: &[f64], y: &[f64], x0: f64) -> f64 {
-    let k = x.partition_point(|v| *v < x0);
-    if k < x.len() && x[k] == x0 {
-        return y[k];
-    }
-    if k == 0 || k >= x.len() {
-        return f64::NAN;
-    }
-    let t = (x0 - x[k - 1]) / (x[k] - x[k - 1]);
-    y[k - 1] + t * (y[k] - y[k - 1])
-}
-
 fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for x in v.filter(|x| x.is_finite()) {
@@ -125,21 +88,6 @@ fn span(v: impl Iterator<Item = f64>) -> (f64, f64) {
     }
     let pad = ((hi - lo) * 0.06).max(1.0);
     (lo - pad, hi + pad)
-}
-
-/// Splits `(x, y)` points into runs of finite values (a line breaks where the model
-/// cannot be evaluated).
-fn runs(points: impl Iterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
-    let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
-    for p in points {
-        if p.0.is_finite() && p.1.is_finite() {
-            out.last_mut().expect("non-empty").push(p);
-        } else if !out.last().expect("non-empty").is_empty() {
-            out.push(Vec::new());
-        }
-    }
-    out.retain(|r| r.len() > 1);
-    out
 }
 
 /// Pixel height of the magnitude and the phase plot.
@@ -156,14 +104,17 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
         (Some(&a), Some(&b)) if a > 0.0 => (hz(a) / 1.1, hz(b) * 1.1),
         _ => (0.1, 1.0),
     };
-    let model_phase: Vec<Vec<f64>> = models.iter().map(|m| unwrap_deg(&m.g)).collect();
+    let model_phase: Vec<Vec<f64>> = models
+        .iter()
+        .map(|m| bode_common::model_phase(m.g.iter().copied()))
+        .collect();
     let reference: Option<Vec<f64>> = models.first().map(|m| {
         data.omega
             .iter()
-            .map(|w| interp(&m.omega, &model_phase[0], *w))
+            .map(|w| bode_common::interp(&m.omega, &model_phase[0], *w))
             .collect()
     });
-    let dph = data_phase(data.g, reference.as_deref());
+    let dph = bode_common::data_phase(data.g, reference.as_deref(), data.radius);
     let in_band = |w: &f64| hz(*w) >= f0 && hz(*w) <= f1;
     let (m0, m1) = span(data.g.iter().map(db).chain(models.iter().flat_map(|m| {
         m.omega
@@ -172,20 +123,18 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
             .filter(move |(w, _)| in_band(w))
             .map(|(_, z)| db(z))
     })));
-    let (p0, p1) = span(
-        dph.iter()
-            .copied()
-            .chain(models.iter().zip(&model_phase).flat_map(|(m, p)| {
-                m.omega
-                    .iter()
-                    .zip(p)
-                    .filter(move |(w, _)| in_band(w))
-                    .map(|(_, v)| *v)
-            })),
-    );
     // Guarded axes: the phase spans multiples of 90° and is ticked (labels and grid lines
     // alike) at multiples of 90°.
-    let phase_axis = crate::plot::axis::PhaseAxis::covering([p0, p1]);
+    let phase_axis = bode_common::phase_axis(
+        &dph,
+        models.iter().zip(&model_phase).flat_map(|(m, p)| {
+            m.omega
+                .iter()
+                .zip(p)
+                .filter(move |(w, _)| in_band(w))
+                .map(|(_, v)| *v)
+        }),
+    );
     let (p0, p1) = phase_axis.ends();
     let (m0, m1) = crate::plot::axis::lin_bounds(m0, m1);
     let (f0, f1) = crate::plot::axis::log_bounds(f0, f1);
@@ -203,9 +152,9 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
             } else {
                 m0
             });
-            let half = crate::plot::phase::disk_half_span_deg(*r, a);
-            upper_ph.push((p + half).min(p1));
-            lower_ph.push((p - half).max(p0));
+            let (lo, hi) = bode_common::disk_phase_bar(*p, *r, a, &phase_axis);
+            upper_ph.push(hi);
+            lower_ph.push(lo);
         }
         (upper_db, lower_db, upper_ph, lower_ph)
     });
@@ -306,13 +255,11 @@ pub fn bode_svg(title: &str, data: &BodeData, models: &[ModelCurve]) -> Result<S
         }
         for (k, (m, p)) in models.iter().zip(&model_phase).enumerate() {
             let look = Look::solid(PALETTE[k % PALETTE.len()], 2.0);
-            let (map_m, map_p) = (PixelMap::of(&mag), PixelMap::of(&ph));
-            for run in runs(m.omega.iter().zip(&m.g).map(|(w, z)| (hz(*w), db(z)))) {
-                overlay.curve(&map_m, run, look);
-            }
-            for run in runs(m.omega.iter().zip(p).map(|(w, v)| (hz(*w), *v))) {
-                overlay.curve(&map_p, run, look);
-            }
+            // Broken where the model cannot be evaluated (the overlay skips non-finite points).
+            let m_db = m.omega.iter().zip(&m.g).map(|(w, z)| (hz(*w), db(z)));
+            overlay.curve(&PixelMap::of(&mag), m_db, look);
+            let m_ph = m.omega.iter().zip(p).map(|(w, v)| (hz(*w), *v));
+            overlay.curve(&PixelMap::of(&ph), m_ph, look);
             legend.add_line(
                 format!("{} (line: evaluated between the data)", m.name),
                 look,

@@ -9,7 +9,8 @@
 //!   as in Fig. 7;
 //! - `mu`: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
 //! - `batch`: every dataset's envelope, the combined envelope and the one fitted `r`;
-//! - `bode_overlay`: `compare`'s data against one or more models;
+//! - `bode_overlay`: `compare`'s data against one or more models (`bode_common`: what the
+//!   two Bode figures share: the phase conventions, the phase axis, a noise disk's span);
 //! - `history`: the error measures after each revision (`history`).
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
@@ -17,11 +18,11 @@
 pub(crate) mod axis;
 pub(crate) mod batch;
 pub(crate) mod bode;
+pub(crate) mod bode_common;
 pub(crate) mod bode_overlay;
 pub(crate) mod fine;
 pub(crate) mod history;
 pub(crate) mod mu;
-pub(crate) mod phase;
 pub(crate) mod r_vs_delta;
 pub(crate) mod stability;
 pub(crate) mod style;
