@@ -4,6 +4,10 @@
 //!   shares (the channel selection `Sel`, the ζ bounds, a term's residue);
 //! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
 //!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`), registered below;
+//! * `path` and `configured`: the two recurring shapes, a path effect on one parameter
+//!   (`delay`, `lag`, `nmp_zero`, `zoh`: `OnPath`, `on_path!`) and a refit of one parameter
+//!   of a configured mode (`mode_shift`, `damping`: `RefitsMode`, `refits_mode!`), whose
+//!   files hold only what differs;
 //! * `candidates`: the candidate [`Cand`] (one variant per registered effect) and what it
 //!   dispatches to its effect;
 //! * `explain`: what each means in the data;
