@@ -24,7 +24,7 @@ use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::slots::{
     gains_of, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl, Term,
 };
-use crate::model::physical::{EffectKind, PhysicalModel};
+use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
 use serde::Serialize;
 
@@ -204,11 +204,7 @@ fn nl_param(m: &PhysicalModel, s: Nl) -> Param {
         Nl::LogEffect(i) => log(format!(
             "effect[{}].{}",
             i + 1,
-            match m.effect[i].kind {
-                EffectKind::Lag => "omega_c",
-                EffectKind::NmpZero => "z",
-                _ => "t_s",
-            }
+            m.effect[i].log_param_name().unwrap_or("parameter")
         )),
     }
 }

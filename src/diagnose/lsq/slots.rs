@@ -126,12 +126,14 @@ pub(crate) fn slots(m: &PhysicalModel, data: &Channels) -> (Vec<Lin>, Vec<Nl>) {
         }
     }
     for (i, e) in m.effect.iter().enumerate() {
-        match e.kind {
-            EffectKind::Delay if e.tau_s.is_some() => nl.push(Nl::Delay(i)),
-            EffectKind::Lag if e.omega_c.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            EffectKind::NmpZero if e.z.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            EffectKind::Zoh if e.t_s.is_some_and(|x| x > 0.0) => nl.push(Nl::LogEffect(i)),
-            _ => {}
+        // A delay is refit as τ; a lag, NMP zero or hold in the logarithm of its parameter
+        // (`EffectSpec::log_param`); a gain or sign is not refit.
+        if e.kind == EffectKind::Delay {
+            if e.tau_s.is_some() {
+                nl.push(Nl::Delay(i));
+            }
+        } else if e.log_param().is_some_and(|x| x > 0.0) {
+            nl.push(Nl::LogEffect(i));
         }
     }
     (lin, nl)
@@ -144,16 +146,7 @@ pub(crate) fn get_nl(m: &PhysicalModel, s: Nl) -> f64 {
         Nl::RigidPole(i) => m.rigid_body[i].friction_pole.unwrap_or(1.0).ln(),
         Nl::In(t, i) => gains_of(m, t).1.to_vec(m.n_inputs())[i],
         Nl::Delay(i) => m.effect[i].tau_s.unwrap_or(0.0),
-        Nl::LogEffect(i) => {
-            let e = &m.effect[i];
-            match e.kind {
-                EffectKind::Lag => e.omega_c,
-                EffectKind::NmpZero => e.z,
-                _ => e.t_s,
-            }
-            .unwrap_or(1.0)
-            .ln()
-        }
+        Nl::LogEffect(i) => m.effect[i].log_param().unwrap_or(1.0).ln(),
     }
 }
 
@@ -166,12 +159,8 @@ pub(crate) fn set_nl(m: &mut PhysicalModel, s: Nl, x: f64) {
         Nl::In(t, i) => set_entry(gains_mut(m, t).1, n_in, i, x),
         Nl::Delay(i) => m.effect[i].tau_s = Some(x),
         Nl::LogEffect(i) => {
-            let e = &mut m.effect[i];
-            let v = Some(x.exp());
-            match e.kind {
-                EffectKind::Lag => e.omega_c = v,
-                EffectKind::NmpZero => e.z = v,
-                _ => e.t_s = v,
+            if let Some(v) = m.effect[i].log_param_mut() {
+                *v = Some(x.exp());
             }
         }
     }

@@ -70,6 +70,38 @@ pub struct EffectSpec {
 }
 
 impl EffectSpec {
+    /// The name of the positive parameter a refit moves in logarithms (`omega_c` of a lag,
+    /// `z` of an NMP zero, `t_s` of a hold); `None` for a delay (refit as τ itself), a gain and
+    /// a sign.
+    pub fn log_param_name(&self) -> Option<&'static str> {
+        match self.kind {
+            EffectKind::Lag => Some("omega_c"),
+            EffectKind::NmpZero => Some("z"),
+            EffectKind::Zoh => Some("t_s"),
+            EffectKind::Delay | EffectKind::Gain | EffectKind::Sign => None,
+        }
+    }
+
+    /// The field of that parameter ([`EffectSpec::log_param_name`]).
+    pub fn log_param_mut(&mut self) -> Option<&mut Option<f64>> {
+        match self.kind {
+            EffectKind::Lag => Some(&mut self.omega_c),
+            EffectKind::NmpZero => Some(&mut self.z),
+            EffectKind::Zoh => Some(&mut self.t_s),
+            EffectKind::Delay | EffectKind::Gain | EffectKind::Sign => None,
+        }
+    }
+
+    /// The value of that parameter, when the effect has one and it is set.
+    pub fn log_param(&self) -> Option<f64> {
+        match self.kind {
+            EffectKind::Lag => self.omega_c,
+            EffectKind::NmpZero => self.z,
+            EffectKind::Zoh => self.t_s,
+            EffectKind::Delay | EffectKind::Gain | EffectKind::Sign => None,
+        }
+    }
+
     /// An effect of this kind with no parameters set, on the input path.
     pub fn new(kind: EffectKind) -> Self {
         Self {
@@ -198,6 +230,28 @@ pub fn pade(tau: f64, n: usize) -> TransferFunction {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The refit's log-parameter is the field its name says (read back through serde's own
+    /// field names, not through the same match).
+    #[test]
+    fn log_param_names_its_field() {
+        use EffectKind::*;
+        for kind in [Delay, Lag, Gain, Sign, Zoh, NmpZero] {
+            let mut e = EffectSpec::new(kind);
+            match e.log_param_mut() {
+                Some(v) => *v = Some(3.5),
+                None => {
+                    assert!(matches!(kind, Delay | Gain | Sign), "{kind:?}");
+                    assert_eq!(e.log_param_name(), None);
+                    continue;
+                }
+            }
+            assert_eq!(e.log_param(), Some(3.5), "{kind:?}");
+            let json = serde_json::to_value(&e).expect("serializes");
+            let name = e.log_param_name().expect("named");
+            assert_eq!(json[name], 3.5, "{kind:?}: {json}");
+        }
+    }
 
     #[test]
     fn pade_matches_delay_at_low_frequency() {
