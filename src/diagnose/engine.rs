@@ -27,7 +27,7 @@ use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
 use crate::diagnose::lsq::retune::retune_within;
 use crate::diagnose::report::{
-    DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
+    DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
 };
 use crate::diagnose::search::beam::{
     roots, screen_configured, search, SearchResult, SearchSettings,
@@ -112,6 +112,7 @@ pub fn diagnose_channels(
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
             refused: vec![],
+            dampings_not_identified: vec![],
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
@@ -168,7 +169,8 @@ pub fn diagnose_channels(
             s.min_delta_bic,
         )
     })?;
-    phases.time("final refit", || final_refit(&mut node, base, data))?;
+    let dampings_not_identified =
+        phases.time("final refit", || final_refit(&mut node, base, data))?;
     // What the written model has and the input did not: the modes read by an assignment.
     node.model = crate::diagnose::search::assign::align_from(
         &[base, &root_model],
@@ -205,6 +207,10 @@ pub fn diagnose_channels(
     };
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
         + &unreached_modes(&peaks, &res.peak_modes_hz);
+    for d in &dampings_not_identified {
+        message += "; ";
+        message += &d.reason;
+    }
     if verdict == DiagnoseVerdict::NoEffectFound {
         let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
         let white =
@@ -248,6 +254,7 @@ pub fn diagnose_channels(
                 refusal: r.clone(),
             })
             .collect(),
+        dampings_not_identified,
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
@@ -301,17 +308,64 @@ fn drop_failing_holdout(
     Ok((holdout, dropped))
 }
 
-/// A last joint refit of the chosen model, kept when it lowers the cost, and its
-/// consistency polish ([`crate::diagnose::search::polish`]).
-fn final_refit(node: &mut Node, base: &PhysicalModel, data: &Channels) -> Result<()> {
+/// A last joint refit of the chosen model, kept when it lowers the cost; a damping that
+/// ended on the record's floor profiled ([`crate::diagnose::lsq::profile`]: where the
+/// likelihood is flat the interval's log-midpoint is written and the rest refit with it
+/// held); then the consistency polish ([`crate::diagnose::search::polish`]).  Returns the
+/// dampings not identified.
+fn final_refit(
+    node: &mut Node,
+    base: &PhysicalModel,
+    data: &Channels,
+) -> Result<Vec<DampingInterval>> {
+    use crate::diagnose::lsq::profile::{modes_at_floor, zeta_profile};
+    use crate::diagnose::lsq::retune::retune_holding;
+    use crate::diagnose::lsq::slots::Nl;
     let refit = retune_within(&node.model, base, data, None, false);
     if refit.v_after < node.v_fit {
         node.v_fit = refit.v_after;
         node.model = refit.model;
     }
+    let mut flat = Vec::new();
+    for k in modes_at_floor(&node.model, data) {
+        let p = zeta_profile(&node.model, base, data, k);
+        if !p.flat() {
+            continue;
+        }
+        let mut m = node.model.clone();
+        m.mode[k].zeta = p.midpoint();
+        let held: Vec<Nl> = flat
+            .iter()
+            .map(|(k, _): &(usize, _)| Nl::ModeZ(*k))
+            .collect();
+        node.model = retune_holding(&m, base, data, &[held, vec![Nl::ModeZ(k)]].concat()).model;
+        flat.push((k, p));
+    }
     let model = std::mem::replace(&mut node.model, base.clone());
     (node.model, node.measures) = settle(model, base, data)?;
-    Ok(())
+    Ok(flat
+        .into_iter()
+        .map(|(k, p)| {
+            let f = p.omega_n / std::f64::consts::TAU;
+            let z = node.model.mode[k].zeta;
+            DampingInterval {
+                frequency_hz: f,
+                zeta_floor: p.floor,
+                zeta_upper: p.upper,
+                zeta_written: z,
+                profile: p.points.iter().map(|(z, v)| [*z, *v]).collect(),
+                threshold: p.threshold,
+                reason: format!(
+                    "ζ of the mode at {} Hz not identified: the likelihood is flat from the record's floor {} to {} (95 %), written {} (the log-midpoint); measure denser lines around {} Hz",
+                    sig(f),
+                    sig(p.floor),
+                    sig(p.upper),
+                    sig(z),
+                    sig(f)
+                ),
+            }
+        })
+        .collect())
 }
 
 /// The four best other effect sets of the search, by BIC, with their gap to the chosen one.
