@@ -356,7 +356,7 @@ fn final_refit(
                 profile: p.points.iter().map(|(z, v)| [*z, *v]).collect(),
                 threshold: p.threshold,
                 reason: format!(
-                    "ζ of the mode at {} Hz not identified: the likelihood is flat from the record's floor {} to {} (95 %), written {} (the log-midpoint); measure denser lines around {} Hz",
+                    "ζ of the mode at {} Hz not identified: the likelihood is flat from the record's floor {} to {} (95 %), set to {} (the log-midpoint); measure denser lines around {} Hz",
                     sig(f),
                     sig(p.floor),
                     sig(p.upper),
