@@ -413,7 +413,7 @@ pub struct Diagnosis {
     /// refit), each with its rule and reason ([`crate::diagnose::admissible`]).
     pub refused: Vec<RefusedEffect>,
     /// Modes of the final model whose damping the data do not identify: the likelihood is
-    /// flat from the record's floor up ([`crate::diagnose::lsq::profile`]).
+    /// flat from the record's floor up (`lsq::profile`).
     pub dampings_not_identified: Vec<DampingInterval>,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
@@ -429,7 +429,7 @@ pub struct Diagnosis {
     pub final_model: PhysicalModel,
 }
 
-/// A damping the data do not identify ([`crate::diagnose::lsq::profile`]): every `ζ` from
+/// A damping the data do not identify (`lsq::profile`): every `ζ` from
 /// the record's floor to `zeta_upper` is supported (95 % likelihood-ratio interval); the
 /// model carries the interval's log-midpoint.
 #[derive(Debug, Clone, Serialize)]
