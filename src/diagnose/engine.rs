@@ -25,9 +25,8 @@ use crate::diagnose::effects::candidates::sig;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
-use crate::diagnose::lsq::retune::retune_within;
 use crate::diagnose::report::{
-    DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
+    DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
 };
 use crate::diagnose::search::beam::{
     roots, screen_configured, search, SearchResult, SearchSettings,
@@ -36,7 +35,6 @@ use crate::diagnose::search::final_effects::final_effects;
 use crate::diagnose::search::first_level::{ranked_candidates, Root};
 use crate::diagnose::search::holdout::{holdouts, model_of};
 use crate::diagnose::search::node::Node;
-use crate::diagnose::search::polish::settle;
 use crate::diagnose::search::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
@@ -169,8 +167,9 @@ pub fn diagnose_channels(
             s.min_delta_bic,
         )
     })?;
-    let dampings_not_identified =
-        phases.time("final refit", || final_refit(&mut node, base, data))?;
+    let dampings_not_identified = phases.time("final refit", || {
+        crate::diagnose::search::final_refit::final_refit(&mut node, base, data)
+    })?;
     // What the written model has and the input did not: the modes read by an assignment.
     node.model = crate::diagnose::search::assign::align_from(
         &[base, &root_model],
@@ -306,66 +305,6 @@ fn drop_failing_holdout(
     });
     node.effects = keep;
     Ok((holdout, dropped))
-}
-
-/// A last joint refit of the chosen model, kept when it lowers the cost; a damping that
-/// ended on the record's floor profiled ([`crate::diagnose::lsq::profile`]: where the
-/// likelihood is flat the interval's log-midpoint is written and the rest refit with it
-/// held); then the consistency polish ([`crate::diagnose::search::polish`]).  Returns the
-/// dampings not identified.
-fn final_refit(
-    node: &mut Node,
-    base: &PhysicalModel,
-    data: &Channels,
-) -> Result<Vec<DampingInterval>> {
-    use crate::diagnose::lsq::profile::{modes_at_floor, zeta_profile};
-    use crate::diagnose::lsq::retune::retune_holding;
-    use crate::diagnose::lsq::slots::Nl;
-    let refit = retune_within(&node.model, base, data, None, false);
-    if refit.v_after < node.v_fit {
-        node.v_fit = refit.v_after;
-        node.model = refit.model;
-    }
-    let mut flat = Vec::new();
-    for k in modes_at_floor(&node.model, data) {
-        let p = zeta_profile(&node.model, base, data, k);
-        if !p.flat() {
-            continue;
-        }
-        let mut m = node.model.clone();
-        m.mode[k].zeta = p.midpoint();
-        let held: Vec<Nl> = flat
-            .iter()
-            .map(|(k, _): &(usize, _)| Nl::ModeZ(*k))
-            .collect();
-        node.model = retune_holding(&m, base, data, &[held, vec![Nl::ModeZ(k)]].concat()).model;
-        flat.push((k, p));
-    }
-    let model = std::mem::replace(&mut node.model, base.clone());
-    (node.model, node.measures) = settle(model, base, data)?;
-    Ok(flat
-        .into_iter()
-        .map(|(k, p)| {
-            let f = p.omega_n / std::f64::consts::TAU;
-            let z = node.model.mode[k].zeta;
-            DampingInterval {
-                frequency_hz: f,
-                zeta_floor: p.floor,
-                zeta_upper: p.upper,
-                zeta_written: z,
-                profile: p.points.iter().map(|(z, v)| [*z, *v]).collect(),
-                threshold: p.threshold,
-                reason: format!(
-                    "ζ of the mode at {} Hz not identified: the likelihood is flat from the record's floor {} to {} (95 %), set to {} (the log-midpoint); measure denser lines around {} Hz",
-                    sig(f),
-                    sig(p.floor),
-                    sig(p.upper),
-                    sig(z),
-                    sig(f)
-                ),
-            }
-        })
-        .collect())
 }
 
 /// The four best other effect sets of the search, by BIC, with their gap to the chosen one.
