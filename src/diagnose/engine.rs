@@ -25,7 +25,6 @@ use crate::diagnose::effects::candidates::sig;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
-use crate::diagnose::lsq::retune::retune_within;
 use crate::diagnose::report::{
     DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
 };
@@ -36,7 +35,6 @@ use crate::diagnose::search::final_effects::final_effects;
 use crate::diagnose::search::first_level::{ranked_candidates, Root};
 use crate::diagnose::search::holdout::{holdouts, model_of};
 use crate::diagnose::search::node::Node;
-use crate::diagnose::search::polish::settle;
 use crate::diagnose::search::ties::{candidate_ties, set_ties};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
@@ -112,6 +110,7 @@ pub fn diagnose_channels(
             final_effects: vec![],
             retuned_in_chosen: Default::default(),
             refused: vec![],
+            dampings_not_identified: vec![],
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
@@ -168,7 +167,9 @@ pub fn diagnose_channels(
             s.min_delta_bic,
         )
     })?;
-    phases.time("final refit", || final_refit(&mut node, base, data))?;
+    let dampings_not_identified = phases.time("final refit", || {
+        crate::diagnose::search::final_refit::final_refit(&mut node, base, data)
+    })?;
     // What the written model has and the input did not: the modes read by an assignment.
     node.model = crate::diagnose::search::assign::align_from(
         &[base, &root_model],
@@ -205,6 +206,10 @@ pub fn diagnose_channels(
     };
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
         + &unreached_modes(&peaks, &res.peak_modes_hz);
+    for d in &dampings_not_identified {
+        message += "; ";
+        message += &d.reason;
+    }
     if verdict == DiagnoseVerdict::NoEffectFound {
         let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
         let white =
@@ -248,6 +253,7 @@ pub fn diagnose_channels(
                 refusal: r.clone(),
             })
             .collect(),
+        dampings_not_identified,
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
@@ -299,19 +305,6 @@ fn drop_failing_holdout(
     });
     node.effects = keep;
     Ok((holdout, dropped))
-}
-
-/// A last joint refit of the chosen model, kept when it lowers the cost, and its
-/// consistency polish ([`crate::diagnose::search::polish`]).
-fn final_refit(node: &mut Node, base: &PhysicalModel, data: &Channels) -> Result<()> {
-    let refit = retune_within(&node.model, base, data, None, false);
-    if refit.v_after < node.v_fit {
-        node.v_fit = refit.v_after;
-        node.model = refit.model;
-    }
-    let model = std::mem::replace(&mut node.model, base.clone());
-    (node.model, node.measures) = settle(model, base, data)?;
-    Ok(())
 }
 
 /// The four best other effect sets of the search, by BIC, with their gap to the chosen one.

@@ -54,8 +54,8 @@ pub use lsq::measures::Measures as ErrorMeasures;
 pub use lsq::retune::{cost, refit_nominal, retune, retune_within, NominalRefit};
 pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSION_TOL};
 pub use report::{
-    CandidateReport, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout, Peak, PeakFate,
-    PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
+    CandidateReport, DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout,
+    Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
 };
 pub use revision::{params_text, write_revision, Apply, Revise, Revision};
 pub use search::backward::eliminate;

@@ -412,6 +412,9 @@ pub struct Diagnosis {
     /// Effects the likelihood wanted but physical admissibility refused (on their joint
     /// refit), each with its rule and reason ([`crate::diagnose::admissible`]).
     pub refused: Vec<RefusedEffect>,
+    /// Modes of the final model whose damping the data do not identify: the likelihood is
+    /// flat from the record's floor up (`lsq::profile`).
+    pub dampings_not_identified: Vec<DampingInterval>,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
     /// Every peak of the residual that stands out of the noise, with its fate (at most
@@ -424,6 +427,29 @@ pub struct Diagnosis {
     /// The final model (effects added, everything refit jointly).
     #[serde(skip)]
     pub final_model: PhysicalModel,
+}
+
+/// A damping the data do not identify (`lsq::profile`): every `ζ` from
+/// the record's floor to `zeta_upper` is supported (95 % likelihood-ratio interval); the
+/// model carries the interval's log-midpoint.
+#[derive(Debug, Clone, Serialize)]
+pub struct DampingInterval {
+    /// The mode's frequency, Hz.
+    pub frequency_hz: f64,
+    /// The record's floor at the mode (the interval's bottom).
+    pub zeta_floor: f64,
+    /// The interval's top.
+    pub zeta_upper: f64,
+    /// The damping written (the log-midpoint).
+    pub zeta_written: f64,
+    /// The profile: `(ζ, V_p(ζ) − V_p(floor))` at every point profiled, and the rise that
+    /// bounds the interval.
+    pub profile: Vec<[f64; 2]>,
+    /// The rise of `V` that bounds the interval (`½ χ²₁(0.95)`, widened by the residual's
+    /// own level when it exceeds the noise).
+    pub threshold: f64,
+    /// In words.
+    pub reason: String,
 }
 
 /// The retune: its measures and what it moved (`retuned.changes` in the JSON).

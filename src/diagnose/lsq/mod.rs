@@ -12,12 +12,14 @@
 //! * `mode_grid`: the cost as one mode moves (the retune's rough placement);
 //! * `retune`: the joint refit of the configured model's own parameters;
 //! * `resolution`: what the record resolves of a mode's damping (ζ's floor from the lines);
+//! * `profile`: the profile likelihood of a damping at that floor (flat: not identified);
 //! * `whiteness`: is the normalized residual the stated noise (level, Ljung–Box).
 pub(crate) mod channels;
 pub(crate) mod lm;
 pub(crate) mod measures;
 pub(crate) mod mode_grid;
 pub(crate) mod problem;
+pub(crate) mod profile;
 pub(crate) mod resolution;
 pub(crate) mod retune;
 pub(crate) mod shapes;

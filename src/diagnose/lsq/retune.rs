@@ -174,9 +174,33 @@ pub(crate) fn retune_or_give_up(
     rough: bool,
     give_up: Option<f64>,
 ) -> (NominalRefit, bool) {
+    refit_holding(m, anchor, data, mask, rough, give_up, &[])
+}
+
+/// [`retune_within`] on every datum with the nonlinear slots `hold` kept at their values in
+/// `m` (a profile of the likelihood in one parameter, [`super::profile`]).
+pub(crate) fn retune_holding(
+    m: &PhysicalModel,
+    anchor: &PhysicalModel,
+    data: &Channels,
+    hold: &[Nl],
+) -> NominalRefit {
+    refit_holding(m, anchor, data, None, false, None, hold).0
+}
+
+fn refit_holding(
+    m: &PhysicalModel,
+    anchor: &PhysicalModel,
+    data: &Channels,
+    mask: Option<&[usize]>,
+    rough: bool,
+    give_up: Option<f64>,
+    hold: &[Nl],
+) -> (NominalRefit, bool) {
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
     let (lin, mut nl) = slots(m, data);
+    nl.retain(|s| !hold.contains(s));
     // On part of the band (a holdout fit), a mode resonating outside that part is not
     // identified there: its ω_n and ζ keep their values.
     if mask.len() < data.len() && !mask.is_empty() {

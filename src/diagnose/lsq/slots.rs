@@ -24,7 +24,7 @@ pub(crate) enum Lin {
     Feed(usize, usize),
 }
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Nl {
     ModeW(usize),
     ModeZ(usize),
