@@ -208,8 +208,21 @@ pub fn analyze(
         if !r.is_proper() {
             return Err(Error::Invalid(format!("the {label} r is not proper")));
         }
-        let rt = t.times_scalar(&StateSpace::from_tf(r));
-        let h = hinf_norm(&rt).map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?;
+        let constant_r = r.num.degree() == 0 && r.den.degree() == 0;
+        // ‖r·T‖∞ = |r|·‖T‖∞ for a constant r (exact scaling, the proven bound included): no
+        // third Hamiltonian iteration on a large model.
+        let h = if constant_r {
+            let g = r.at_infinity().abs();
+            HinfNorm {
+                gamma: g * t_norm.gamma,
+                omega: t_norm.omega,
+                upper: g * t_norm.upper * (1.0 + f64::EPSILON),
+                iterations: 0,
+            }
+        } else {
+            let rt = t.times_scalar(&StateSpace::from_tf(r));
+            hinf_norm(&rt).map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?
+        };
         let alpha = 1.0 / h.gamma;
         let alpha_lower = 1.0 / h.upper;
         // A grid point where T could not be evaluated (0 in the figure's curve) bounds nothing.
@@ -219,7 +232,6 @@ pub fn analyze(
             .filter(|(i, _)| **i > 0.0)
             .map(|(i, r)| i / r)
             .fold(f64::INFINITY, f64::min);
-        let constant_r = r.num.degree() == 0 && r.den.degree() == 0;
         let b_over_r = (normalized && constant_r).then(|| b_gk / r.at_infinity().abs());
         let (verdict, check) = decide(alpha, alpha_lower, alpha_grid, b_over_r);
         margins.push(MarginRow {
