@@ -167,8 +167,22 @@ pub fn analyze(
     rs: &[(String, TransferFunction)],
     grid: &[f64],
 ) -> Result<(RobustStability, GridCurve)> {
+    analyze_with_stages(f, controller, rs, grid, &|_| ())
+}
+
+/// [`analyze`], telling `stage` what it starts (the poles, each exact H∞ norm): on a model of
+/// hundreds of states each is a dense eigenproblem of seconds to minutes (issue 34).
+pub fn analyze_with_stages(
+    f: &Factorization,
+    controller: &Controller,
+    rs: &[(String, TransferFunction)],
+    grid: &[f64],
+    stage: &dyn Fn(&str),
+) -> Result<(RobustStability, GridCurve)> {
     let k = controller_fits(f, controller)?;
     let t = theorem1_system(f, &k)?;
+    let n = t.states();
+    stage(&format!("closed-loop poles ({n} states)"));
     let poles = eigenvalues(&t.a, "closed-loop poles")?;
     let abscissa = spectral_abscissa(&poles);
     let internally_stable = abscissa < 0.0;
@@ -201,8 +215,20 @@ pub fn analyze(
             curve,
         ));
     }
+    stage(&format!(
+        "||T||_inf, exact (Hamiltonian iteration, {} x {} eigenproblems)",
+        2 * n,
+        2 * n
+    ));
     let t_norm = hinf_norm(&t)?;
-    let b_gk = 1.0 / hinf_norm(&gang_of_four(f, &k)?)?.gamma;
+    let g4 = gang_of_four(f, &k)?;
+    let n4 = g4.states();
+    stage(&format!(
+        "b(G,K), exact (Hamiltonian iteration, {} x {} eigenproblems)",
+        2 * n4,
+        2 * n4
+    ));
+    let b_gk = 1.0 / hinf_norm(&g4)?.gamma;
     let mut margins = Vec::new();
     for ((label, r), rc) in rs.iter().zip(&r_curves) {
         if !r.is_proper() {
@@ -220,6 +246,7 @@ pub fn analyze(
                 iterations: 0,
             }
         } else {
+            stage(&format!("||r T||_inf of the {label} r, exact"));
             let rt = t.times_scalar(&StateSpace::from_tf(r));
             hinf_norm(&rt).map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?
         };
