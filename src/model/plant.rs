@@ -253,7 +253,7 @@ impl PlantSection {
         let (w, res, gain) = ncf
             .reconstruction_residual()
             .map_err(|e| format!("[plant]: {e}"))?;
-        if !(res <= FACTOR_RESIDUAL_MAX) {
+        if res.is_nan() || res > FACTOR_RESIDUAL_MAX {
             return Err(format!(
                 "[plant]: its gain |G| ≈ {gain:.1e} at {w:.3e} rad/s is too far from 1 for normalized coprime factors in double precision (‖M̃G − Ñ‖ = {res:.1e}, needs ≤ {FACTOR_RESIDUAL_MAX:.0e}); rescale the plant (its output or input units) so that its gain is nearer 1"
             ));
