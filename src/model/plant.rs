@@ -244,7 +244,7 @@ impl PlantSection {
     }
 
     /// The standard factorization by the normalized left coprime factors of the plant,
-    /// refused when the factors do not reproduce the plant to [`FACTOR_RESIDUAL_MAX`].
+    /// refused when the factors do not reproduce the plant (`‖M̃G − Ñ‖ ≤ 1e-5`).
     pub fn to_factorization(&self, base: &Path) -> std::result::Result<Factorization, String> {
         let ss = self.state_space(base)?;
         let ncf = NormalizedLcf::new(ss).map_err(|e| format!("[plant]: {e}"))?;
