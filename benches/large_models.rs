@@ -1,23 +1,27 @@
 //! Issue 34 item 9: where the time of a large modal model goes. The model is the issue-21
 //! structure of `benches/support/modes.rs` (`K` lightly damped modes, special factorization
-//! with a diagonal `M̃`), `K` = 25, 50, 100 (200 and 1000 are minutes: see the report of
-//! issue 34), with a static controller `K = 10⁻³`.
+//! with a diagonal `M̃`, 4 states per mode in the loop), with a static controller
+//! `K = 10⁻³` and the constant bound `r = 10⁻³`.
 //!
 //! * `load`: `Config::load` (what `compare` and every command pays first);
 //! * `theorem1_system`: the realization of the loop (`modal_system` = `M̃⁻¹·[Ñ·J  I]`, the
 //!   minimal realizations, the feedback);
 //! * `closed_loop_poles`: that plus the eigenvalues (the internal-stability verdict);
-//! * `stability_run`: `pipeline::stability::run` (poles, the grid, the exact H∞ norms).
+//! * `stability_run`: `pipeline::stability::run` (poles, the grid, the exact H∞ norms);
+//! * `compare_run`: `diagnose::compare` on the model's 200 noisy data (Theorem 4's μ
+//!   envelope, what `compare` and each step of `diagnose` pay).
 //!
-//! Run: `cargo bench --bench large_models -- --sample-count 1`.
+//! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
+//! smallest size of the two long benches runs, as a check that the measurement works).
 //!
-//! Measured 2026-11-27 (2 shared cores, one sample each), K = 25 / 50 / 100 modes:
-//! `load` 0.24 / 0.42 / 1.1 ms; `theorem1_system` 2.2 / 13 / 91 ms; `closed_loop_poles`
-//! 5.3 / 35 / 262 ms; `stability_run` 1.03 s / 10.7 s / 2.36 min. The poles are cheap; the
-//! time is the exact H∞ norms (`‖T‖∞`, `b(G,K)`, `‖r·T‖∞`): a perf profile of 200 modes puts
-//! 60 % in `FreqEvaluator::eval` and 29 % in dense products — the lower-bound candidates of
-//! `hinf_norm` (8 per pole: 3200 responses of a system with one input per mode, each
-//! `O(N²·n)`), not the Hamiltonian eigenvalues.
+//! Measured before issue 34's second session (2 shared cores, loaded, one sample), K = 25 /
+//! 50 / 100: `stability_run` 1.03 s / 10.7 s / 2.36 min, 200 modes > 10 min; a perf profile put
+//! 60 % in `FreqEvaluator::eval` for the 8 starting candidates per pole of `hinf_norm`, and
+//! `compare` at 1000 modes in Theorem 4's dense `(n+1)²` copies per μ evaluation (70 s).
+//! After it (one starting frequency per pole and a 40-point grid, row-wise back
+//! substitution and real GEMMs in the responses, `|r|·‖T‖∞` for a constant `r`, no dense
+//! `M̃⁻¹`, `V`, `F_L` or copy per datum or μ step on a diagonal `M̃`), the same machine and
+//! load: see the table in the session's report (docs/internals-large-models.md).
 
 #[path = "support/modes.rs"]
 #[allow(dead_code)]
@@ -31,6 +35,16 @@ fn main() {
 }
 
 const SIZES: &[usize] = &[25, 50, 100];
+
+/// Sizes of the long benches (`stability_run` at 1000 modes is a dense eigenproblem of
+/// 8000 × 8000 per Hamiltonian iteration: not measured).
+const STABILITY_SIZES: &[usize] = &[25, 50, 100, 200];
+const COMPARE_SIZES: &[usize] = &[50, 100, 200, 1000];
+
+/// Whether this is `cargo bench` (it passes `--bench`), not a `cargo test` check run.
+fn benching() -> bool {
+    std::env::args().any(|a| a == "--bench")
+}
 
 fn inputs(k: usize) -> (Config, Controller, tempfile::TempDir) {
     let dir = tempfile::tempdir().expect("temporary directory");
@@ -64,12 +78,11 @@ fn closed_loop_poles(bencher: Bencher, k: usize) {
     });
 }
 
-#[divan::bench(args = SIZES, sample_count = 1)]
+#[divan::bench(args = STABILITY_SIZES, sample_count = 1)]
 fn stability_run(bencher: Bencher, k: usize) {
-    // `cargo bench` passes `--bench`; `cargo test --all-targets` runs each bench once in a
-    // debug build, where 50 and 100 modes take minutes: there only 25 modes are run (a
-    // check that the measurement works), the larger sizes measure nothing.
-    if k > SIZES[0] && !std::env::args().any(|a| a == "--bench") {
+    // `cargo test --all-targets` runs each bench once in a debug build, where the larger
+    // sizes take minutes: there only the smallest is run, the others measure nothing.
+    if k > STABILITY_SIZES[0] && !benching() {
         bencher.bench(|| ());
         return;
     }
@@ -81,4 +94,18 @@ fn stability_run(bencher: Bencher, k: usize) {
     bencher.bench(|| {
         rshape::pipeline::stability::run(&config, &controller, &r, None).expect("stability")
     });
+}
+
+#[divan::bench(args = COMPARE_SIZES, sample_count = 1)]
+fn compare_run(bencher: Bencher, k: usize) {
+    if k > COMPARE_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, _controller, _dir) = inputs(k);
+    let data =
+        rshape::data::read_frf_csv(config.data.as_deref().expect("data file")).expect("data");
+    let model = rshape::diagnose::PlantModel::from_config(&config);
+    let siso = rshape::diagnose::prepare(&config, &data, None, None).expect("prepare");
+    bencher.bench(|| rshape::diagnose::compare(&config, &model, &siso).expect("compare"));
 }

@@ -96,6 +96,9 @@ fn channels(
     Ok(Channels::from_siso(&siso)?)
 }
 
+/// From this many modes on, `diagnose` announces its long search (200 modes: 15 s).
+const LARGE_MODEL_MODES: usize = 100;
+
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     // 0 was silently taken as 1: say so instead.
@@ -152,7 +155,18 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         allow_mains: a.allow_mains,
         ..Default::default()
     };
+    // A model of hundreds of modes refits two parameters per mode in every candidate of the
+    // search, silent for minutes (issue 34: 1000 modes ran 300 s without a line): say so.
+    let view = (base.mode.len() >= LARGE_MODEL_MODES).then(|| {
+        let v = super::progress::FitProgressView::new("diagnose");
+        v.stage(&format!(
+            "a model of {} modes: the retune of every configured parameter, then the candidate search (each candidate refits them jointly; minutes at this size)",
+            base.mode.len()
+        ));
+        v
+    });
     let d = diagnose_channels(&base, &data, &settings)?;
+    drop(view);
     if let (Some(what), Some(out)) = (a.apply, &a.write) {
         let rev = write_revision(
             &Revise {

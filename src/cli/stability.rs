@@ -79,7 +79,13 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         ));
         v
     });
-    let outcome = stability::run(&config, &controller, &rs, a.bounds.data.as_deref())?;
+    let stage = |what: &str| {
+        if let Some(v) = &view {
+            v.stage(what);
+        }
+    };
+    let outcome =
+        stability::run_with_stages(&config, &controller, &rs, a.bounds.data.as_deref(), &stage)?;
     drop(view);
     let written = match &a.out {
         Some(out) => {

@@ -49,11 +49,32 @@ pub enum MethodArg {
     Hinf,
 }
 
+/// From this many plant states on, `synthesize` announces its stages (a 50-mode structure,
+/// 100 states, takes about 30 s before its first answer).
+const LARGE_PLANT_STATES: usize = 100;
+
 /// Runs `rshape synthesize`.
 pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     crate::synthesis::check_gamma_factor(a.gamma_factor)?;
     let config = Config::load(&a.config)?;
+    // A large model's synthesis is dense linear algebra of O(n³) for minutes, silent while it
+    // runs: say what is going on (issue 34: 200 modes ran minutes without a line).
+    let f = &config.factorization;
+    let states = f
+        .realization
+        .as_ref()
+        .map_or(2 * f.states(), |n| n.plant.states());
+    let view = (states >= LARGE_PLANT_STATES).then(|| {
+        let v = super::progress::FitProgressView::new("synthesize");
+        v.stage(&format!(
+            "normalized coprime factors of a plant with about {states} states (realization, Riccati equation: dense, O(n³))"
+        ));
+        v
+    });
     synthesize::plant_factors(&config, &a.config)?;
+    if let Some(v) = &view {
+        v.stage("the controller, then its Theorem 1 proof (exact H∞ norms of the loop)");
+    }
     let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     let inputs: Vec<&Path> = std::iter::once(a.config.as_path())
         .chain(a.bounds.files())
@@ -84,6 +105,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         synthesize::run(&config, &a.config, rs, &settings, data, &controller_path)
     };
     let dry = prove(&rs)?;
+    drop(view);
     // Without --fit the run above is the outcome; with it, r is fitted in memory and the
     // proof repeated with the fitted r added, all before anything is written (a refusal,
     // e.g. --reduce on an unstable H∞ controller, leaves no r.json behind).

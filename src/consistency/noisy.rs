@@ -13,7 +13,10 @@ use super::envelope::{check_sizes, Envelope, EnvelopeMethod};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::{Factorization, FactorsAt};
-use crate::mu::{mu_full_scalar_low_rank, FullPlusScalar, LowRank, MuSettings, MuStatus};
+use crate::mu::{
+    mu_full_scalar_low_rank, mu_full_scalar_structured, FullPlusScalar, LowRank, MuSettings,
+    MuStatus,
+};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
@@ -48,9 +51,25 @@ impl NoisyFailure {
 /// Relative threshold under which `|φ − V₂₂|` counts as zero (A7), as for A5 in Theorem 3.
 const A7_RTOL: f64 = 1e-13;
 
+/// `M̃⁻¹(jω)`: dense, or its diagonal when `M̃` is diagonal (a `[physical]` model, one row
+/// per mode: no `n × n` matrix per datum).
+enum Minv {
+    Dense(DMatrix<Complex64>),
+    Diagonal(Vec<Complex64>),
+}
+
+impl Minv {
+    fn size(&self) -> usize {
+        match self {
+            Self::Dense(m) => m.nrows(),
+            Self::Diagonal(d) => d.len(),
+        }
+    }
+}
+
 /// The pieces of `V` that do not depend on `r` or `L_a`.
 struct Parts {
-    minv: DMatrix<Complex64>,
+    minv: Minv,
     minv_nj: DMatrix<Complex64>,
     c_minv: DMatrix<Complex64>,
     v22: Complex64,
@@ -66,19 +85,44 @@ fn parts(at: &FactorsAt) -> std::result::Result<Parts, NoisyFailure> {
     if !(j.norm() > 0.0 && j.is_finite()) {
         return Err(NoisyFailure::JSingular);
     }
-    let mut rhs = DMatrix::zeros(n, n + 1);
-    rhs.view_mut((0, 0), (n, 1)).copy_from(&(&at.n * j));
-    rhs.view_mut((0, 1), (n, n)).fill_with_identity();
     if at.m_singular() {
         return Err(NoisyFailure::MSingular);
     }
+    if crate::system::linalg::diagonal_fast_path(&at.m) {
+        // The same divisions as `m_solve`'s diagonal path, without the identity columns.
+        let mut minv = Vec::with_capacity(n);
+        let mut minv_nj = DMatrix::zeros(n, 1);
+        let mut c_minv = DMatrix::zeros(1, n);
+        let one = Complex64::new(1.0, 0.0);
+        for i in 0..n {
+            let d = at.m[(i, i)];
+            if d == Complex64::default() {
+                return Err(NoisyFailure::MSingular);
+            }
+            let inv = one / d;
+            minv.push(inv);
+            minv_nj[(i, 0)] = (at.n[(i, 0)] * j) / d;
+            c_minv[(0, i)] = at.c[(0, i)] * inv;
+        }
+        let v22 = (&at.c * &minv_nj)[(0, 0)];
+        return Ok(Parts {
+            minv: Minv::Diagonal(minv),
+            minv_nj,
+            c_minv,
+            v22,
+            j,
+        });
+    }
+    let mut rhs = DMatrix::zeros(n, n + 1);
+    rhs.view_mut((0, 0), (n, 1)).copy_from(&(&at.n * j));
+    rhs.view_mut((0, 1), (n, n)).fill_with_identity();
     let sol = at.m_solve(&rhs).ok_or(NoisyFailure::MSingular)?;
     let minv_nj = sol.columns(0, 1).into_owned();
     let minv = sol.columns(1, n).into_owned();
     let c_minv = &at.c * &minv;
     let v22 = (&at.c * &minv_nj)[(0, 0)];
     Ok(Parts {
-        minv,
+        minv: Minv::Dense(minv),
         minv_nj,
         c_minv,
         v22,
@@ -99,9 +143,16 @@ pub fn v_matrix(
 
 /// [`v_matrix`] from its `r`-free [`Parts`].
 fn v_of_parts(p: &Parts, r: Complex64, la: f64) -> DMatrix<Complex64> {
-    let n = p.minv.nrows();
+    let n = p.minv.size();
     let mut v = DMatrix::zeros(n + 3, n + 2);
-    v.view_mut((1, 0), (n, n)).copy_from(&(&p.minv * r));
+    match &p.minv {
+        Minv::Dense(m) => v.view_mut((1, 0), (n, n)).copy_from(&(m * r)),
+        Minv::Diagonal(d) => {
+            for (i, di) in d.iter().enumerate() {
+                v[(1 + i, i)] = di * r;
+            }
+        }
+    }
     v[(0, n + 1)] = r * p.j;
     v.view_mut((1, n + 1), (n, 1)).copy_from(&(&p.minv_nj * r));
     v[(n + 1, n + 1)] = Complex64::new(1.0, 0.0);
@@ -118,18 +169,23 @@ pub fn lower_lft(
     phi: Complex64,
 ) -> std::result::Result<DMatrix<Complex64>, NoisyFailure> {
     let (rows, cols) = (v.nrows() - 1, v.ncols() - 1);
-    if !(phi.norm() > 0.0 && phi.is_finite()) {
-        return Err(NoisyFailure::A6);
-    }
-    let v22 = v[(rows, cols)];
-    let k = phi - v22;
-    if k.norm().is_nan() || k.norm() <= A7_RTOL * phi.norm().max(v22.norm()) {
-        return Err(NoisyFailure::A7);
-    }
+    let k = lft_denominator(phi, v[(rows, cols)])?;
     let v11 = v.view((0, 0), (rows, cols));
     let v12 = v.view((0, cols), (rows, 1));
     let v21 = v.view((rows, 0), (1, cols));
     Ok(v11 + (v12 * v21) / k)
+}
+
+/// `φ − V₂₂`, after A6 (`φ ≠ 0`) and A7 (`φ − V₂₂ ≠ 0`).
+fn lft_denominator(phi: Complex64, v22: Complex64) -> std::result::Result<Complex64, NoisyFailure> {
+    if !(phi.norm() > 0.0 && phi.is_finite()) {
+        return Err(NoisyFailure::A6);
+    }
+    let k = phi - v22;
+    if k.norm().is_nan() || k.norm() <= A7_RTOL * phi.norm().max(v22.norm()) {
+        return Err(NoisyFailure::A7);
+    }
+    Ok(k)
 }
 
 /// `F_L[V(jω), φ⁻¹]` at `r` and `L_a` (eqs. (14)–(15)): the matrix whose `μ_Γ` decides
@@ -211,11 +267,11 @@ fn status_rank(s: MuStatus) -> u8 {
 /// `F_L(V(1), φ⁻¹) = E + a·bᴴ` when `M̃(jω)` is diagonal (a `[physical]` model, one row per
 /// mode): `E = V₁₁ = [0; M̃⁻¹ 0; 0]` has one entry per mode, `a = V₁₂`,
 /// `bᴴ = V₂₁/(φ − V₂₂)` (eqs. (14)–(15)).  `None` for a full `M̃`.
-fn low_rank(at: &FactorsAt, p: &Parts, phi: Complex64, la: f64) -> Option<LowRank> {
-    if !crate::system::linalg::diagonal_fast_path(&at.m) {
+fn low_rank(p: &Parts, phi: Complex64, la: f64) -> Option<LowRank> {
+    let Minv::Diagonal(minv) = &p.minv else {
         return None;
-    }
-    let n = at.m.nrows();
+    };
+    let n = minv.len();
     let k = phi - p.v22;
     let mut a = nalgebra::DVector::zeros(n + 2);
     a[0] = p.j;
@@ -227,7 +283,7 @@ fn low_rank(at: &FactorsAt, p: &Parts, phi: Complex64, la: f64) -> Option<LowRan
     }
     b[n] = Complex64::new(la, 0.0) / k.conj();
     Some(LowRank {
-        entries: (0..n).map(|i| (i + 1, i, p.minv[(i, i)])).collect(),
+        entries: (0..n).map(|i| (i + 1, i, minv[i])).collect(),
         a,
         b,
     })
@@ -255,11 +311,22 @@ pub fn r_min_noisy(
 ) -> std::result::Result<NoisyDatum, NoisyFailure> {
     // The parts serve both M(1) and its low-rank description: one solve with M̃ per datum.
     let p = parts(at)?;
-    let m1 = lower_lft(&v_of_parts(&p, Complex64::new(1.0, 0.0), la), phi)?;
+    let k = lft_denominator(phi, p.v22)?;
+    // M(1) = F_L(V(1), φ⁻¹) is formed only when a step needs it: never on the O(n) path of
+    // a diagonal M̃, whose description `E + a·bᴴ` comes from the same parts (issue 34: the
+    // O(n²) copies per datum and per μ made Theorem 4 on 1000 modes take half a minute).
+    let m1_cell = std::cell::OnceCell::new();
+    let m1 = || {
+        m1_cell.get_or_init(|| {
+            lower_lft(&v_of_parts(&p, Complex64::new(1.0, 0.0), la), phi)
+                .expect("A6 and A7 were checked")
+        })
+    };
     let n = at.m.nrows();
     let a1 = at.a1_limit();
     let s = FullPlusScalar::gamma(n);
-    let mu0 = m1[(n + 1, n)].norm();
+    // M(1)'s entry (n+1, n) is V₁₂[n+1]·V₂₁[n]/(φ − V₂₂) = 1·L_a/(φ − V₂₂).
+    let mu0 = (Complex64::new(la, 0.0) / k).norm();
     let mut out = NoisyDatum {
         r_min: 0.0,
         a1_limit: a1,
@@ -274,28 +341,36 @@ pub fn r_min_noisy(
     if mu0 > 1.0 {
         return Ok(out);
     }
-    let mut scaled = m1.clone();
     let mut hint: Option<f64> = None;
-    let structure = low_rank(at, &p, phi, la);
+    let structure = low_rank(&p, phi, la).filter(|lr| lr.fits(s.rows, s.cols));
     let mut lr = structure.clone();
-    // μ(ρ) and d ln μ/d ln ρ.
-    let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
+    // M(ρ) = diag(ρ·I_{n+1}, 1)·M(1).
+    let dense_at = |rho: f64| {
+        let m1 = m1();
+        let mut scaled = m1.clone();
         for i in 0..=n {
             for j in 0..=n {
                 scaled[(i, j)] = m1[(i, j)] * rho;
             }
         }
-        // The rows feeding Δ̃ scale with ρ: E and a₀..aₙ.
-        if let (Some(base), Some(lr)) = (&structure, &mut lr) {
-            for (e, e0) in lr.entries.iter_mut().zip(&base.entries) {
-                e.2 = e0.2 * rho;
+        scaled
+    };
+    // μ(ρ) and d ln μ/d ln ρ.
+    let mut mu_of = |rho: f64, out: &mut NoisyDatum| -> (f64, f64) {
+        let b = match (&structure, &mut lr) {
+            (Some(base), Some(lr)) => {
+                // The rows feeding Δ̃ scale with ρ: E and a₀..aₙ.
+                for (e, e0) in lr.entries.iter_mut().zip(&base.entries) {
+                    e.2 = e0.2 * rho;
+                }
+                for i in 0..=n {
+                    lr.a[i] = base.a[i] * rho;
+                }
+                mu_full_scalar_structured(lr, &|| dense_at(rho), s, &settings.mu, hint)
             }
-            for i in 0..=n {
-                lr.a[i] = base.a[i] * rho;
-            }
+            _ => mu_full_scalar_low_rank(&dense_at(rho), s, &settings.mu, hint, None),
         }
-        let b = mu_full_scalar_low_rank(&scaled, s, &settings.mu, hint, lr.as_ref())
-            .expect("shape of F_L matches Γ");
+        .expect("shape of F_L matches Γ");
         out.mu_evaluations += 1;
         out.decompositions += b.evaluations;
         out.worst_mu_gap = out.worst_mu_gap.max(b.rel_gap);

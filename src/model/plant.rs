@@ -243,10 +243,27 @@ impl PlantSection {
         }
     }
 
-    /// The standard factorization by the normalized left coprime factors of the plant.
+    /// The standard factorization by the normalized left coprime factors of the plant,
+    /// refused when the factors do not reproduce the plant (`‖M̃G − Ñ‖ ≤ 1e-5`).
     pub fn to_factorization(&self, base: &Path) -> std::result::Result<Factorization, String> {
         let ss = self.state_space(base)?;
         let ncf = NormalizedLcf::new(ss).map_err(|e| format!("[plant]: {e}"))?;
+        // The factors checked against the plant itself: a gain far from 1 leaves M̃ ≈ 1/G
+        // without a correct digit, and every later answer wrong or a puzzling failure.
+        let (w, res, gain) = ncf
+            .reconstruction_residual()
+            .map_err(|e| format!("[plant]: {e}"))?;
+        if res.is_nan() || res > FACTOR_RESIDUAL_MAX {
+            return Err(format!(
+                "[plant]: its gain |G| ≈ {gain:.1e} at {w:.3e} rad/s is too far from 1 for normalized coprime factors in double precision (‖M̃G − Ñ‖ = {res:.1e}, needs ≤ {FACTOR_RESIDUAL_MAX:.0e}); rescale the plant (its output or input units) so that its gain is nearer 1"
+            ));
+        }
         Ok(Factorization::normalized(ncf))
     }
 }
+
+/// Largest reconstruction residual `‖M̃G − Ñ‖` of a plant's normalized factors
+/// ([`NormalizedLcf::reconstruction_residual`]) accepted: five correct digits, which the
+/// residual `≈ ε·|G|` keeps for plant gains up to about 1e10–1e11 (`1e10/(s(s+1))`: 2.2e-6;
+/// `1e12/(s(s+1))`: 9.3e-5, its A1 limit already off in the fifth digit).
+pub const FACTOR_RESIDUAL_MAX: f64 = 1e-5;

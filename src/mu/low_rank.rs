@@ -49,7 +49,7 @@ struct Gram {
 
 impl LowRank {
     /// Checks the shape and that `E` has at most one nonzero per row and column.
-    pub(super) fn fits(&self, q: usize, k: usize) -> bool {
+    pub fn fits(&self, q: usize, k: usize) -> bool {
         let mut rows = vec![false; k];
         let mut cols = vec![false; q];
         self.a.len() == k + 1
@@ -67,7 +67,7 @@ impl LowRank {
     /// True when `m` equals `E + a·bᴴ` entry by entry to rounding (relative to the size of
     /// the terms, in the 1-norm of ℂ = ℝ², which needs no square roots), so that the
     /// structured evaluation describes the matrix of the search.
-    pub(super) fn matches(&self, m: &nalgebra::DMatrix<Complex64>) -> bool {
+    pub fn matches(&self, m: &nalgebra::DMatrix<Complex64>) -> bool {
         let l1 = |z: Complex64| z.re.abs() + z.im.abs();
         let mut e_of_col = vec![None; m.ncols()];
         for &(i, j, v) in &self.entries {

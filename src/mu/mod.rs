@@ -38,7 +38,7 @@ pub use two_scalar::mu_two_scalar;
 use crate::error::{Error, Result};
 use nalgebra::{DMatrix, DVector, SVD};
 use num_complex::Complex64;
-use search::{newton_search, Search};
+use search::{newton_search, Dense, Search};
 
 /// Block sizes of the structure `Γ = {diag(Δ̃, w̃)}` (eq. (16)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -246,33 +246,60 @@ pub fn mu_full_scalar_low_rank(
     let (q, k) = (s.rows, s.cols);
     let n12 = m.view((0, q), (k, 1)).norm();
     let n21 = m.view((k, 0), (1, q)).norm();
-    let mut search = Search {
-        m,
-        q,
-        k,
-        settings,
-        evals: 0,
-        upper: f64::INFINITY,
-        t_upper: f64::NAN,
-        share_upper: f64::NAN,
-        lower: 0.0,
-        witness: None,
-        svd_failed: false,
-        low_rank,
-    };
+    let search = Search::new(Dense::given(m), q, k, settings, low_rank);
+    Ok(run_search(search, n12, n21, log_d_hint).bounds(s))
+}
+
+/// As [`mu_full_scalar_low_rank`] for a caller that built `M = E + a·bᴴ` and its
+/// [`LowRank`] description from the same parts and checked them against each other once
+/// ([`LowRank::matches`] on an unscaled copy): the dense `M` is not formed (the O(n²) copy
+/// per evaluation that made Theorem 4 on a 1000-mode model take half a minute, issue 34)
+/// unless a step falls back to the dense eigenproblem, where `dense` builds it. The lower
+/// bound is evaluated through `low_rank` (`M·x` in O(n)), which describes `M` exactly.
+/// A description that does not fit the structure sends the whole computation to the dense
+/// path.
+pub fn mu_full_scalar_structured(
+    low_rank: &LowRank,
+    dense: &dyn Fn() -> DMatrix<Complex64>,
+    s: FullPlusScalar,
+    settings: &MuSettings,
+    log_d_hint: Option<f64>,
+) -> Result<MuBounds> {
+    let (q, k) = (s.rows, s.cols);
+    if q == 0 || k == 0 || !low_rank.fits(q, k) {
+        return mu_full_scalar_low_rank(&dense(), s, settings, log_d_hint, None);
+    }
+    let finite = |v: &Complex64| v.is_finite();
+    let (amax, bmax) = (low_rank.a.camax(), low_rank.b.camax());
+    if !(low_rank.a.iter().all(finite)
+        && low_rank.b.iter().all(finite)
+        && low_rank.entries.iter().all(|e| e.2.is_finite())
+        && (amax * bmax).is_finite())
+    {
+        return Ok(Outcome::non_finite().bounds(s));
+    }
+    // Column q of M is a·conj(b_q) (E has no entry there), row k is a_k·bᴴ (nor there).
+    let n12 = low_rank.a.rows(0, k).norm() * low_rank.b[q].norm();
+    let n21 = low_rank.a[k].norm() * low_rank.b.rows(0, q).norm();
+    let search = Search::new(Dense::lazy(dense), q, k, settings, Some(low_rank));
+    Ok(run_search(search, n12, n21, log_d_hint).bounds(s))
+}
+
+/// The search of [`mu_full_scalar_low_rank`] once `‖M₁₂‖` and `‖M₂₁‖` are known.
+fn run_search(mut search: Search<'_>, n12: f64, n21: f64, log_d_hint: Option<f64>) -> Outcome {
+    let q = search.q;
     // |M₂₂| with witness e_last (Δ̃ = 0).
     let mut e_last = DVector::zeros(q + 1);
     e_last[q] = Complex64::new(1.0, 0.0);
     search.offer(e_last);
-    let outcome = if n12 == 0.0 || n21 == 0.0 {
+    if n12 == 0.0 || n21 == 0.0 {
         block_triangular(&mut search, n12)
     } else {
         let t0 = log_d_hint
             .filter(|t| t.is_finite())
             .unwrap_or(0.5 * (n12 / n21).ln());
         scaled_search(&mut search, t0)
-    };
-    Ok(outcome.bounds(s))
+    }
 }
 
 /// The sizes of `M` against the structure `diag(Δ̃ q×k, w̃)`.
@@ -342,7 +369,7 @@ impl Outcome {
 
 /// `σ̄(M₁₁)`, offering its top right singular vector (padded with a zero) as a witness.
 fn sigma11(search: &mut Search) -> Option<f64> {
-    let (m, q, k) = (search.m, search.q, search.k);
+    let (m, q, k) = (search.m.get(), search.q, search.k);
     let m11 = m.view((0, 0), (k, q)).into_owned();
     let svd = SVD::try_new_unordered(
         m11,
@@ -371,7 +398,7 @@ fn sigma11(search: &mut Search) -> Option<f64> {
 /// `M₁₂ = 0` or `M₂₁ = 0`: block triangular, `det(I − MΔ_s) = det(I − M₁₁Δ̃)·(1 − M₂₂w̃)`,
 /// so `μ = max(σ̄(M₁₁), |M₂₂|)` exactly, at `d → 0` or `d → ∞`.
 fn block_triangular(search: &mut Search, n12: f64) -> Outcome {
-    let m22 = search.m[(search.k, search.q)].norm();
+    let m22 = search.m.get()[(search.k, search.q)].norm();
     let Some(s11) = sigma11(search) else {
         return Outcome {
             upper: f64::NAN,

@@ -13,8 +13,43 @@ pub(super) struct Eval {
     pub(super) curv: f64,
 }
 
+/// The matrix `M` of a search: given, or built on first use from a structured description
+/// (a search that stays on the O(n) low-rank path never forms the dense `(n+2)×(n+1)` matrix).
+pub(super) struct Dense<'a> {
+    given: Option<&'a DMatrix<Complex64>>,
+    make: Option<&'a dyn Fn() -> DMatrix<Complex64>>,
+    built: std::cell::OnceCell<DMatrix<Complex64>>,
+}
+
+impl<'a> Dense<'a> {
+    pub(super) fn given(m: &'a DMatrix<Complex64>) -> Self {
+        Self {
+            given: Some(m),
+            make: None,
+            built: std::cell::OnceCell::new(),
+        }
+    }
+
+    pub(super) fn lazy(make: &'a dyn Fn() -> DMatrix<Complex64>) -> Self {
+        Self {
+            given: None,
+            make: Some(make),
+            built: std::cell::OnceCell::new(),
+        }
+    }
+
+    /// `M` itself (built now if it was not given).
+    pub(super) fn get(&self) -> &DMatrix<Complex64> {
+        match (self.given, self.make) {
+            (Some(m), _) => m,
+            (None, Some(make)) => self.built.get_or_init(make),
+            (None, None) => unreachable!("a Dense is built given or lazy"),
+        }
+    }
+}
+
 pub(super) struct Search<'a> {
-    pub(super) m: &'a DMatrix<Complex64>,
+    pub(super) m: Dense<'a>,
     pub(super) q: usize,
     pub(super) k: usize,
     pub(super) settings: &'a MuSettings,
@@ -30,10 +65,33 @@ pub(super) struct Search<'a> {
     pub(super) low_rank: Option<&'a super::LowRank>,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    pub(super) fn new(
+        m: Dense<'a>,
+        q: usize,
+        k: usize,
+        settings: &'a MuSettings,
+        low_rank: Option<&'a super::LowRank>,
+    ) -> Self {
+        Self {
+            m,
+            q,
+            k,
+            settings,
+            evals: 0,
+            upper: f64::INFINITY,
+            t_upper: f64::NAN,
+            share_upper: f64::NAN,
+            lower: 0.0,
+            witness: None,
+            svd_failed: false,
+            low_rank,
+        }
+    }
+
     pub(super) fn scaled(&self, t: f64) -> DMatrix<Complex64> {
         let (d, (q, k)) = (t.exp(), (self.q, self.k));
-        let mut md = self.m.clone();
+        let mut md = self.m.get().clone();
         for j in 0..q {
             md[(k, j)] *= d;
         }
@@ -63,7 +121,7 @@ impl Search<'_> {
         // With a low-rank description (checked against `m` to rounding) the product is O(n).
         let z = match self.low_rank {
             Some(lr) => lr.times(&x),
-            None => self.m * &x,
+            None => self.m.get() * &x,
         };
         let lb = lower_of(&x, &z, self.q, self.k);
         if lb > self.lower {
@@ -179,7 +237,7 @@ impl Search<'_> {
             x
         };
         let diff = |x: &DVector<Complex64>| {
-            let z = self.m * x;
+            let z = self.m.get() * x;
             z.rows(0, self.k).norm() / x.rows(0, q).norm() - z[self.k].norm() / x[q].norm()
         };
         let (mut lo, mut hi) = (-0.1, 0.1);

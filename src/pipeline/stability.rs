@@ -8,7 +8,7 @@ use crate::model::controller::Controller;
 use crate::model::{Config, FactorizationKind};
 use crate::plot::stability::{stability_svg, StabilityInput};
 use crate::report::fmt::fmt_g;
-use crate::stability::{analyze, GridCurve, RobustStability, Verdict};
+use crate::stability::{analyze_with_stages, GridCurve, RobustStability, Verdict};
 use crate::system::{logspace, TransferFunction};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -124,9 +124,20 @@ pub fn run(
     rs: &[(String, TransferFunction)],
     data: Option<&Path>,
 ) -> Result<StabilityOutcome> {
+    run_with_stages(config, controller, rs, data, &|_| ())
+}
+
+/// [`run`], telling `stage` what it starts (see [`analyze_with_stages`]).
+pub fn run_with_stages(
+    config: &Config,
+    controller: &Controller,
+    rs: &[(String, TransferFunction)],
+    data: Option<&Path>,
+    stage: &dyn Fn(&str),
+) -> Result<StabilityOutcome> {
     let poles = check_controller(config, controller)?;
     let g = grid(config, data, &poles);
-    let (report, curve) = analyze(&config.factorization, controller, rs, &g)?;
+    let (report, curve) = analyze_with_stages(&config.factorization, controller, rs, &g, stage)?;
     let robust = report.internally_stable && report.margins.iter().all(|m| m.robust);
     Ok(StabilityOutcome {
         report,

@@ -29,6 +29,6 @@ pub(crate) mod theorem1;
 
 pub use factor_loop::{gang_of_four, modal_system, plant_system, t_sigma_max, theorem1_system};
 pub use theorem1::{
-    analyze, closed_loop_poles, controller_fits, decide, GridCurve, MarginRow, RobustStability,
-    Verdict, CROSS_CHECK_RTOL,
+    analyze, analyze_with_stages, closed_loop_poles, controller_fits, decide, GridCurve, MarginRow,
+    RobustStability, Verdict, CROSS_CHECK_RTOL,
 };

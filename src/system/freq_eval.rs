@@ -100,23 +100,35 @@ impl FreqEvaluator {
                 }
             }
         }
+        // Back substitution row by row: each step is an axpy over a contiguous row of `x`
+        // (the same operations in the same order per entry as a column-wise sweep).
         for i in (0..n).rev() {
             let piv = m[i * n + i];
             if piv.norm() <= f64::EPSILON * scale * 1e-3 {
                 return None;
             }
             let row = &m[i * n + i + 1..i * n + n];
-            for j in 0..k {
-                let mut acc = x[i * k + j];
-                for (off, a) in row.iter().enumerate() {
-                    acc -= a * x[(i + 1 + off) * k + j];
+            let (head, tail) = x.split_at_mut((i + 1) * k);
+            let xi = &mut head[i * k..];
+            for (off, a) in row.iter().enumerate() {
+                if *a == Complex64::default() {
+                    continue;
                 }
-                x[i * k + j] = acc / piv;
+                for (d, v) in xi.iter_mut().zip(&tail[off * k..(off + 1) * k]) {
+                    *d -= a * v;
+                }
+            }
+            for d in xi.iter_mut() {
+                *d /= piv;
             }
         }
-        let x = DMatrix::from_row_slice(n, k, &x);
-        let cq = self.cq.map(|v| Complex64::new(v, 0.0));
-        y += cq * x;
+        // `C·Q` is real: two real products (optimized GEMM) instead of a complex one.
+        let re = DMatrix::from_fn(n, k, |i, j| x[i * k + j].re);
+        let im = DMatrix::from_fn(n, k, |i, j| x[i * k + j].im);
+        let (yr, yi) = (&self.cq * re, &self.cq * im);
+        for ((v, r), i) in y.iter_mut().zip(yr.iter()).zip(yi.iter()) {
+            *v += Complex64::new(*r, *i);
+        }
         y.iter().all(|v| v.is_finite()).then_some(y)
     }
 

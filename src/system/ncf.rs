@@ -185,6 +185,53 @@ impl NormalizedLcf {
         })
     }
 
+    /// The worst reconstruction residual `‖M̃(jω)·G(jω) − Ñ(jω)‖` over the frequencies of
+    /// the plant's poles (their moduli, and 1 rad/s when none is nonzero), with `G(jω)`
+    /// evaluated from the plant itself — a route independent of the factors' realization.
+    /// Returns `(ω, residual, σ_max(G(jω)))` at the worst frequency.
+    ///
+    /// `[Ñ M̃]` is co-inner (norm 1), so the residual is an absolute error of the factors; it
+    /// grows like `ε·|G|`: a plant gain of 1e15 leaves `M̃ ≈ 1/G` with no correct digit
+    /// (`1e150/(s(s+1))` failed later with "frequency response not finite", issue 34).
+    pub fn reconstruction_residual(&self) -> Result<(f64, f64, f64)> {
+        let poles = super::eig::eigenvalues(&self.plant.a, "plant poles")?;
+        let mut ws: Vec<f64> = poles
+            .iter()
+            .filter(|z| z.im >= 0.0)
+            .map(|z| z.norm())
+            .filter(|w| *w > 0.0 && w.is_finite())
+            .collect();
+        ws.sort_by(f64::total_cmp);
+        ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+        if ws.len() > 64 {
+            // A large model: every 1 in k, the extremes kept (the check costs O(n²) each).
+            let step = ws.len().div_ceil(64);
+            let last = *ws.last().expect("non-empty");
+            ws = ws.into_iter().step_by(step).chain([last]).collect();
+        }
+        if ws.is_empty() {
+            ws.push(1.0);
+        }
+        let plant = FreqEvaluator::new(&self.plant);
+        let mut worst = (ws[0], 0.0, 0.0);
+        for w in ws {
+            let Some(g) = plant.freq(w) else {
+                // A pole on the axis (an integrator's is at 0, not tested): the plant has no
+                // value there; the factors are tested elsewhere.
+                continue;
+            };
+            // Factors that cannot be evaluated where the plant can are as wrong as can be.
+            let res = self.at(w).map_or(f64::INFINITY, |(mt, nt)| {
+                super::linalg::spectral_norm(&(&mt * &g - &nt))
+            });
+            let gain = super::linalg::spectral_norm(&g);
+            if res.is_nan() || res > worst.1 {
+                worst = (w, if res.is_nan() { f64::INFINITY } else { res }, gain);
+            }
+        }
+        Ok(worst)
+    }
+
     /// Outputs `p` and inputs `m` of the plant.
     pub fn shape(&self) -> (usize, usize) {
         self.plant.d.shape()

@@ -553,3 +553,56 @@ fn normalized_factors_of_a_large_gain_keep_their_slow_pole() {
         }
     }
 }
+
+/// The integrator plant `1e150/(s(s+1))` failed deep inside each command with a true but
+/// unhelpful reason ("frequency response not finite", "M̃(jω) is singular", "L is singular:
+/// raise the γ factor"): its normalized factors have no correct digit (`M̃ ≈ 1/G`). The
+/// factors are now checked against the plant when the config is read (`‖M̃G − Ñ‖`, an
+/// independent evaluation of `G`); every command refuses with one line that says what to
+/// do, writes nothing, and a gain of 1e8 (residual ≈ 1e-8) still works. The residual grows
+/// like ε·|G| (checked here at 1e12 and 1e15, refused too).
+#[test]
+fn huge_gain_plant_is_refused_with_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = repo("configs/plant_first.csv");
+    std::fs::copy(&data, dir.path().join("plant_first.csv")).unwrap();
+    let k = write(
+        dir.path(),
+        "k.toml",
+        "[controller]\ntf = [[{ num = [2, 1], den = [1, 4] }]]\n",
+    );
+    let cfg_of = |gain: &str| {
+        write(
+            dir.path(),
+            &format!("g{gain}.toml"),
+            &format!(
+                "data = \"plant_first.csv\"\n[plant]\ntf = [[{{ num = [{gain}], den = [1, 1, 0] }}]]\n[r]\nnum = [0.3, 0.01]\nden = [1, 1]\n"
+            ),
+        )
+    };
+    for gain in ["1e150", "1e15", "1e12"] {
+        let cfg = cfg_of(gain);
+        let out = dir.path().join(format!("out{gain}"));
+        let out_s = out.to_str().unwrap();
+        for args in [
+            vec!["check", cfg.as_str()],
+            vec!["stability", cfg.as_str(), "--controller", k.as_str()],
+            vec!["synthesize", cfg.as_str(), "--out", out_s],
+            vec!["compare", cfg.as_str()],
+            vec!["run", cfg.as_str(), "--out", out_s],
+        ] {
+            let o = rshape(&args);
+            assert_one_line_error(&o, &["[plant]", "too far from 1", "rescale the plant"]);
+            assert!(!out.exists(), "{args:?} left {}", out.display());
+        }
+    }
+    // 1e8: the factors reproduce the plant; the loop is judged (closed form: the loop
+    // s³ + 5s² + (4 + 2g)s + g is stable for every g > 0 by Routh).
+    let o = rshape(&["stability", &cfg_of("1e8"), "--controller", &k]);
+    let text = stdout(&o);
+    assert!(
+        text.contains("internally stable: 3 closed-loop poles"),
+        "{text}{}",
+        stderr(&o)
+    );
+}

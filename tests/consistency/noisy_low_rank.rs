@@ -9,7 +9,10 @@ use nalgebra::DMatrix;
 use num_complex::Complex64;
 use rshape::consistency::{gamma_lft, r_min_noisy, BisectionSettings};
 use rshape::model::FactorsAt;
-use rshape::mu::{mu_full_scalar, mu_full_scalar_low_rank, FullPlusScalar, LowRank, MuSettings};
+use rshape::mu::{
+    mu_full_scalar, mu_full_scalar_low_rank, mu_full_scalar_structured, FullPlusScalar, LowRank,
+    MuSettings,
+};
 
 struct Rng(u64);
 impl Rng {
@@ -106,6 +109,7 @@ fn structured_noisy_envelope_matches_the_dense_route() {
 #[test]
 fn low_rank_mu_matches_dense_and_ignores_a_wrong_description() {
     let mut rng = Rng(7);
+    let mut lazy_dense_free = 0;
     for n in [8usize, 20, 50] {
         for _ in 0..5 {
             let (q, k) = (n, n + 1);
@@ -126,10 +130,32 @@ fn low_rank_mu_matches_dense_and_ignores_a_wrong_description() {
             assert!((fast.upper - dense.upper).abs() <= 1e-9 * dense.upper);
             assert!(fast.lower <= dense.upper * (1.0 + 1e-12));
             assert!(fast.rel_gap <= 1e-9, "gap {}", fast.rel_gap);
+            // Without the dense matrix (issue 34): the same bounds, and the dense M built
+            // at most once, only where a step falls back to the dense eigenproblem.
+            let built = std::cell::Cell::new(0);
+            let make = || {
+                built.set(built.get() + 1);
+                m.clone()
+            };
+            let lazy = mu_full_scalar_structured(&lr, &make, s, &set, None).unwrap();
+            assert!(
+                (lazy.upper - dense.upper).abs() <= 1e-9 * dense.upper,
+                "structured {} vs dense {}",
+                lazy.upper,
+                dense.upper
+            );
+            assert!(lazy.lower <= dense.upper * (1.0 + 1e-12));
+            assert!(lazy.rel_gap <= 1e-9, "gap {}", lazy.rel_gap);
+            assert!(built.get() <= 1, "dense M built {} times", built.get());
+            lazy_dense_free += usize::from(built.get() == 0);
             let mut wrong = lr.clone();
             wrong.a[0] += Complex64::new(0.5, 0.0);
             let ignored = mu_full_scalar_low_rank(&m, s, &set, None, Some(&wrong)).unwrap();
             assert!((ignored.upper - dense.upper).abs() <= 1e-9 * dense.upper);
         }
     }
+    assert!(
+        lazy_dense_free >= 10,
+        "only {lazy_dense_free} of 15 structured μ stayed without the dense matrix"
+    );
 }

@@ -7,6 +7,7 @@
 mod common;
 
 mod closed_loop_stability_large;
+mod hinf_large_modal;
 mod hinf_near_d;
 mod iss_reduction;
 mod stability;

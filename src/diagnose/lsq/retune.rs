@@ -102,9 +102,12 @@ fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
     // Qᵀy by the Householder reflections (no explicit Q).
     let mut qty = y;
     qr.q_tr_mul(&mut qty);
-    let rmax = (0..n).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    // More parameters than rows (a 1000-mode model on 200 data panicked here, issue 34): R
+    // has only `rows` pivots; the trailing parameters stay 0 (a basic least-squares solution).
+    let k = r.nrows().min(n);
+    let rmax = (0..k).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
     let mut x = DVector::<f64>::zeros(n);
-    for i in (0..n).rev() {
+    for i in (0..k).rev() {
         if r[(i, i)].abs() <= 1e-12 * rmax {
             continue;
         }
@@ -351,6 +354,19 @@ pub fn refit_nominal(
 
 #[cfg(test)]
 mod tests {
+    /// Fewer rows than parameters: no panic, and the answer fits the data exactly (the
+    /// system is consistent), with the parameters beyond the rows at 0.
+    #[test]
+    fn qr_solve_with_more_parameters_than_rows() {
+        use nalgebra::{DMatrix, DVector};
+        let a = DMatrix::from_row_slice(2, 4, &[1.0, 2.0, 0.5, -1.0, 0.0, 3.0, 1.0, 2.0]);
+        let y = DVector::from_row_slice(&[1.0, -2.0]);
+        let x = super::qr_solve(a.clone(), y.clone());
+        assert_eq!(x.len(), 4);
+        assert!((&a * &x - &y).norm() < 1e-12, "{x}");
+        assert_eq!((x[2], x[3]), (0.0, 0.0));
+    }
+
     use super::*;
     use crate::model::physical::{EffectKind, Gains, ModeSpec, PoleAtZeroSpec};
 
