@@ -88,10 +88,14 @@ impl InputArgs {
     /// Loads inputs and computes their envelope ([`crate::pipeline::envelope::envelope`]).
     pub fn envelope(&self) -> Result<(Inputs, Envelope)> {
         let inputs = self.load()?;
-        let options = crate::pipeline::RunOptions::noise_radius(self.noise_radius);
-        let env =
-            crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, &options)?.envelope;
+        let env = self.envelope_of(&inputs)?;
         Ok((inputs, env))
+    }
+
+    /// The envelope of inputs already loaded by [`InputArgs::load`].
+    pub fn envelope_of(&self, inputs: &Inputs) -> Result<Envelope> {
+        let options = crate::pipeline::RunOptions::noise_radius(self.noise_radius);
+        Ok(crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, &options)?.envelope)
     }
 }
 
@@ -104,6 +108,14 @@ pub use crate::report::fmt::{fmt_g, fmt_omegas};
 /// noise files beside a data file, [`data_and_siblings`]).  Keep the guard alive while the
 /// run writes.
 pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result<OutputManifest> {
+    check_out(out, inputs)?;
+    Ok(OutputManifest::begin(out)?)
+}
+
+/// The checks of [`prepare_out`] alone, touching nothing: for commands that do their work
+/// before clearing the folder (so that a refusal leaves the previous run's files), yet must
+/// refuse a bad `--out` before that work.
+pub fn check_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result<()> {
     if out.exists() && !out.is_dir() {
         return Err(anyhow!(
             "--out {}: is an existing file; give a folder (it is created if needed)",
@@ -136,7 +148,7 @@ pub fn prepare_out(out: &std::path::Path, inputs: &[&std::path::Path]) -> Result
             }
         }
     }
-    Ok(OutputManifest::begin(out)?)
+    Ok(())
 }
 
 /// Checks a single output file given by `flag` (`--svg FILE`, `--write FILE`) before any

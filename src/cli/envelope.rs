@@ -21,12 +21,13 @@ pub struct EnvelopeArgs {
 
 /// Runs `rshape envelope`.
 pub fn run(a: &EnvelopeArgs) -> Result<i32> {
-    let env = a.input.envelope_only()?;
     let inputs: Vec<&std::path::Path> = [Some(a.input.config.as_path()), a.input.data.as_deref()]
         .into_iter()
         .flatten()
         .collect();
+    // `--out` is checked before the work: a refusal must not cost the user the envelope.
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
+    let env = a.input.envelope_only()?;
     let path = a.out.join("envelope.csv");
     let mut file = AtomicFile::create(&path)?;
     write_envelope_csv(&env, file.writer()).map_err(|source| crate::error::Error::Io {

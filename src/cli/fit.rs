@@ -82,11 +82,13 @@ pub fn run(a: &FitArgs) -> Result<i32> {
                 data: a.data.clone(),
                 noise_radius: a.noise_radius,
             };
-            let (inputs, env) = input.envelope()?;
+            let inputs = input.load()?;
+            // `--out` is checked before the work: a refusal must not cost the user the envelope.
+            let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
+            let env = input.envelope_of(&inputs)?;
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
             let settings = settings.with_a1_model(f);
-            let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             run_fit(&env, Some(&a1), &settings, a.order, Some(progress))
         }
         (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),

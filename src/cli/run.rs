@@ -73,10 +73,11 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         envelope_progress: Some(&envelope_progress),
         fit_progress: Some(&progress),
     };
+    // `--out` is checked before the work: a refusal must not cost the user the fit.
+    let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;
     let mut out = pipeline::run(config, data, a.order, &options)?;
     view.finish();
     out.timings.0.insert("load".into(), load_ms);
-    let _manifest = super::common::prepare_out(&a.out, &[&a.input.config, &data.path])?;
     let (rep, files) = write_outputs(&a.out, config, data, &mut out)?;
 
     let name = rep

@@ -46,15 +46,18 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     // The controller's size is checked before anything is written (the loop itself, dear on
     // a large model, is built once, by `stability::run`).
     crate::stability::controller_fits(&config.factorization, &controller)?;
-    // With --fit, the data are read and the envelope computed before the folder is touched.
-    let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
-    // input's folder; the previous run's listed files are cleared.
+    // input's folder (refused before any work); the previous run's listed files are cleared.
     let inputs: Vec<&Path> = [a.config.as_path(), a.controller.as_path()]
         .into_iter()
         .chain(a.bounds.files())
         .chain(config.data.as_deref())
         .collect();
+    if let Some(out) = &a.out {
+        super::common::check_out(out, &inputs)?;
+    }
+    // With --fit, the data are read and the envelope computed before the folder is touched.
+    let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     let _manifest = match &a.out {
         Some(out) => Some(super::common::prepare_out(out, &inputs)?),
         None => None,

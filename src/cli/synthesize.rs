@@ -82,7 +82,8 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         .chain(config.data.as_deref())
         .collect();
     // Everything that can fail on bad input is checked before the folder is touched: the
-    // synthesis itself runs in memory first.
+    // synthesis itself runs in memory first; a bad `--out` is refused before that work.
+    super::common::check_out(&a.out, &inputs)?;
     let settings = synthesize::SynthesisSettings {
         gamma_factor: a.gamma_factor,
         reduce: a.reduce,
