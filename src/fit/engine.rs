@@ -135,32 +135,9 @@ pub(crate) fn fit_order(
 ) -> OrderFit {
     let mut o = OrderSearch::new(prep, n, prev, set);
     let pole_sets = o.partial_fraction_minimax(&mut masks.0);
-    let l1 = o.lp_solves;
     o.area_polish(pole_sets, &mut masks.1);
-    let l2 = o.lp_solves;
     o.fallbacks();
-    let t_before = o
-        .cands
-        .iter()
-        .filter(|c| feasible(c))
-        .map(|c| c.max_log)
-        .fold(f64::INFINITY, f64::min);
     o.global_minimax();
-    if std::env::var("RSHAPE_TRACE_STALL").is_ok() {
-        let t_after = o
-            .cands
-            .iter()
-            .filter(|c| feasible(c))
-            .map(|c| c.max_log)
-            .fold(f64::INFINITY, f64::min);
-        eprintln!(
-            "ORDER {n} thorough={} pf {l1} area {} poly {} ev {} best-before-poly {t_before:.5} after {t_after:.5}",
-            set.thorough,
-            l2 - l1,
-            o.lp_solves - l2,
-            o.events.len()
-        );
-    }
     OrderFit {
         ranked: o.rank(),
         events: o.events,

@@ -83,16 +83,6 @@ fn recheck_stall(
     let lp_solves = of.lp_solves + again.lp_solves;
     let mut events = of.events.clone();
     events.append(&mut again.events);
-    if std::env::var("RSHAPE_TRACE_STALL").is_ok() {
-        eprintln!(
-            "STALL order {n} prev {:.5} fast {:.5} ({} LPs) thorough {:.5} ({} LPs)",
-            p.max_log,
-            best(&of),
-            of.lp_solves,
-            best(&again),
-            again.lp_solves
-        );
-    }
     let ranked = if best(&again) < best(&of) {
         again.ranked
     } else {

@@ -134,17 +134,6 @@ pub(crate) fn minimax(
                 pending.retain(|p| *p != attempts[1]);
             }
         }
-        if std::env::var("RSHAPE_TRACE_STALL").is_ok() {
-            eprintln!(
-                "  ATTEMPT n={n} x0={:.3e} cut={:.0e} t_start={:.5e} found={:?} lps={} ev={}",
-                a.attempt.0,
-                a.attempt.1,
-                a.t_start,
-                a.found.as_ref().map(|c| c.t),
-                a.lp_solves,
-                a.events.len()
-            );
-        }
         let decisive = a.events.is_empty();
         events.append(&mut a.events);
         *lp_solves += a.lp_solves;

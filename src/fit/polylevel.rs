@@ -25,14 +25,6 @@ const RETRY_ITER: u32 = 100;
 /// Rounds of positivity cuts per level.
 const CUT_ROUNDS: usize = 8;
 
-/// LPs one level may cost (both passes) before it is a doubt.
-fn level_lps() -> usize {
-    std::env::var("RSHAPE_LEVEL_LPS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(usize::MAX)
-}
-
 /// What one level's LP decided.
 enum Level {
     /// Feasible, with this solution.
@@ -70,8 +62,6 @@ pub(super) struct LevelLp<'a> {
     pub(super) lp_solves: usize,
     /// Whether a cut `B ≥ b_cut` was ever added.
     pub(super) b_cut_used: bool,
-    /// `lp_solves` when the current level started (for [`LEVEL_LPS`]).
-    level_start: usize,
 }
 
 impl<'a> LevelLp<'a> {
@@ -111,7 +101,6 @@ impl<'a> LevelLp<'a> {
             cuts: Rows::default(),
             lp_solves: 0,
             b_cut_used: false,
-            level_start: 0,
         }
     }
 
@@ -144,28 +133,11 @@ impl<'a> LevelLp<'a> {
     /// always on, 1.3 s on a doubt only).  A level infeasible only with the cuts on `B`
     /// ([`Level::CutBound`]) is not solved again: refinement does not remove a cut.
     fn level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
-        let l0 = self.lp_solves;
-        let r = self.level_inner(t, events);
-        if std::env::var("RSHAPE_TRACE_STALL").is_ok() {
-            let v = match &r {
-                Level::Feasible(_) => "feasible",
-                Level::Infeasible => "infeasible",
-                Level::Doubt => "DOUBT",
-                Level::CutBound => "cutbound",
-            };
-            eprintln!("    LEVEL t={t:.5e} {v} lps={}", self.lp_solves - l0);
-        }
-        r
-    }
-
-    fn level_inner(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
-        self.level_start = self.lp_solves;
         if self.set.thorough {
             return self.level_with(t, events, true);
         }
         let before = events.len();
         match self.level_with(t, events, false) {
-            Level::Doubt if self.lp_solves - self.level_start > level_lps() => Level::Doubt,
             Level::Doubt => {
                 events.truncate(before);
                 self.level_with(t, events, true)
@@ -214,12 +186,6 @@ impl<'a> LevelLp<'a> {
                 Retry::Decides,
             );
             self.lp_solves += rounds;
-            if self.lp_solves - self.level_start > level_lps()
-                && out.status != SolverStatus::PrimalInfeasible
-            {
-                self.doubt(events, t, out.status, "level LP budget spent".into());
-                return Level::Doubt;
-            }
             // Only a full-accuracy certificate of infeasibility decides the level; a
             // reduced-accuracy one is a doubt like any other status below.
             if out.status == SolverStatus::PrimalInfeasible {
