@@ -75,14 +75,16 @@ pub fn diagnose_channels(
     }
     let before = measures(base, data)?;
     let n = data.n_data();
-    let mk_stats = |expanded, joint_refits, refits_given_up, phases: Phases| SearchStats {
-        beam: s.beam,
-        nodes_expanded: expanded,
-        joint_refits,
-        refits_given_up,
-        seconds: t0.elapsed().as_secs_f64(),
-        phases: phases.0,
-    };
+    let mk_stats =
+        |expanded, joint_refits, refits_given_up, mode_groups_hz, phases: Phases| SearchStats {
+            beam: s.beam,
+            nodes_expanded: expanded,
+            joint_refits,
+            refits_given_up,
+            mode_groups_hz,
+            seconds: t0.elapsed().as_secs_f64(),
+            phases: phases.0,
+        };
     if before.consistent() {
         return Ok(Diagnosis {
             verdict: DiagnoseVerdict::Consistent,
@@ -114,7 +116,7 @@ pub fn diagnose_channels(
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
-            search: mk_stats(0, 0, 0, Phases::default()),
+            search: mk_stats(0, 0, 0, Vec::new(), Phases::default()),
             final_model: base.clone(),
         });
     }
@@ -257,7 +259,13 @@ pub fn diagnose_channels(
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
-        search: mk_stats(res.expanded, res.joint_refits, res.gave_up, phases),
+        search: mk_stats(
+            res.expanded,
+            res.joint_refits,
+            res.gave_up,
+            res.multi_modes_hz.clone(),
+            phases,
+        ),
         final_model: node.model,
     })
 }
