@@ -9,7 +9,8 @@
 //!   the model and **every** parameter is refit jointly (the node's own and the new
 //!   effect's). Besides the screen's candidates, a mode is proposed at every other peak of
 //!   the residual that would pass the screen ([`super::peak_modes`]), and all those modes
-//!   together, in one step ([`super::multi_mode`]). A child is kept when its joint ΔBIC against the node exceeds 10, it
+//!   together, in one step ([`super::multi_mode`]; each mode counts against
+//!   `max_effects`). A child is kept when its joint ΔBIC against the node exceeds 10, it
 //!   improves on the node ([`crate::diagnose::search::rank::improves`]: no more invalid data, or a lower
 //!   `misfit_rms`), and the refit left no new mode at a band edge.
 //! * **Level**: the children of all nodes, one per effect set (the best of the orders that
@@ -89,6 +90,16 @@ fn expand(
     screened: Option<Vec<Screened>>,
 ) -> Result<Expansion> {
     let node = &nodes[ni];
+    // A node that has used the effect budget (a group of modes counts each) is not expanded.
+    if node.effects.len() >= s.max_effects {
+        return Ok(Expansion {
+            screened: vec![],
+            n_screen: 0,
+            refit: vec![],
+            multi: None,
+            ref_v: node.v_fit,
+        });
+    }
     let mut screened = match screened {
         Some(sc) => sc,
         None => {
@@ -125,6 +136,7 @@ fn expand(
         &singles,
         &local_only,
         s.min_delta_bic,
+        s.max_effects.saturating_sub(node.effects.len()),
     );
     screened.extend(singles);
     let mut tried = 0;

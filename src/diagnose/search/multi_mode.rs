@@ -31,13 +31,15 @@ const SAME_RESONANCE_REL: f64 = super::peaks::LOCAL_MIN_REL;
 /// `min_delta_bic`); one per resonance (within 2 %: the peak's local fit first, a
 /// whole-band fit being pulled by the other missing modes), none at a mode `model` already
 /// has (within its half-power band, at least ±0.3 %: what is left of that mode's fit is a
-/// retune's job, and a second mode there a cancelling pair); `None` unless two or more.
+/// retune's job, and a second mode there a cancelling pair); at most `budget` (the effects
+/// the search may still add: each mode of a group counts); `None` unless two or more.
 pub(super) fn proposal(
     model: &PhysicalModel,
     screen: &[Screened],
     at_peaks: &[Screened],
     local: &[Screened],
     min_delta_bic: f64,
+    budget: usize,
 ) -> Option<Vec<Screened>> {
     let at_a_mode = |sc: &Screened| {
         let w = sc.mods.theta[0].exp();
@@ -66,6 +68,7 @@ pub(super) fn proposal(
             kept.push(sc.clone());
         }
     }
+    kept.truncate(budget);
     (kept.len() >= 2).then_some(kept)
 }
 
@@ -226,16 +229,11 @@ mod tests {
             fitted(100.3, 800.0),
             fitted(320.0, 5.0),
         ];
-        let g = proposal(
-            &model,
-            &screen,
-            &[fitted(150.0, 500.0)],
-            &[fitted(250.0, -3.0)],
-            10.0,
-        )
-        .expect("a group");
+        let (at, local) = ([fitted(150.0, 500.0)], [fitted(250.0, -3.0)]);
+        let g = proposal(&model, &screen, &at, &local, 10.0, 3).expect("a group");
         assert_eq!(hz(&g), vec![150.0, 250.0]);
-        // One mode is no group.
-        assert!(proposal(&model, &screen, &[], &[], 10.0).is_none());
+        // One mode is no group, nor is a budget of one effect.
+        assert!(proposal(&model, &screen, &[], &[], 10.0, 3).is_none());
+        assert!(proposal(&model, &screen, &at, &local, 10.0, 1).is_none());
     }
 }
