@@ -207,7 +207,14 @@ pub fn diagnose_channels(
         DiagnoseVerdict::NoEffectFound
     };
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
-        + &unreached_modes(&peaks, &res.peak_modes_hz);
+        + &unreached_modes(
+            &peaks,
+            &res.peak_modes_hz
+                .iter()
+                .chain(res.multi_modes_hz.iter().flatten())
+                .copied()
+                .collect::<Vec<_>>(),
+        );
     for d in &dampings_not_identified {
         message += "; ";
         message += &d.reason;
@@ -341,7 +348,8 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
 /// mode fitted at the peak would pass the screen although no candidate of the run was
 /// fitted there: the modes the search's proposals did not reach (empty when none).  A peak
 /// where the search did refit a mode of its own ([`crate::diagnose::search::peak_modes`],
-/// frequencies `proposed_hz`) is named apart: proposed, not chosen.
+/// alone or in a group of modes, frequencies `proposed_hz`) is named apart: proposed, not
+/// chosen.
 fn unreached_modes(peaks: &[crate::diagnose::report::Peak], proposed_hz: &[f64]) -> String {
     let mut f: Vec<f64> = Vec::new();
     let mut refit: Vec<f64> = Vec::new();

@@ -377,7 +377,8 @@ pub fn search(
             };
             let judge = Judge {
                 data,
-                s,
+                min_delta_bic: s.min_delta_bic,
+                allow_mains: s.allow_mains,
                 anchor: &anchor,
                 retuned: &nodes[1].model,
                 reference: &reference,

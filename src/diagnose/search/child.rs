@@ -5,7 +5,6 @@
 //! physically admissible ([`crate::diagnose::admissible`]).  Steps and effects stay
 //! parallel: one step per effect added, the modes of a group sharing their step number.
 
-use super::beam::SearchSettings;
 use super::multi_mode::check_each;
 use super::node::Node;
 use super::rank::{improves, modes_at_band_edge, si_map, Screened};
@@ -22,7 +21,10 @@ pub(super) type Refit = (PhysicalModel, Measures, f64, usize);
 /// What a child is judged against.
 pub(super) struct Judge<'a> {
     pub data: &'a Channels,
-    pub s: &'a SearchSettings,
+    /// ΔBIC a child must exceed.
+    pub min_delta_bic: f64,
+    /// Write modes at mains frequencies anyway.
+    pub allow_mains: bool,
     /// The configured model (the anchor of every refit's boxes).
     pub anchor: &'a PhysicalModel,
     /// The retuned root's model.
@@ -61,7 +63,7 @@ pub(super) fn judge(
     // modes where the retune put them): from a rough start a configured mode may lie nearer
     // the added one than where it belongs.
     let model = super::assign::align_from(&[j.anchor, j.retuned], &model, &effects);
-    let likely = d_bic > j.s.min_delta_bic && improves(&m, &node.measures) && !at_edge;
+    let likely = d_bic > j.min_delta_bic && improves(&m, &node.measures) && !at_edge;
     if !likely {
         return (None, None);
     }
@@ -72,11 +74,11 @@ pub(super) fn judge(
                 model: &model,
                 measures: &m,
                 reference: j.reference,
-                allow_mains: j.s.allow_mains,
+                allow_mains: j.allow_mains,
             },
             data,
         ),
-        _ => check_each(&model, added.len(), &m, j.s.allow_mains, data),
+        _ => check_each(&model, added.len(), &m, j.allow_mains, data),
     };
     if refusal.is_some() {
         return (None, refusal);
