@@ -36,12 +36,13 @@ Output (numpy 2.x, about 30 s of CPU), then the verdicts:
   lags atan(fc/f), 4x larger at 25 Hz than at 100 Hz (the data: flat 9-11 deg); a delay
   giving 9 deg at 50 Hz gives 171 deg at 950 Hz (the data: 2 deg); mode 1's own damping
   gives 8 deg at 30 Hz only with zeta ~ 0.08 (its peak says 5e-4).
-* Non-proportional damping: with one response point, residues R_1j ~ phi_1 phi_j share
-  one phase on every channel only when the shape is real up to a common factor, i.e. a real
-  normal mode, whose residue is real: the equal ~9 deg on all three channels is not mode
-  complexity.  What is common to every channel of a roving-hammer test is the response
-  transducer and the measurement chain; no catalogue term (delay, lag, high-pass, ZOH) has
-  this shape, and no candidate tested here is physics that explains it.
+* Non-proportional damping: with one response point, residues R_1j ~ phi_1 phi_j Q share
+  one phase on every channel only when the shape has one phase at all three points, as a
+  real normal mode has (whose residue is real); non-proportional damping spreads the phases.
+  The equal ~9 deg on all three channels is unlikely to be mode complexity.  What is common
+  to every channel of a roving-hammer test is the response transducer and the measurement
+  chain; no catalogue term (delay, lag, high-pass, ZOH) has this shape, and no candidate
+  tested here is physics that explains it.
 Run from the repository root:
     python3 tests/data/ema_reference/phase_lag_hypotheses.py
 """
