@@ -75,14 +75,16 @@ pub fn diagnose_channels(
     }
     let before = measures(base, data)?;
     let n = data.n_data();
-    let mk_stats = |expanded, joint_refits, refits_given_up, phases: Phases| SearchStats {
-        beam: s.beam,
-        nodes_expanded: expanded,
-        joint_refits,
-        refits_given_up,
-        seconds: t0.elapsed().as_secs_f64(),
-        phases: phases.0,
-    };
+    let mk_stats =
+        |expanded, joint_refits, refits_given_up, mode_groups_hz, phases: Phases| SearchStats {
+            beam: s.beam,
+            nodes_expanded: expanded,
+            joint_refits,
+            refits_given_up,
+            mode_groups_hz,
+            seconds: t0.elapsed().as_secs_f64(),
+            phases: phases.0,
+        };
     if before.consistent() {
         return Ok(Diagnosis {
             verdict: DiagnoseVerdict::Consistent,
@@ -114,7 +116,7 @@ pub fn diagnose_channels(
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
-            search: mk_stats(0, 0, 0, Phases::default()),
+            search: mk_stats(0, 0, 0, Vec::new(), Phases::default()),
             final_model: base.clone(),
         });
     }
@@ -205,7 +207,14 @@ pub fn diagnose_channels(
         DiagnoseVerdict::NoEffectFound
     };
     let mut message = verdict_message(verdict, [&before, &retuned, &after], &moved, &chosen_labels)
-        + &unreached_modes(&peaks, &res.peak_modes_hz);
+        + &unreached_modes(
+            &peaks,
+            &res.peak_modes_hz
+                .iter()
+                .chain(res.multi_modes_hz.iter().flatten())
+                .copied()
+                .collect::<Vec<_>>(),
+        );
     for d in &dampings_not_identified {
         message += "; ";
         message += &d.reason;
@@ -257,7 +266,13 @@ pub fn diagnose_channels(
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
-        search: mk_stats(res.expanded, res.joint_refits, res.gave_up, phases),
+        search: mk_stats(
+            res.expanded,
+            res.joint_refits,
+            res.gave_up,
+            res.multi_modes_hz.clone(),
+            phases,
+        ),
         final_model: node.model,
     })
 }
@@ -333,7 +348,8 @@ fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
 /// mode fitted at the peak would pass the screen although no candidate of the run was
 /// fitted there: the modes the search's proposals did not reach (empty when none).  A peak
 /// where the search did refit a mode of its own ([`crate::diagnose::search::peak_modes`],
-/// frequencies `proposed_hz`) is named apart: proposed, not chosen.
+/// alone or in a group of modes, frequencies `proposed_hz`) is named apart: proposed, not
+/// chosen.
 fn unreached_modes(peaks: &[crate::diagnose::report::Peak], proposed_hz: &[f64]) -> String {
     let mut f: Vec<f64> = Vec::new();
     let mut refit: Vec<f64> = Vec::new();

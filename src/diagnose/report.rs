@@ -281,6 +281,10 @@ pub struct SearchStats {
     /// Joint refits given up: still above three times their reference cost after 10
     /// iterations (they could not pass).
     pub refits_given_up: usize,
+    /// The groups of modes proposed together in one step (every mode fitted alone at a node
+    /// that would pass the screen; `diagnose::search::multi_mode`), Hz, one list per joint
+    /// refit, whatever became of them.
+    pub mode_groups_hz: Vec<Vec<f64>>,
     /// Wall time, s.
     pub seconds: f64,
     /// Wall time of each phase, in the order they ran (`--verbose` prints the table).

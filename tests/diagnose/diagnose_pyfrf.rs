@@ -291,7 +291,7 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 /// 4390 Hz) either in the final model or named in the last step's per-peak account with its
 /// fate and a reason (docs/guide/discovery-walkthrough.md, section 6).
 #[test]
-#[ignore = "the whole band, ten steps: about 60 s in release"]
+#[ignore = "the whole band, ten steps: about 60 s in release; fails today (on main 8ef951d too): no mode within 3 Hz of 3664 Hz, the walk ends with 3668.5 and 3689.2 Hz"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);

@@ -221,3 +221,34 @@ fn a_mode_the_covariance_does_not_determine_is_not_identified() {
     let d2 = data_of(&tr, dense());
     assert_eq!(rule_of(Cand::Mode, &tr, &d2, &AFTER, false), None);
 }
+
+/// A friction pole far below the band (its relative effect at the band bottom `p/ω_min`
+/// below the noise's relative resolution there) is negligible whatever the likelihood says;
+/// one that changes the response at the band bottom by 40 % is not.
+#[test]
+fn a_friction_pole_far_below_the_band_is_negligible() {
+    let body = |pole: Option<f64>| {
+        let mut m = truth();
+        m.rigid_body.push(crate::model::physical::PoleAtZeroSpec {
+            name: None,
+            mass: 1.0,
+            input_gain: Gains::Scalar(1.0),
+            output_gain: Gains::Scalar(500.0),
+            friction_pole: pole,
+        });
+        m
+    };
+    let d = data_of(&body(None), dense());
+    // 1e-4 rad/s against a 50 rad/s band bottom: 2e-6, below r/|G| = 0.01/√n.
+    let tiny = refused(Cand::Friction(0), &body(Some(1e-4)), &d, &AFTER, false);
+    assert_eq!(
+        tiny.as_ref().map(|r| r.rule),
+        Some(Rule::Negligible),
+        "{tiny:?}"
+    );
+    assert!(tiny.unwrap().reason.contains("relative resolution"));
+    assert_eq!(
+        rule_of(Cand::Friction(0), &body(Some(20.0)), &d, &AFTER, false),
+        None
+    );
+}

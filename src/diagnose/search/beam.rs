@@ -7,7 +7,10 @@
 //!   scored by `ΔBIC = 2(V_node − V) − n·ln(2F)`; the best `beam + 1` that pass the screen
 //!   (ΔBIC > 10, plausible: no parameter at a bound, a mode inside the band) are written into
 //!   the model and **every** parameter is refit jointly (the node's own and the new
-//!   effect's). A child is kept when its joint ΔBIC against the node exceeds 10, it
+//!   effect's). Besides the screen's candidates, a mode is proposed at every other peak of
+//!   the residual that would pass the screen ([`super::peak_modes`]), and all those modes
+//!   together, in one step ([`super::multi_mode`]; each mode counts against
+//!   `max_effects`). A child is kept when its joint ΔBIC against the node exceeds 10, it
 //!   improves on the node ([`crate::diagnose::search::rank::improves`]: no more invalid data, or a lower
 //!   `misfit_rms`), and the refit left no new mode at a band edge.
 //! * **Level**: the children of all nodes, one per effect set (the best of the orders that
@@ -23,20 +26,18 @@
 //!   moved inside its own 95 % confidence region towards the disks.  The BIC stays that of
 //!   the least-squares fit.
 
-use crate::diagnose::admissible::{check, Child, Refusal};
+use crate::diagnose::admissible::Refusal;
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
 use crate::diagnose::lsq::retune::{retune, retune_or_give_up};
-use crate::diagnose::report::{Phases, Step};
-use crate::diagnose::search::final_effects::final_effects;
+use crate::diagnose::report::Phases;
+use crate::diagnose::search::child::{judge as judge_child, Judge, Refit};
 use crate::diagnose::search::holdout::same_set;
 use crate::diagnose::search::node::{add_effect, Node};
 use crate::diagnose::search::polish::settle;
-use crate::diagnose::search::rank::{
-    candidate_list, improves, modes_at_band_edge, prior, si_map, Screened, MIN_DELTA_BIC, TIE_BIC,
-};
+use crate::diagnose::search::rank::{candidate_list, prior, Screened, MIN_DELTA_BIC, TIE_BIC};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -66,10 +67,6 @@ fn steps_explain_more(a: &Node, b: &Node) -> bool {
         .is_some_and(|o| o.is_gt())
 }
 
-/// A child's joint refit: the model, its measures, its least-squares cost and number of
-/// parameters.
-type Refit = (PhysicalModel, Measures, f64, usize);
-
 /// One node's screen: every candidate fitted alone (best first), which of them get a joint
 /// refit (the `beam + 1` best promising ones), and the cost the children are measured
 /// against.
@@ -78,6 +75,8 @@ struct Expansion {
     /// `screened[..n_screen]` is the catalogue's screen, the rest peaks' mode proposals.
     n_screen: usize,
     refit: Vec<bool>,
+    /// The modes proposed together ([`super::multi_mode`]).
+    multi: Option<Vec<Screened>>,
     ref_v: f64,
 }
 
@@ -91,6 +90,16 @@ fn expand(
     screened: Option<Vec<Screened>>,
 ) -> Result<Expansion> {
     let node = &nodes[ni];
+    // A node that has used the effect budget (a group of modes counts each) is not expanded.
+    if node.effects.len() >= s.max_effects {
+        return Ok(Expansion {
+            screened: vec![],
+            n_screen: 0,
+            refit: vec![],
+            multi: None,
+            ref_v: node.v_fit,
+        });
+    }
     let mut screened = match screened {
         Some(sc) => sc,
         None => {
@@ -105,20 +114,31 @@ fn expand(
     };
     // Every peak proposed ([`super::peak_modes`]): the modes at the residual's other peaks
     // that would pass the screen, each refit (beyond the beam's share), so that one refused
-    // mode candidate does not hide the others.
+    // mode candidate does not hide the others; with the modes that pass only on the lines
+    // around their peak, they are also proposed together ([`super::multi_mode`]).  A mode
+    // candidate of the screen that would not pass hides no peak.
     let n_screen = screened.len();
     let taken: Vec<f64> = screened
         .iter()
-        .filter(|sc| sc.cand == Cand::Mode && sc.no_fit.is_none())
+        .filter(|sc| {
+            sc.cand == Cand::Mode
+                && sc.no_fit.is_none()
+                && sc.flags.is_empty()
+                && sc.delta_bic > s.min_delta_bic
+        })
         .map(|sc| sc.mods.theta[0].exp())
         .collect();
-    screened.extend(super::peak_modes::peak_modes(
+    let (singles, local_only) =
+        super::peak_modes::peak_modes(&node.model, data, node.measures, &taken, s.min_delta_bic)?;
+    let multi = super::multi_mode::proposal(
         &node.model,
-        data,
-        node.measures,
-        &taken,
+        &screened,
+        &singles,
+        &local_only,
         s.min_delta_bic,
-    )?);
+        s.max_effects.saturating_sub(node.effects.len()),
+    );
+    screened.extend(singles);
     let mut tried = 0;
     let refit = screened
         .iter()
@@ -141,6 +161,7 @@ fn expand(
         screened,
         n_screen,
         refit,
+        multi,
         ref_v,
     })
 }
@@ -212,6 +233,9 @@ pub struct SearchResult {
     /// Frequencies (Hz) of the modes proposed at residual peaks and refit jointly
     /// ([`super::peak_modes`]), whatever became of them.
     pub peak_modes_hz: Vec<f64>,
+    /// Frequencies (Hz) of each group of modes proposed together and refit jointly
+    /// ([`super::multi_mode`]), whatever became of them.
+    pub multi_modes_hz: Vec<Vec<f64>>,
 }
 
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {
@@ -261,7 +285,6 @@ pub fn search(
     mut first_screen: Option<Vec<Screened>>,
 ) -> Result<SearchResult> {
     s.validate()?;
-    let ln2f = (2.0 * data.n_data() as f64).ln();
     let mut level: Vec<usize> = (0..roots.len()).collect();
     // The configured model: the anchor of every refit's boxes.
     let anchor = roots[0].model.clone();
@@ -269,6 +292,7 @@ pub fn search(
     let mut first_level = Vec::new();
     let mut refused: Vec<(usize, Refusal)> = Vec::new();
     let mut peak_modes_hz: Vec<f64> = Vec::new();
+    let mut multi_modes_hz: Vec<Vec<f64>> = Vec::new();
     let (mut expanded, mut joint_refits, mut gave_up) = (0, 0, 0);
     let mut phases = Phases::default();
     for depth in 1..=s.max_effects {
@@ -297,7 +321,8 @@ pub fn search(
         // A screen done beforehand was timed where it ran.
         phases.add("screen", t_screen.elapsed().as_secs_f64(), n_screened);
         expanded += level.len();
-        let jobs: Vec<(usize, usize)> = expansions
+        // Per node: its single proposals in screen order, then its modes proposed together.
+        let jobs: Vec<(usize, Option<usize>)> = expansions
             .iter()
             .enumerate()
             .flat_map(|(li, e)| {
@@ -305,32 +330,76 @@ pub fn search(
                     .iter()
                     .enumerate()
                     .filter(|(_, go)| **go)
-                    .map(move |(j, _)| (li, j))
+                    .map(move |(j, _)| (li, Some(j)))
+                    .chain(e.multi.iter().map(move |_| (li, None)))
             })
             .collect();
         let t_refit = std::time::Instant::now();
-        let done: Vec<Result<Option<Refit>>> = jobs
+        let done: Vec<Result<Option<(Refit, Measures)>>> = jobs
             .par_iter()
             .map(|&(li, j)| {
                 let node = &nodes[level[li]];
-                let sc = &expansions[li].screened[j];
-                let added = add_effect(&node.model, &sc.cand, &sc.mods.theta, data);
-                let give_up = Some(GIVE_UP_FACTOR * expansions[li].ref_v);
+                let e = &expansions[li];
+                let group: Vec<&Screened> = match j {
+                    Some(j) => vec![&e.screened[j]],
+                    None => e.multi.iter().flatten().collect(),
+                };
+                let mut added = node.model.clone();
+                for sc in &group {
+                    added = add_effect(&added, &sc.cand, &sc.mods.theta, data);
+                }
+                let before = match group.as_slice() {
+                    [one] => one.measures,
+                    _ => Problem::new(&added, data)?.measures(&Default::default()),
+                };
+                let give_up = Some(GIVE_UP_FACTOR * e.ref_v);
                 let (r, gave_up) =
                     retune_or_give_up(&added, &anchor, data, None, node.configured, give_up);
                 if gave_up {
                     return Ok(None);
                 }
                 let (v_fit, n_params) = (r.v_after, r.n_params);
-                settle(r.model, &anchor, data).map(|(model, m)| Some((model, m, v_fit, n_params)))
+                settle(r.model, &anchor, data)
+                    .map(|(model, m)| Some(((model, m, v_fit, n_params), before)))
             })
             .collect();
         phases.add("joint refits", t_refit.elapsed().as_secs_f64(), jobs.len());
-        // The refits in job order: node by node, candidate by candidate.
+        // The refits in job order: node by node, candidate by candidate, then the group.
         let mut done = done.into_iter();
         for (&ni, e) in level.iter().zip(&expansions) {
             let node = nodes[ni].clone();
-            let ref_v = e.ref_v;
+            // Physical admissibility of a joint refit is judged against the node (or, for
+            // the configured model, the better of it and its retune).
+            let reference = if node.configured && nodes[1].v_fit < node.v_fit {
+                nodes[1].measures
+            } else {
+                node.measures
+            };
+            let judge = Judge {
+                data,
+                min_delta_bic: s.min_delta_bic,
+                allow_mains: s.allow_mains,
+                anchor: &anchor,
+                retuned: &nodes[1].model,
+                reference: &reference,
+                ref_v: e.ref_v,
+                depth,
+            };
+            let mut note = |refusal: &Option<Refusal>| {
+                if let Some(r) = refusal {
+                    let seen = refused.iter().any(|(_, x): &(usize, Refusal)| {
+                        x.effect == r.effect
+                            && x.rule == r.rule
+                            && match (x.frequency_hz, r.frequency_hz) {
+                                (Some(a), Some(b)) => (a - b).abs() <= 1e-3 * a,
+                                (a, b) => a.is_none() && b.is_none(),
+                            }
+                    });
+                    if !seen {
+                        refused.push((depth, r.clone()));
+                    }
+                }
+            };
             for (j, (sc, go)) in e.screened.iter().zip(&e.refit).enumerate() {
                 // A peak's own mode proposal is a search child only (the first-level
                 // candidates stay the screen's).
@@ -342,117 +411,42 @@ pub fn search(
                 let mut first_refusal = None;
                 if let Some(refit) = go.then(|| done.next()).flatten() {
                     joint_refits += 1;
-                    let Some((model, m, v_fit, n_refit)) = refit? else {
+                    let Some((refit, before)) = refit? else {
                         gave_up += 1;
                         if depth == 1 && ni == 0 && !extra {
                             first_level.push((sc.clone(), None, None));
                         }
                         continue;
                     };
-                    let n_new = sc.cand.n_params(data.n_ch());
-                    let d_bic = 2.0 * (ref_v - v_fit) - n_new as f64 * ln2f;
-                    // A mode the joint refit pushed to a band edge is not a resonance of the
-                    // data (it would be written at exactly the band top).
-                    let (w_lo, w_hi) = (data.omega[0], *data.omega.last().expect("data"));
-                    let at_edge = modes_at_band_edge(&model, w_lo, w_hi)
-                        > modes_at_band_edge(&node.model, w_lo, w_hi);
-                    let mut effects = node.effects.clone();
-                    effects.push((sc.cand, sc.mods.theta.clone()));
-                    // The configured modes first, matched by frequency and shape, then the
-                    // added ones in the order chosen (never read by slot).
-                    // Matched against the retuned root (the configured modes where the retune
-                    // put them): from a rough start a configured mode may lie nearer the
-                    // added one than where it belongs.
-                    let model = crate::diagnose::search::assign::align_from(
-                        &[&anchor, &nodes[1].model],
-                        &model,
-                        &effects,
-                    );
-                    let likely =
-                        d_bic > s.min_delta_bic && improves(&m, &node.measures) && !at_edge;
-                    // Physical admissibility of the joint refit, against the node (or, for
-                    // the configured model, the better of it and its retune).
-                    let refusal = likely
-                        .then(|| {
-                            let reference = if node.configured && nodes[1].v_fit < node.v_fit {
-                                &nodes[1].measures
-                            } else {
-                                &node.measures
-                            };
-                            check(
-                                &Child {
-                                    cand: sc.cand,
-                                    model: &model,
-                                    measures: &m,
-                                    reference,
-                                    allow_mains: s.allow_mains,
-                                },
-                                data,
-                            )
-                        })
-                        .flatten();
-                    if let Some(r) = &refusal {
-                        let seen = refused.iter().any(|(_, x): &(usize, Refusal)| {
-                            x.effect == r.effect
-                                && x.rule == r.rule
-                                && match (x.frequency_hz, r.frequency_hz) {
-                                    (Some(a), Some(b)) => (a - b).abs() <= 1e-3 * a,
-                                    (a, b) => a.is_none() && b.is_none(),
-                                }
-                        });
-                        if !seen {
-                            refused.push((depth, r.clone()));
-                        }
-                    }
-                    first_refusal.clone_from(&refusal);
-                    if likely && refusal.is_none() {
-                        let mut steps = node.steps.clone();
-                        steps.push(Step {
-                            step: depth,
-                            effect: sc.cand.label(),
-                            params: final_effects(
-                                &model,
-                                &anchor,
-                                &effects.iter().map(|e| e.0).collect::<Vec<_>>(),
-                                data,
-                                false,
-                            )
-                            .pop()
-                            .map(|e| e.params)
-                            .unwrap_or_default(),
-                            params_fitted_alone: si_map(&sc.cand, &sc.mods.theta, &data.entries),
-                            explanation: crate::diagnose::effects::explain::explain(
-                                &sc.cand,
-                                &sc.mods.theta,
-                                &data.entries,
-                                &node.model,
-                                &data.omega,
-                            ),
-                            misfit_rms: m.misfit_rms,
-                            invalid_fraction: m.invalid_fraction,
-                            delta_bic: d_bic,
-                            misfit_rms_before_refit: sc.measures.misfit_rms,
-                            invalid_fraction_before_refit: sc.measures.invalid_fraction,
-                            n_refit,
-                            ties: vec![],
-                        });
-                        let child = Node {
-                            effects,
-                            bic: bic(v_fit, n_refit, data),
-                            model,
-                            measures: m,
-                            v_fit,
-                            n_params: n_refit,
-                            steps,
-                            configured: false,
-                        };
-                        child_node = Some(child.clone());
-                        children.push(child);
+                    let (child, refusal) = judge_child(&judge, &node, &[sc], refit, before);
+                    note(&refusal);
+                    first_refusal = refusal;
+                    if let Some(c) = child {
+                        child_node = Some(c.clone());
+                        children.push(c);
                     }
                 }
                 if depth == 1 && ni == 0 && !extra {
                     first_level.push((sc.clone(), child_node, first_refusal));
                 }
+            }
+            if let Some(group) = &e.multi {
+                let refit = done.next().expect("a refit per job");
+                joint_refits += 1;
+                let Some((refit, before)) = refit? else {
+                    gave_up += 1;
+                    continue;
+                };
+                let added: Vec<&Screened> = group.iter().collect();
+                multi_modes_hz.push(
+                    added
+                        .iter()
+                        .map(|sc| sc.mods.theta[0].exp() / std::f64::consts::TAU)
+                        .collect(),
+                );
+                let (child, refusal) = judge_child(&judge, &node, &added, refit, before);
+                note(&refusal);
+                children.extend(child);
             }
         }
         // One node per effect set (the best order; added modes at different frequencies
@@ -523,5 +517,6 @@ pub fn search(
         gave_up,
         phases,
         peak_modes_hz,
+        multi_modes_hz,
     })
 }

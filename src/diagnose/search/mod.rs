@@ -12,16 +12,20 @@
 //! * `backward`: backward elimination;
 //! * `peaks`: every peak of the residual and its fate;
 //! * `peak_modes`: a mode proposed at every peak that would pass the screen;
+//! * `multi_mode`: those modes proposed together, in one step;
+//! * `child`: a joint refit judged (likelihood, admissibility) and made a node;
 //! * `assign`: configured and added modes matched to the refit's;
 //! * `final_effects`: the effects the written model has and the input did not;
 //! * `final_refit`: the chosen model's last refit (dampings at the floor profiled).
 pub(crate) mod assign;
 pub(crate) mod backward;
 pub(crate) mod beam;
+pub(crate) mod child;
 pub(crate) mod final_effects;
 pub(crate) mod final_refit;
 pub(crate) mod first_level;
 pub(crate) mod holdout;
+pub(crate) mod multi_mode;
 pub(crate) mod node;
 pub(crate) mod peak_modes;
 pub(crate) mod peaks;

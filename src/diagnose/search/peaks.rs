@@ -306,7 +306,7 @@ fn probe_mode(
     p: &RawPeak,
     data: &Channels,
 ) -> Option<PeakProbe> {
-    let (fit, v, _) = fit_at(pb, p, data)?;
+    let AtPeak { fit, v, .. } = fit_at(pb, p, data)?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let delta_bic = 2.0 * (cur.v - v) - Cand::Mode.n_params(data.n_ch()) as f64 * ln2f;
     let (mut flags, no_fit) = plausibility(
@@ -330,28 +330,62 @@ fn probe_mode(
     })
 }
 
+/// Lines of a peak's local fit: its window widened by [`LOCAL_WIDTHS`] times its width
+/// on each side, and by at least [`LOCAL_MIN_REL`]`·ω`.
+pub const LOCAL_WIDTHS: f64 = 2.0;
+/// Least half-width of a local fit's lines, relative to the peak's frequency.
+pub const LOCAL_MIN_REL: f64 = 0.02;
+
+/// The lines of peak `p`'s local fit (see [`LOCAL_WIDTHS`]).
+pub(super) fn local_lines(p: &RawPeak, data: &Channels) -> Vec<usize> {
+    let w = data.omega[p.k];
+    let pad = (LOCAL_WIDTHS * (p.hi - p.lo)).max(LOCAL_MIN_REL * w);
+    let (lo, hi) = (p.lo - pad, p.hi + pad);
+    (0..data.len())
+        .filter(|&k| (lo..=hi).contains(&data.omega[k]))
+        .collect()
+}
+
+/// A mode fitted at a peak ([`fit_at`]).
+pub(super) struct AtPeak {
+    /// The mode.
+    pub fit: Mods,
+    /// The cost with it on all lines.
+    pub v: f64,
+    /// What it lowers the cost on the lines of its local fit.
+    pub local_gain: f64,
+    /// `JᵀJ` of the local fit.
+    pub jtj: nalgebra::DMatrix<f64>,
+}
+
 /// One mode started at peak `p` and fitted on top of the model of `pb` (see
-/// [`probe_mode`]): the fit, its cost and `JᵀJ`.
-pub(super) fn fit_at(
-    pb: &Problem<'_>,
-    p: &RawPeak,
-    data: &Channels,
-) -> Option<(Mods, f64, nalgebra::DMatrix<f64>)> {
+/// [`probe_mode`]).  The fit is local (issue 33): starts and refit use the lines around the
+/// peak only ([`local_lines`]).  Fitted on the whole band, the lone mode also answers for
+/// the other missing modes' tails, and where the radius is proportional to `|G|` (small at
+/// the data's anti-resonances) those tails can pull it out of its peak (measured: 263.7 →
+/// 265.5 Hz); a mode is a local feature, and the joint refit places it among the others.
+pub(super) fn fit_at(pb: &Problem<'_>, p: &RawPeak, data: &Channels) -> Option<AtPeak> {
     let w = data.omega[p.k];
     let all: Vec<usize> = (0..data.len()).collect();
+    let local = local_lines(p, data);
     let z0 = ((p.hi - p.lo) / (2.0 * 3f64.sqrt() * w)).clamp(2e-4, 0.3);
     let empty = Mods::default();
     let resp = pb.response(&empty);
     let mut best: Option<(Mods, f64, nalgebra::DMatrix<f64>)> = None;
     for z in [z0, 3.0 * z0, z0 / 3.0] {
-        let th = pb.mode_theta(&empty, &resp, w, z, &all);
+        let th = pb.mode_theta(&empty, &resp, w, z, &local);
         let m = empty.with(Cand::Mode, &th);
-        let (fit, v, jtj) = pb.refit(&m, &all);
-        if v.is_finite() && best.as_ref().is_none_or(|b| v < b.1) {
-            best = Some((fit, v, jtj));
+        let (fit, v_local, jtj) = pb.refit(&m, &local);
+        if v_local.is_finite() && best.as_ref().is_none_or(|b| v_local < b.1) {
+            best = Some((fit, v_local, jtj));
         }
     }
-    best
+    best.map(|(fit, v_local, jtj)| AtPeak {
+        v: pb.v(&fit, &all),
+        local_gain: pb.v(&empty, &local) - v_local,
+        fit,
+        jtj,
+    })
 }
 
 impl PeakProbe {
