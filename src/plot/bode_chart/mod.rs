@@ -90,8 +90,8 @@ pub enum Layout {
         /// Columns of panels (inputs).
         cols: usize,
     },
-    /// One wide panel, frequency labels chosen so none overlaps (`log_axis_ticks`) under
-    /// the phase chart.
+    /// One wide panel (the first; its models overlaid), frequency labels chosen so none
+    /// overlaps (`log_axis_ticks`) under the phase chart.
     Overlay,
 }
 
