@@ -213,3 +213,31 @@ where
     }
     layout::finish(fig, root, &ph, &ticks)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scales place a datum, its noise disk and a model point by their closed forms:
+    /// `|G| = 1` with `r = 0.5` spans 0.5…1.5 (log) or −6.02…+3.52 dB; a disk holding 0 goes
+    /// down to the axis; zero has no place on a log axis and is −6000 dB (floored) in dB.
+    #[test]
+    fn scales_place_data_disks_and_models_by_their_closed_forms() {
+        let axis = (1e-3, 1e3);
+        assert_eq!(MagScale::Log.spread(1.0, 0.5, axis), (0.5, 1.5));
+        assert_eq!(MagScale::Log.spread(1.0, 2.0, axis), (1e-3, 3.0));
+        assert_eq!(MagScale::Log.spread(1.0, 1e4, axis), (1e-3, 1e3));
+        let (lo, hi) = MagScale::Db.spread(1.0, 0.5, (-60.0, 60.0));
+        assert!((lo - 20.0 * 0.5f64.log10()).abs() < 1e-12 && (lo + 6.0206).abs() < 1e-4);
+        assert!((hi - 20.0 * 1.5f64.log10()).abs() < 1e-12 && (hi - 3.5218).abs() < 1e-4);
+        assert_eq!(MagScale::Db.spread(1.0, 2.0, (-60.0, 60.0)).0, -60.0);
+        assert_eq!(MagScale::Log.dot(0.0), None);
+        assert_eq!(MagScale::Log.dot(f64::NAN), None);
+        assert_eq!(MagScale::Log.dot(2.0), Some(2.0));
+        assert_eq!(MagScale::Db.dot(0.0), Some(-6000.0));
+        assert_eq!(MagScale::Db.dot(10.0), Some(20.0));
+        assert!(MagScale::Log.curve(0.0, axis).is_nan());
+        assert_eq!(MagScale::Log.curve(1e6, axis), 1e3);
+        assert_eq!(MagScale::Db.curve(100.0, (-1.0, 1.0)), 40.0);
+    }
+}
