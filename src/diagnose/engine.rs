@@ -195,6 +195,7 @@ pub fn diagnose_channels(
                 candidates: &candidates,
                 dropped: &dropped,
                 eliminated: &eliminated,
+                min_delta_bic: s.min_delta_bic,
             },
             data,
         )

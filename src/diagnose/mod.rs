@@ -3,20 +3,25 @@
 //! catalogue `docs/design/effects.md`.
 //!
 //! In layers, each using only those below it (checked by `tests/docs/diagnose_layers.rs`):
-//! * `effects`: the catalogue of effects (`candidates`: what each is and how it modifies
-//!   the model; `explain`: what each means in the data; `lscf`: mode proposals from the
-//!   residual by an LSCF stabilization diagram);
+//! * `effects`: the catalogue of effects, one file per effect implementing the `Effect`
+//!   trait (`effect`) and one registration line each (`effects/mod.rs`; the how-to is
+//!   docs/design/effects.md); `candidates`: the candidate `Cand` and what it dispatches to
+//!   its effect; `explain`: what each means in the data; `lscf`: mode proposals from the
+//!   residual by an LSCF stabilization diagram;
 //! * `lsq`: the least squares: `channels` (the data channels, each with its noise radius
 //!   and model entry), `measures` (error measures), `shapes` (a model's path and mode
 //!   shapes), `problem` (base model, candidate effects, cost `V`), `starts` (each candidate's
 //!   starting points), `lm` (Levenberg–Marquardt), `slots` (the parameters `retune` refits),
-//!   `varpro` (variable projection), `retune` (the joint refit of the model's own parameters);
+//!   `varpro` (variable projection), `mode_grid`, `retune` (the joint refit of the model's own
+//!   parameters), `resolution`, `profile` and `whiteness` (what the record resolves of a
+//!   damping, its profile likelihood, whether the residual is the stated noise);
 //! * `search`: `rank` (screening and physical plausibility), `node` (an effect set written
 //!   into the model), `beam` (the beam search over effect sets with joint refits),
 //!   `first_level`, `polish` (the consistency polish), `ties` (sets the data cannot tell
 //!   apart), `holdout` (the final set checked on held-out data), `backward` (backward
-//!   elimination), `peaks` (every peak of the residual and its fate), `assign` (added modes
-//!   matched to the refit's), `final_effects`;
+//!   elimination), `peaks` (every peak of the residual and its fate), `peak_modes` (a mode
+//!   proposed at each peak), `assign` (added modes matched to the refit's), `final_effects`,
+//!   `final_refit`;
 //! * on top: `engine` (the whole `diagnose`: entry points [`diagnose`],
 //!   [`diagnose_channels`], [`apply_candidate`]), `report` (what it reports), `changes` (the
 //!   parameter changes and their σ), [`admissible`] (physical admissibility of a refit),

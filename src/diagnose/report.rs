@@ -226,7 +226,8 @@ pub struct PeakProbe {
     pub flags: Vec<String>,
     /// No more invalid data, or a lower `misfit_rms` (`rank::improves`).
     pub improves: bool,
-    /// ΔBIC > 10, no flag, and `improves`: it would pass the screen.
+    /// ΔBIC above the search's `min_delta_bic` (default 10), no flag, and `improves`: it
+    /// would pass the screen.
     pub would_pass: bool,
 }
 

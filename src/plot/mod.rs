@@ -9,8 +9,9 @@
 //!   as in Fig. 7;
 //! - `mu`: `μ_Γ` per datum with the line `μ = 1` (Fig. 8);
 //! - `batch`: every dataset's envelope, the combined envelope and the one fitted `r`;
-//! - `bode_overlay`: `compare`'s data against one or more models (`bode_common`: what the
-//!   two Bode figures share: the phase conventions, the phase axis, a noise disk's span);
+//! - `bode_overlay`: `compare`'s data against one or more models; both Bode figures are
+//!   descriptions drawn by the one Bode drawer, `bode_chart` (chart pairs of magnitude over
+//!   phase; the phase conventions, the layouts, the data and model marks);
 //! - `history`: the error measures after each revision (`history`).
 //!
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
@@ -18,7 +19,7 @@
 pub(crate) mod axis;
 pub(crate) mod batch;
 pub(crate) mod bode;
-pub(crate) mod bode_common;
+pub(crate) mod bode_chart;
 pub(crate) mod bode_overlay;
 pub(crate) mod fine;
 pub(crate) mod history;

@@ -211,14 +211,16 @@ impl NormalizedLcf {
         ws.retain(|w| *w > 1e-9 * top && *w > 0.0);
         ws.sort_by(f64::total_cmp);
         ws.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
-        let ws_between: Vec<f64> = match (ws.first(), ws.last()) {
-            (Some(&lo), Some(&hi)) => std::iter::once(lo / 2.0)
-                .chain(ws.windows(2).map(|p| (p[0] * p[1]).sqrt()))
-                .chain(std::iter::once(hi * 2.0))
-                .collect(),
-            _ => Vec::new(),
-        };
-        let mut ws = ws_between;
+        // The frequencies between the poles, in place: from the top down, each modulus becomes
+        // the geometric mean with the one below it, the lowest half itself, and twice the
+        // highest is appended.
+        if let (Some(&lo), Some(&hi)) = (ws.first(), ws.last()) {
+            for i in (1..ws.len()).rev() {
+                ws[i] = (ws[i - 1] * ws[i]).sqrt();
+            }
+            ws[0] = lo / 2.0;
+            ws.push(hi * 2.0);
+        }
         if ws.len() > 64 {
             // A large model: every 1 in k, the extremes kept (the check costs O(n²) each).
             let step = ws.len().div_ceil(64);

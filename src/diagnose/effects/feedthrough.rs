@@ -1,67 +1,32 @@
 //! An added feedthrough `D` (the upper residual of modes above the band); θ = [d_1 … d_C].
 
-use crate::diagnose::effects::effect::{
-    per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
-};
+use crate::diagnose::effects::coefficient::{coefficient, Coefficient};
+use crate::diagnose::effects::effect::{Band, Explain, Param, Stands, Writer};
 use crate::model::physical::{Feedthrough as Spec, PhysicalModel, Quantity};
-use num_complex::Complex64;
 
 /// An added feedthrough.
 #[derive(Debug, Clone, Copy)]
 pub struct Feedthrough;
 
-impl Effect for Feedthrough {
+impl Coefficient for Feedthrough {
     const NAME: &'static str = "feedthrough";
-
-    fn tried_on(_: Sel) -> Vec<Self> {
-        vec![]
-    }
+    const SI: &'static str = "d";
 
     fn tried(_: &PhysicalModel) -> Vec<Self> {
         vec![Feedthrough]
     }
 
-    fn sel(&self) -> Option<Sel> {
-        None
+    /// `D s⁰`.
+    fn power(&self) -> u8 {
+        0
     }
 
-    fn n_params(&self, n_ch: usize) -> usize {
-        n_ch
+    fn labels(&self) -> Vec<(String, f64, f64)> {
+        vec![]
     }
 
-    fn typ(&self, theta: &[f64], _: f64) -> Vec<f64> {
-        theta.iter().map(|x| x.abs().max(1e-300)).collect()
-    }
-
-    fn bounds(&self, n_ch: usize, _: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
-        vec![(f64::NEG_INFINITY, f64::INFINITY); n_ch]
-    }
-
-    fn natural(&self, _: &[f64], _: &mut [f64]) {}
-
-    fn base_residue(&self, _: &PhysicalModel, _: (usize, usize)) -> f64 {
-        0.0
-    }
-
-    fn modify(
-        &self,
-        nat: &[f64],
-        _: f64,
-        _: &PhysicalModel,
-        _: f64,
-        ch: usize,
-        _: (usize, usize),
-        core: &mut Complex64,
-        _: &mut Complex64,
-    ) {
-        *core += nat[ch];
-    }
-
-    fn si_params(&self, th: &[f64], entries: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        per_channel("d", th, 0, entries)
-    }
-
-    fn write(&self, w: &mut Writer) {
+    /// Added to the configured `D` entry by entry.
+    fn write_into(&self, w: &mut Writer) {
         let m = &mut *w.m;
         let (p_out, m_in) = (m.n_outputs(), m.n_inputs());
         let mut d = match &m.feedthrough {
@@ -79,7 +44,7 @@ impl Effect for Feedthrough {
         });
     }
 
-    fn explain(&self, x: &Explain) -> String {
+    fn says(&self, x: &Explain) -> String {
         match x.base.quantity {
             Quantity::Displacement => format!(
                 "the error is a constant real term, flat in frequency, that dominates where the model rolls off and moves the anti-resonances: the upper residual (residual flexibility of modes above the band) D = {}",
@@ -95,44 +60,27 @@ impl Effect for Feedthrough {
         }
     }
 
-    fn prior(&self) -> usize {
+    fn rank() -> usize {
         5
     }
 
-    /// Each channel's `d` by least squares on the path.
-    fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
-        vec![(0..site.n_ch())
-            .map(|ch| site.ls(&[ch], &|ch, k| site.path(ch, k)))
-            .collect()]
+    /// A feedthrough is plausible on every quantity (the upper residual).
+    fn implausible(&self, _: Band) -> Option<String> {
+        None
     }
 
-    fn flags(&self, _: &[f64], _: &dyn Fn(usize) -> bool, _: &Si, _: Band, _: &mut Vec<String>) {}
-
-    fn stands(&self) -> Stands {
+    fn stands_as(&self) -> Stands {
         Stands::Feedthrough
     }
 
-    fn lacks_its_term(&self, _: &PhysicalModel) -> bool {
-        false
-    }
-
-    fn its_mode(&self, _: &PhysicalModel) -> Option<usize> {
+    /// None: the feedthrough's size is not judged alone.
+    fn alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
         None
     }
 
-    fn term_alone(&self, _: &PhysicalModel) -> Option<PhysicalModel> {
-        None
-    }
-
-    fn below_resolution(&self, _: &PhysicalModel, _: &Resolution) -> Option<String> {
-        None
-    }
-
-    fn owns(&self, _: &PhysicalModel) -> Vec<Param> {
+    fn owned(&self, _: &PhysicalModel) -> Vec<Param> {
         vec![Param::Feedthrough]
     }
-
-    fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
-        0.0
-    }
 }
+
+coefficient!(Feedthrough);

@@ -4,10 +4,13 @@
 //!   shares (the channel selection `Sel`, the ζ bounds, a term's residue);
 //! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
 //!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`), registered below;
-//! * `path` and `configured`: the two recurring shapes, a path effect on one parameter
-//!   (`delay`, `lag`, `nmp_zero`, `zoh`: `OnPath`, `on_path!`) and a refit of one parameter
-//!   of a configured mode (`mode_shift`, `damping`: `RefitsMode`, `refits_mode!`), whose
-//!   files hold only what differs;
+//! * `path`, `configured`, `coefficient` and `factor`: the four recurring shapes, a path
+//!   effect on one parameter (`delay`, `lag`, `nmp_zero`, `zoh`: `OnPath`, `on_path!`), a
+//!   refit of one parameter of a configured mode (`mode_shift`, `damping`: `RefitsMode`,
+//!   `refits_mode!`), an added term `c_ch/s^k` of one coefficient per channel
+//!   (`feedthrough`, `integrator`: `Coefficient`, `coefficient!`) and a path factor the
+//!   search does not try (`gain`, `sign`: `PathFactor`, `path_factor!`), whose files hold
+//!   only what differs;
 //! * `candidates`: the candidate [`Cand`] (one variant per registered effect) and what it
 //!   dispatches to its effect;
 //! * `explain`: what each means in the data;
@@ -16,9 +19,11 @@
 //! Adding an effect is one file implementing [`effect::Effect`] and one line in the
 //! registration list below (docs/design/effects.md, "Adding an effect").
 pub(crate) mod candidates;
+pub(crate) mod coefficient;
 pub(crate) mod configured;
 pub(crate) mod effect;
 pub(crate) mod explain;
+pub(crate) mod factor;
 pub(crate) mod lscf;
 pub(crate) mod path;
 mod tests;

@@ -36,7 +36,7 @@ use crate::diagnose::effects::candidates::{sig, Cand};
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::problem::{Mods, Problem};
 use crate::diagnose::report::{CandidateReport, Peak, PeakFate, PeakProbe};
-use crate::diagnose::search::rank::{improves, plausibility, MIN_DELTA_BIC};
+use crate::diagnose::search::rank::{improves, plausibility};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -148,6 +148,9 @@ pub(crate) struct Outcome<'a> {
     pub dropped: &'a [String],
     /// Effects the backward elimination dropped.
     pub eliminated: &'a [String],
+    /// The ΔBIC an effect must exceed ([`crate::diagnose::SearchSettings::min_delta_bic`]):
+    /// what a probe's "would pass the screen" is judged by.
+    pub min_delta_bic: f64,
 }
 
 /// The per-peak account (module docs) and the number of peaks not listed.
@@ -234,9 +237,9 @@ pub(crate) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                 ),
             )
         } else {
-            probe = probe_mode(&probe_on, &final_measures, &p, data);
+            probe = probe_mode(&probe_on, &final_measures, &p, data, o.min_delta_bic);
             let verdict = match &probe {
-                Some(pr) => pr.verdict(&p),
+                Some(pr) => pr.verdict(&p, o.min_delta_bic),
                 None => "one mode started here did not converge".into(),
             };
             match proposed {
@@ -251,7 +254,7 @@ pub(crate) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                         match c.rejection() {
                             Some(why) => format!("rejected: {why}"),
                             None if o.dropped.iter().any(|d| d == "mode") => "passed the screen, but a mode of the chosen set failed the holdout (fitted on 3 of every 4 lines it did not predict the fourth better) and was dropped".into(),
-                            None if o.eliminated.iter().any(|d| d == "mode") => "passed the screen, but the backward elimination dropped a mode of the chosen set (ΔBIC ≤ 10 without it)".into(),
+                            None if o.eliminated.iter().any(|d| d == "mode") => format!("passed the screen, but the backward elimination dropped a mode of the chosen set (ΔBIC ≤ {} without it)", o.min_delta_bic),
                             None => "passed the screen but is not in the chosen set (another set has the lower BIC)".into(),
                         }
                     ),
@@ -299,12 +302,14 @@ fn mode_candidates(c: &[CandidateReport]) -> String {
 /// One mode started at peak `p` and fitted on top of the model of `pb` (the model fixed):
 /// `ζ` from the window (the half-height width of a resonance is `2√3 ζω`), three starts
 /// (ζ, 3ζ, ζ/3) with residues by weighted linear least squares, the best refit by
-/// Levenberg–Marquardt.
+/// Levenberg–Marquardt.  It would pass the screen with no flag, a ΔBIC above
+/// `min_delta_bic` and a better fit.
 fn probe_mode(
     pb: &Problem<'_>,
     cur: &crate::diagnose::lsq::measures::Measures,
     p: &RawPeak,
     data: &Channels,
+    min_delta_bic: f64,
 ) -> Option<PeakProbe> {
     let AtPeak { fit, v, .. } = fit_at(pb, p, data)?;
     let ln2f = (2.0 * data.n_data() as f64).ln();
@@ -323,7 +328,7 @@ fn probe_mode(
     Some(PeakProbe {
         frequency_hz: fit.theta[0].exp() / TAU,
         zeta: fit.theta[1].exp(),
-        would_pass: flags.is_empty() && delta_bic > MIN_DELTA_BIC && better,
+        would_pass: flags.is_empty() && delta_bic > min_delta_bic && better,
         delta_bic,
         flags,
         improves: better,
@@ -389,8 +394,9 @@ pub(super) fn fit_at(pb: &Problem<'_>, p: &RawPeak, data: &Channels) -> Option<A
 }
 
 impl PeakProbe {
-    /// One line: what the probe found, and whether it would pass the screen.
-    fn verdict(&self, p: &RawPeak) -> String {
+    /// One line: what the probe found, and whether it would pass the screen (ΔBIC above
+    /// `min_delta_bic`).
+    fn verdict(&self, p: &RawPeak, min_delta_bic: f64) -> String {
         let at = format!(
             "one mode started here refits to {} Hz (ζ {}), ΔBIC {}",
             sig(self.frequency_hz),
@@ -402,8 +408,8 @@ impl PeakProbe {
             format!("{at}: it would pass the screen (the search did not reach it)")
         } else if !self.flags.is_empty() {
             format!("{at}: rejected: {}", self.flags.join("; "))
-        } else if self.delta_bic <= MIN_DELTA_BIC {
-            format!("{at}: too small a gain (needs ΔBIC > {MIN_DELTA_BIC})")
+        } else if self.delta_bic <= min_delta_bic {
+            format!("{at}: too small a gain (needs ΔBIC > {min_delta_bic})")
         } else if !self.improves {
             format!("{at}: more invalid data and misfit_rms not lower")
         } else {
@@ -415,6 +421,33 @@ impl PeakProbe {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A probe's verdict judges its gain by the search's threshold, not a constant: ΔBIC 25
+    /// is too small a gain under 30 and not under 10.
+    #[test]
+    fn a_probe_is_judged_by_the_threshold_of_the_settings() {
+        let p = RawPeak {
+            k: 0,
+            height: 8.0,
+            lo: 90.0,
+            hi: 110.0,
+        };
+        let probe = PeakProbe {
+            frequency_hz: 100.0 / TAU,
+            zeta: 0.01,
+            delta_bic: 25.0,
+            flags: vec![],
+            improves: true,
+            would_pass: false,
+        };
+        let strict = probe.verdict(&p, 30.0);
+        assert!(
+            strict.ends_with("too small a gain (needs ΔBIC > 30)"),
+            "{strict}"
+        );
+        let loose = probe.verdict(&p, 10.0);
+        assert!(!loose.contains("too small a gain"), "{loose}");
+    }
 
     /// Two resonance bumps and a rippled plateau on a noise floor of 1: three peaks, the
     /// resonances with windows of the half-height width `2√3 ζω`, the ripple's maxima

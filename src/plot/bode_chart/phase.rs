@@ -1,9 +1,8 @@
-//! What the two Bode figures share (`bode.rs`: `run`'s data against the nominal model, one
-//! panel per channel; `bode_overlay.rs`: `compare`'s data against one or more models): the
-//! phase conventions (the model's phase unwrapped along its grid, each datum drawn on the
-//! model's branch), the phase axis, a noise disk's phase span.  Their
-//! magnitude axes and frequency units differ on purpose (`run`: |G| on a log axis against
-//! rad/s, as in the paper's Fig. 7; `compare`: dB against Hz, the unit modes are quoted in).
+//! The phase of a Bode figure: the model's phase unwrapped along its grid, each datum drawn on
+//! the model's branch, the phase axis (multiples of 90°), a noise disk's phase span.  Both
+//! figures follow these rules, whatever their magnitude axis and frequency unit (`run`: |G| on
+//! a log axis against rad/s, as in the paper's Fig. 7; `compare`: dB against Hz, the unit
+//! modes are quoted in).
 
 use crate::plot::axis::{unwrap_deg, PhaseAxis};
 use num_complex::Complex64;
