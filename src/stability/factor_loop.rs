@@ -23,13 +23,17 @@ use num_complex::Complex64;
 /// A realization of `M̃⁻¹·[Ñ·J  I_n]`: inputs `[u; w]`, output the modal signal `ξ`.
 ///
 /// For normalized state-space factors (a `[plant]`) it is `[G  M̃⁻¹]` sharing the plant's
-/// states. For factors typed as transfer functions it is the cascade `M̃⁻¹·[Ñ·J  I]`, whose
+/// states. For factors typed as transfer functions it is `M̃⁻¹·[Ñ  I]·diag(J, I)` (built row by
+/// row when `M̃` is diagonal, see `modal_rows`, else as the cascade), whose
 /// hidden modes are poles of the (stable) factors `Ñ`, `J` and zeros of `M̃`; the latter
 /// are poles of the modal system itself, so the closed-loop eigenvalues decide the
 /// internal stability of the loop of Fig. 1 (modes that `C` does not see included).
 pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
     if let Some(ncf) = &f.realization {
         return Ok(ncf.plant_and_m_inverse());
+    }
+    if f.m.is_diagonal() {
+        return Ok(modal_rows(f)?.series(&j_and_identity(f)));
     }
     let (n, m) = (f.states(), f.inputs());
     let rows: Vec<Vec<TransferFunction>> = (0..n)
@@ -44,6 +48,67 @@ pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
     let s = StateSpace::from_tf_matrix(&nj_i).minimal(1e-12);
     let mm = StateSpace::from_tf_matrix(&f.m).minimal(1e-12);
     Ok(mm.inverse("M̃")?.series(&s))
+}
+
+/// `M̃⁻¹·[Ñ  I_n]` for a diagonal `M̃` (every `[physical]` model), one modal coordinate at a
+/// time: row `i` is `M̃ᵢᵢ⁻¹·[Ñᵢ  1]`, realized and made minimal on its own (a few states,
+/// balanced), and the rows are stacked block-diagonally. When `Ñᵢ` has the denominator of
+/// `M̃ᵢᵢ` (a mode: `Ñᵢ = b·s^k/q`, `M̃ᵢᵢ = d/q`), `q` is cancelled exactly and the row is
+/// `[b·s^k  q]/d`: 2 states per mode.
+///
+/// Why: in the cascade of the whole matrices the poles `q(s)` of `Ñ` cancel the zeros of
+/// `M̃⁻¹` only to rounding; on 20 or more lightly damped modes (10..1e4 rad/s) the minimal
+/// realization of that cascade kept all 4 states per mode (the hidden ones nearly
+/// uncontrollable and unobservable), and the filter Riccati equation of the plant did not
+/// converge (`synthesize` failed, issue 34 item 9).
+fn modal_rows(f: &Factorization) -> Result<StateSpace> {
+    let (n, m) = (f.states(), f.inputs());
+    let mut blocks = Vec::with_capacity(n);
+    for i in 0..n {
+        let mii = f.m.entry(i, i);
+        let nrow: Vec<&TransferFunction> = (0..m).map(|j| f.n.entry(i, j)).collect();
+        if nrow.iter().all(|t| t.den == mii.den) {
+            // The common case (a [physical] mode: Ñᵢ = b·s^k/q, M̃ᵢᵢ = d/q): cancel q exactly,
+            // `M̃ᵢᵢ⁻¹·[Ñᵢ  1] = [b·s^k  q]/d`, and realize that row of one denominator.
+            let mut row: Vec<TransferFunction> = nrow
+                .iter()
+                .map(|t| TransferFunction {
+                    num: t.num.clone(),
+                    den: mii.num.clone(),
+                })
+                .collect();
+            row.push(TransferFunction {
+                num: mii.den.clone(),
+                den: mii.num.clone(),
+            });
+            let tf = TfMatrix::from_rows(vec![row]).expect("one row");
+            blocks.push(StateSpace::from_tf_matrix(&tf).minimal(1e-12).balanced());
+            continue;
+        }
+        let mut row: Vec<TransferFunction> = nrow.into_iter().cloned().collect();
+        row.push(TransferFunction::gain(1.0));
+        let s = StateSpace::from_tf_matrix(&TfMatrix::from_rows(vec![row]).expect("one row"))
+            .minimal(1e-12);
+        let mi = StateSpace::from_tf_matrix(&TfMatrix::diagonal(vec![mii.clone()])).minimal(1e-12);
+        blocks.push(mi.inverse("M̃")?.series(&s).minimal(1e-12).balanced());
+    }
+    let total: usize = blocks.iter().map(StateSpace::states).sum();
+    let mut a = DMatrix::zeros(total, total);
+    let mut b = DMatrix::zeros(total, m + n);
+    let mut c = DMatrix::zeros(n, total);
+    let mut d = DMatrix::zeros(n, m + n);
+    let mut at = 0;
+    for (i, blk) in blocks.iter().enumerate() {
+        let k = blk.states();
+        a.view_mut((at, at), (k, k)).copy_from(&blk.a);
+        b.view_mut((at, 0), (k, m)).copy_from(&blk.b.columns(0, m));
+        b.view_mut((at, m + i), (k, 1)).copy_from(&blk.b.column(m));
+        c.view_mut((i, at), (1, k)).copy_from(&blk.c);
+        d.view_mut((i, 0), (1, m)).copy_from(&blk.d.columns(0, m));
+        d[(i, m + i)] = blk.d[(0, m)];
+        at += k;
+    }
+    Ok(StateSpace { a, b, c, d })
 }
 
 /// `K·C`: the controller reading the modal signal through the output matrix `C`.
