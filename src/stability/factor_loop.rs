@@ -23,17 +23,13 @@ use num_complex::Complex64;
 /// A realization of `M̃⁻¹·[Ñ·J  I_n]`: inputs `[u; w]`, output the modal signal `ξ`.
 ///
 /// For normalized state-space factors (a `[plant]`) it is `[G  M̃⁻¹]` sharing the plant's
-/// states. For factors typed as transfer functions it is `M̃⁻¹·[Ñ  I]·diag(J, I)` (built row by
-/// row when `M̃` is diagonal, see `modal_rows`, else as the cascade), whose
+/// states. For factors typed as transfer functions it is the cascade `M̃⁻¹·[Ñ·J  I]`, whose
 /// hidden modes are poles of the (stable) factors `Ñ`, `J` and zeros of `M̃`; the latter
 /// are poles of the modal system itself, so the closed-loop eigenvalues decide the
 /// internal stability of the loop of Fig. 1 (modes that `C` does not see included).
 pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
     if let Some(ncf) = &f.realization {
         return Ok(ncf.plant_and_m_inverse());
-    }
-    if f.m.is_diagonal() {
-        return Ok(modal_rows(f)?.series(&j_and_identity(f)));
     }
     let (n, m) = (f.states(), f.inputs());
     let rows: Vec<Vec<TransferFunction>> = (0..n)
@@ -144,10 +140,15 @@ pub fn theorem1_system(f: &Factorization, k: &StateSpace) -> Result<StateSpace> 
     Ok(j_and_identity(f).series(&closed))
 }
 
-/// A realization of the plant `G = C·M̃⁻¹·Ñ·J` (input `u`, output `y`), from the modal
-/// system.
+/// A realization of the plant `G = C·M̃⁻¹·Ñ·J` (input `u`, output `y`): for a diagonal `M̃`
+/// row by row (`modal_rows`: 2 states per mode, what `synthesize` needs), else from the
+/// modal system. The Theorem 1 loop keeps [`modal_system`] (its hidden modes included).
 pub fn plant_system(f: &Factorization) -> Result<StateSpace> {
-    let ms = modal_system(f)?;
+    let ms = if f.realization.is_none() && f.m.is_diagonal() {
+        modal_rows(f)?.series(&j_and_identity(f))
+    } else {
+        modal_system(f)?
+    };
     let m = f.inputs();
     Ok(StateSpace {
         a: ms.a.clone(),
