@@ -46,6 +46,67 @@ pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
     Ok(mm.inverse("M̃")?.series(&s))
 }
 
+/// `M̃⁻¹·[Ñ  I_n]` for a diagonal `M̃` (every `[physical]` model), one modal coordinate at a
+/// time: row `i` is `M̃ᵢᵢ⁻¹·[Ñᵢ  1]`, realized and made minimal on its own (a few states,
+/// balanced), and the rows are stacked block-diagonally. When `Ñᵢ` has the denominator of
+/// `M̃ᵢᵢ` (a mode: `Ñᵢ = b·s^k/q`, `M̃ᵢᵢ = d/q`), `q` is cancelled exactly and the row is
+/// `[b·s^k  q]/d`: 2 states per mode.
+///
+/// Why: in the cascade of the whole matrices the poles `q(s)` of `Ñ` cancel the zeros of
+/// `M̃⁻¹` only to rounding; on 20 or more lightly damped modes (10..1e4 rad/s) the minimal
+/// realization of that cascade kept all 4 states per mode (the hidden ones nearly
+/// uncontrollable and unobservable), and the filter Riccati equation of the plant did not
+/// converge (`synthesize` failed, issue 34 item 9).
+fn modal_rows(f: &Factorization) -> Result<StateSpace> {
+    let (n, m) = (f.states(), f.inputs());
+    let mut blocks = Vec::with_capacity(n);
+    for i in 0..n {
+        let mii = f.m.entry(i, i);
+        let nrow: Vec<&TransferFunction> = (0..m).map(|j| f.n.entry(i, j)).collect();
+        if nrow.iter().all(|t| t.den == mii.den) {
+            // The common case (a [physical] mode: Ñᵢ = b·s^k/q, M̃ᵢᵢ = d/q): cancel q exactly,
+            // `M̃ᵢᵢ⁻¹·[Ñᵢ  1] = [b·s^k  q]/d`, and realize that row of one denominator.
+            let mut row: Vec<TransferFunction> = nrow
+                .iter()
+                .map(|t| TransferFunction {
+                    num: t.num.clone(),
+                    den: mii.num.clone(),
+                })
+                .collect();
+            row.push(TransferFunction {
+                num: mii.den.clone(),
+                den: mii.num.clone(),
+            });
+            let tf = TfMatrix::from_rows(vec![row]).expect("one row");
+            blocks.push(StateSpace::from_tf_matrix(&tf).minimal(1e-12).balanced());
+            continue;
+        }
+        let mut row: Vec<TransferFunction> = nrow.into_iter().cloned().collect();
+        row.push(TransferFunction::gain(1.0));
+        let s = StateSpace::from_tf_matrix(&TfMatrix::from_rows(vec![row]).expect("one row"))
+            .minimal(1e-12);
+        let mi = StateSpace::from_tf_matrix(&TfMatrix::diagonal(vec![mii.clone()])).minimal(1e-12);
+        blocks.push(mi.inverse("M̃")?.series(&s).minimal(1e-12).balanced());
+    }
+    let total: usize = blocks.iter().map(StateSpace::states).sum();
+    let mut a = DMatrix::zeros(total, total);
+    let mut b = DMatrix::zeros(total, m + n);
+    let mut c = DMatrix::zeros(n, total);
+    let mut d = DMatrix::zeros(n, m + n);
+    let mut at = 0;
+    for (i, blk) in blocks.iter().enumerate() {
+        let k = blk.states();
+        a.view_mut((at, at), (k, k)).copy_from(&blk.a);
+        b.view_mut((at, 0), (k, m)).copy_from(&blk.b.columns(0, m));
+        b.view_mut((at, m + i), (k, 1)).copy_from(&blk.b.column(m));
+        c.view_mut((i, at), (1, k)).copy_from(&blk.c);
+        d.view_mut((i, 0), (1, m)).copy_from(&blk.d.columns(0, m));
+        d[(i, m + i)] = blk.d[(0, m)];
+        at += k;
+    }
+    Ok(StateSpace { a, b, c, d })
+}
+
 /// `K·C`: the controller reading the modal signal through the output matrix `C`.
 fn controller_on_modes(f: &Factorization, k: &StateSpace) -> StateSpace {
     StateSpace {
@@ -79,10 +140,15 @@ pub fn theorem1_system(f: &Factorization, k: &StateSpace) -> Result<StateSpace> 
     Ok(j_and_identity(f).series(&closed))
 }
 
-/// A realization of the plant `G = C·M̃⁻¹·Ñ·J` (input `u`, output `y`), from the modal
-/// system.
+/// A realization of the plant `G = C·M̃⁻¹·Ñ·J` (input `u`, output `y`): for a diagonal `M̃`
+/// row by row (`modal_rows`: 2 states per mode, what `synthesize` needs), else from the
+/// modal system. The Theorem 1 loop keeps [`modal_system`] (its hidden modes included).
 pub fn plant_system(f: &Factorization) -> Result<StateSpace> {
-    let ms = modal_system(f)?;
+    let ms = if f.realization.is_none() && f.m.is_diagonal() {
+        modal_rows(f)?.series(&j_and_identity(f))
+    } else {
+        modal_system(f)?
+    };
     let m = f.inputs();
     Ok(StateSpace {
         a: ms.a.clone(),
