@@ -18,6 +18,7 @@ pub(crate) mod eig;
 pub(crate) mod freq_eval;
 pub(crate) mod golden;
 pub(crate) mod hinf;
+pub(crate) mod hqr;
 pub(crate) mod interconnect;
 pub(crate) mod linalg;
 pub(crate) mod ncf;
