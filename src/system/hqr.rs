@@ -80,13 +80,13 @@ pub(crate) fn hessenberg_eigenvalues(mut h: DMatrix<f64>) -> Option<Vec<Complex6
             }
             kdefl += 1;
             let (mut h11, mut h12, mut h21, mut h22);
-            if kdefl % (2 * EXCEPTIONAL_EVERY) == 0 {
+            if kdefl.is_multiple_of(2 * EXCEPTIONAL_EVERY) {
                 let s = h[(iu, iu - 1)].abs() + h[(iu - 1, iu - 2)].abs();
                 h11 = 0.75 * s + h[(iu, iu)];
                 h12 = -0.4375 * s;
                 h21 = s;
                 h22 = h11;
-            } else if kdefl % EXCEPTIONAL_EVERY == 0 {
+            } else if kdefl.is_multiple_of(EXCEPTIONAL_EVERY) {
                 let s = h[(l + 1, l)].abs() + h[(l + 2, l + 1)].abs();
                 h11 = 0.75 * s + h[(l, l)];
                 h12 = -0.4375 * s;
