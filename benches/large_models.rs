@@ -22,6 +22,10 @@
 //! substitution and real GEMMs in the responses, `|r|·‖T‖∞` for a constant `r`, no dense
 //! `M̃⁻¹`, `V`, `F_L` or copy per datum or μ step on a diagonal `M̃`), the same machine and
 //! load: see the table in the session's report (docs/internals-large-models.md).
+//! Third session (`cargo bench --bench large_models -- stability_run --sample-count 1`,
+//! load 4.8–5.8): `stability_run` 25 / 50 / 100 / 200 modes 0.39 s / 0.32 s / 1.87 s /
+//! 15.2 s (norms on the row-by-row loop from 200 loop states, the structured grid value
+//! from 50 modes, the norm started from the grid's peaks, `hqr` eigenvalues from 200 × 200).
 
 #[path = "support/modes.rs"]
 #[allow(dead_code)]
@@ -36,8 +40,8 @@ fn main() {
 
 const SIZES: &[usize] = &[25, 50, 100];
 
-/// Sizes of the long benches (`stability_run` at 1000 modes is a dense eigenproblem of
-/// 8000 × 8000 per Hamiltonian iteration: not measured).
+/// Sizes of the long benches (`stability_run` at 1000 modes has dense eigenproblems of
+/// 4000 × 4000, the loop's poles and each Hamiltonian iteration: not measured).
 const STABILITY_SIZES: &[usize] = &[25, 50, 100, 200];
 const COMPARE_SIZES: &[usize] = &[50, 100, 200, 1000];
 

@@ -66,7 +66,7 @@ fn sigma_max(ev: &FreqEvaluator, omega: f64) -> f64 {
 /// [`refine_peak`] is the norm (`Ok`), unless it rises above `level`, in which case the
 /// iteration goes on from it (`Err` carries the new `(γ, ω)`).
 fn polish(
-    ev: &FreqEvaluator,
+    ev: &dyn Fn(f64) -> f64,
     gamma: f64,
     omega: f64,
     level: f64,
@@ -89,12 +89,12 @@ fn polish(
 /// (cut at the band's lower edge `lo`).
 /// Near a sharp peak two crossing eigenvalues of `H(γ)` nearly coalesce and round-off can
 /// push them off the axis; this local search recovers the last digits.
-fn refine_peak(ev: &FreqEvaluator, omega: f64, lo: f64) -> (f64, f64) {
+fn refine_peak(ev: &dyn Fn(f64) -> f64, omega: f64, lo: f64) -> (f64, f64) {
     if !(omega.is_finite() && omega > 0.0) {
-        return (sigma_max(ev, omega), omega);
+        return (ev(omega), omega);
     }
     let (a, b) = ((omega / 1.001).max(lo).ln(), (omega * 1.001).ln());
-    let (x, neg) = super::golden::golden_section_min(|x| -sigma_max(ev, x.exp()), a, b, 80);
+    let (x, neg) = super::golden::golden_section_min(|x| -ev(x.exp()), a, b, 80);
     (-neg, x.exp())
 }
 
@@ -274,7 +274,25 @@ fn dense_candidates(poles: &[Complex64], lo: f64, wmin: f64, wmax: f64) -> Vec<f
 /// `‖G‖∞` of a stable system; errors when `A` is not Hurwitz (the norm is infinite) or an
 /// eigenvalue computation fails.
 pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
-    peak_gain(ss, 0.0, true)
+    peak_gain(ss, 0.0, true, None, None)
+}
+
+/// [`hinf_norm`] started from the caller's frequencies instead of one per pole and a grid:
+/// the lower bound is `σ_max(G(jω))` at those frequencies (evaluated here on `ss`), and the
+/// Hamiltonian iteration proves the bound as always, whatever the start. For a large
+/// system whose peak the caller has located by a cheaper route (a structured grid), where
+/// the built-in candidates (one dense response per pole) would cost more than the iteration.
+///
+/// `sigma`, when given, evaluates `σ_max(G(jω))` in place of the dense response (the probes
+/// and the local polish of the peak): it must never exceed the true value (a Rayleigh
+/// quotient, a converged Lanczos value) so that `gamma` stays a lower bound; `None` from
+/// it falls back to the dense response. The upper bound is the Hamiltonian's, as always.
+pub fn hinf_norm_near(
+    ss: &StateSpace,
+    omegas: &[f64],
+    sigma: Option<&dyn Fn(f64) -> Option<f64>>,
+) -> Result<HinfNorm> {
+    peak_gain(ss, 0.0, true, Some(omegas), sigma)
 }
 
 /// `sup σ_max(G(jω))` over `ω ∈ [omega_lo, ∞]` for any `A` (stable or not): the `L∞` norm of
@@ -289,10 +307,16 @@ pub fn peak_gain_above(ss: &StateSpace, omega_lo: f64) -> Result<HinfNorm> {
             "peak gain: band edge {omega_lo} must be finite and ≥ 0"
         )));
     }
-    peak_gain(ss, omega_lo, false)
+    peak_gain(ss, omega_lo, false, None, None)
 }
 
-fn peak_gain(ss: &StateSpace, lo: f64, require_stable: bool) -> Result<HinfNorm> {
+fn peak_gain(
+    ss: &StateSpace,
+    lo: f64,
+    require_stable: bool,
+    start: Option<&[f64]>,
+    sigma: Option<&dyn Fn(f64) -> Option<f64>>,
+) -> Result<HinfNorm> {
     ss.validate("H∞ norm")?;
     // An exact similarity that keeps the Hamiltonian's eigenvalues accurate when the
     // realization has widely spread entries (companion forms of high-order weights).
@@ -318,7 +342,11 @@ fn peak_gain(ss: &StateSpace, lo: f64, require_stable: bool) -> Result<HinfNorm>
             "H∞ norm: the system is not stable (pole with real part {abscissa:.3e}); the norm is infinite"
         )));
     }
-    let ev = FreqEvaluator::new(ss);
+    let dense = FreqEvaluator::new(ss);
+    let ev = |w: f64| match sigma.and_then(|f| f(w)) {
+        Some(s) => s,
+        None => sigma_max(&dense, w),
+    };
     // Lower bound: ω = 0, ∞, the poles' natural and damped frequencies, and a log grid.
     let (mut gamma, mut omega) = (d_norm, f64::INFINITY);
     let wmax = poles
@@ -332,9 +360,16 @@ fn peak_gain(ss: &StateSpace, lo: f64, require_stable: bool) -> Result<HinfNorm>
         .filter(|w| *w > 0.0)
         .fold(f64::INFINITY, f64::min)
         .min(wmax);
-    let candidates = starting_candidates(&poles, lo, wmin, wmax);
+    let candidates = match start {
+        Some(ws) => ws
+            .iter()
+            .copied()
+            .filter(|w| *w >= lo && w.is_finite())
+            .collect(),
+        None => starting_candidates(&poles, lo, wmin, wmax),
+    };
     for w in candidates {
-        let s = sigma_max(&ev, w);
+        let s = ev(w);
         if s > gamma {
             gamma = s;
             omega = w;
@@ -400,7 +435,7 @@ fn peak_gain(ss: &StateSpace, lo: f64, require_stable: bool) -> Result<HinfNorm>
             }
         }));
         for w in probe {
-            let s = sigma_max(&ev, w);
+            let s = ev(w);
             if s > gamma {
                 gamma = s;
                 omega = w;

@@ -18,7 +18,9 @@ pub(crate) mod eig;
 pub(crate) mod freq_eval;
 pub(crate) mod golden;
 pub(crate) mod hinf;
+pub(crate) mod hqr;
 pub(crate) mod interconnect;
+pub(crate) mod lanczos;
 pub(crate) mod linalg;
 pub(crate) mod ncf;
 pub(crate) mod polynomial;
@@ -30,7 +32,7 @@ pub(crate) mod transfer_function;
 
 pub use eig::{eigenvalues, spectral_abscissa};
 pub use freq_eval::FreqEvaluator;
-pub use hinf::{hinf_norm, peak_gain_above, HinfNorm, HINF_RTOL};
+pub use hinf::{hinf_norm, hinf_norm_near, peak_gain_above, HinfNorm, HINF_RTOL};
 pub use interconnect::negative_feedback;
 pub use linalg::{extreme_singular_values, spectral_norm};
 pub use ncf::NormalizedLcf;

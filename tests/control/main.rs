@@ -14,3 +14,4 @@ mod stability;
 mod stability_special;
 mod synthesize;
 mod synthesize_hinf;
+mod synthesize_modal;

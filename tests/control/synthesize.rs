@@ -75,7 +75,7 @@ fn assert_refused(cfg: &Path, args: &[&str], out: &Path, name: Option<&str>) {
 }
 
 /// `AX + XAᵀ + Q = 0` by the Kronecker form `(I⊗A + A⊗I)vec(X) = −vec(Q)`, dense LU.
-fn lyap_kron(a: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
+pub(crate) fn lyap_kron(a: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
     let n = a.nrows();
     let id = DMatrix::<f64>::identity(n, n);
     let k = id.kronecker(a) + a.kronecker(&id);
@@ -85,7 +85,7 @@ fn lyap_kron(a: &DMatrix<f64>, q: &DMatrix<f64>) -> DMatrix<f64> {
 }
 
 /// The Hankel norm of a stable system: `√λ_max(PQ)` with its Gramians.
-fn hankel_norm(ss: &StateSpace) -> f64 {
+pub(crate) fn hankel_norm(ss: &StateSpace) -> f64 {
     let p = lyap_kron(&ss.a, &(&ss.b * ss.b.transpose()));
     let q = lyap_kron(&ss.a.transpose(), &(ss.c.transpose() * &ss.c));
     let e = rshape::system::eigenvalues(&(p * q), "pq").unwrap();
