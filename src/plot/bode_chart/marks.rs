@@ -23,7 +23,8 @@ impl MagScale {
     fn dot(self, a: f64) -> Option<f64> {
         match self {
             MagScale::Log => (a > 0.0 && a.is_finite()).then_some(a),
-            MagScale::Db => Some(db(a)),
+            // An unknown magnitude has no place; 0 sits at the floor (−6000 dB), clamped.
+            MagScale::Db => (!a.is_nan()).then(|| db(a)),
         }
     }
 
@@ -33,6 +34,9 @@ impl MagScale {
         match self {
             MagScale::Log if a > 0.0 => clamp(a, lo, hi),
             MagScale::Log => f64::NAN,
+            // `NaN.max(1e-300)` is 1e-300: without this arm an unknown model value would
+            // draw the curve down to the axis' bottom instead of breaking it.
+            MagScale::Db if a.is_nan() => f64::NAN,
             MagScale::Db => db(a),
         }
     }
@@ -239,5 +243,7 @@ mod tests {
         assert!(MagScale::Log.curve(0.0, axis).is_nan());
         assert_eq!(MagScale::Log.curve(1e6, axis), 1e3);
         assert_eq!(MagScale::Db.curve(100.0, (-1.0, 1.0)), 40.0);
+        assert!(MagScale::Db.curve(f64::NAN, (-1.0, 1.0)).is_nan());
+        assert_eq!(MagScale::Db.dot(f64::NAN), None);
     }
 }
