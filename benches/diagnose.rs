@@ -203,7 +203,13 @@ fn problem() -> (PhysicalModel, Channels) {
 fn three_effects_400_data(bencher: divan::Bencher) {
     let (base, data) = problem();
     bencher.bench(|| {
-        let d = diagnose_channels(&base, &data, &SearchSettings::default()).unwrap();
+        let d = diagnose_channels(
+            &base,
+            &data,
+            &SearchSettings::default(),
+            &Default::default(),
+        )
+        .unwrap();
         assert!(!d.chosen.is_empty());
         d
     });
@@ -231,6 +237,7 @@ fn one_step_six_modes_1000x3(bencher: divan::Bencher) {
                 max_effects: 1,
                 ..Default::default()
             },
+            &Default::default(),
         )
         .unwrap()
     });
@@ -247,6 +254,7 @@ fn siso_step_1200(bencher: divan::Bencher) {
                 max_effects: 1,
                 ..Default::default()
             },
+            &Default::default(),
         )
         .unwrap()
     });
@@ -257,7 +265,13 @@ fn siso_step_1200(bencher: divan::Bencher) {
 fn discover(base: &PhysicalModel, data: &Channels, max_steps: usize) -> (PhysicalModel, usize) {
     let mut model = base.clone();
     for step in 0..max_steps {
-        let d = diagnose_channels(&model, data, &SearchSettings::default()).unwrap();
+        let d = diagnose_channels(
+            &model,
+            data,
+            &SearchSettings::default(),
+            &Default::default(),
+        )
+        .unwrap();
         if d.verdict != DiagnoseVerdict::EffectsFound {
             return (model, step);
         }
@@ -310,5 +324,13 @@ fn complete_discovery_1000x3(bencher: divan::Bencher) {
 fn one_step_free_beam_1664x9(bencher: divan::Bencher) {
     let b = free_beam::free_beam(1, true);
     assert_eq!((b.data.omega.len(), b.data.n_ch()), (1664, 9));
-    bencher.bench(|| diagnose_channels(&b.rigid, &b.data, &SearchSettings::default()).unwrap());
+    bencher.bench(|| {
+        diagnose_channels(
+            &b.rigid,
+            &b.data,
+            &SearchSettings::default(),
+            &Default::default(),
+        )
+        .unwrap()
+    });
 }

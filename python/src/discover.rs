@@ -187,7 +187,7 @@ pub fn _diagnose(
             allow_mains,
             ..Default::default()
         };
-        let diagnosis = diagnose_channels(&base, &channels, &settings).py()?;
+        let diagnosis = diagnose_channels(&base, &channels, &settings, &Default::default()).py()?;
         let json = serde_json::to_string(&diagnosis).map_err(|e| input(e.to_string()))?;
         Ok(DiagnosisHandle {
             config,

@@ -5,7 +5,8 @@ use super::common::{fmt_g, InputArgs};
 use super::compare::channel_arg;
 use crate::diagnose::physical_from_config;
 use crate::diagnose::{
-    diagnose_channels, prepare, Channels, DiagnoseVerdict, Diagnosis, SearchSettings,
+    diagnose_channels, prepare, Channels, DiagnoseOptions, DiagnoseProgress, DiagnoseVerdict,
+    Diagnosis, SearchSettings,
 };
 use crate::diagnose::{params_text, write_revision, Apply, Revise};
 use crate::report::fmt::{fmt_pct, sig};
@@ -53,6 +54,10 @@ pub struct DiagnoseArgs {
     /// Also print where the time went: a table of the search's phases.
     #[arg(long)]
     pub verbose: bool,
+    /// From this many modes on, progress lines on stderr (a test lowers it to see them on a
+    /// small model).
+    #[arg(long, default_value_t = LARGE_MODEL_MODES, hide = true)]
+    pub progress_from_modes: usize,
 }
 
 fn parse_apply(s: &str) -> std::result::Result<Apply, String> {
@@ -98,6 +103,21 @@ fn channels(
 
 /// From this many modes on, `diagnose` announces its long search (200 modes: 15 s).
 const LARGE_MODEL_MODES: usize = 100;
+
+/// Renders one report of the library: a stage or a level as it begins at once (a few lines
+/// in all), the joint refits of a level rate-limited (one line every few seconds).
+fn show_progress(v: &super::progress::FitProgressView, p: DiagnoseProgress) {
+    match p {
+        DiagnoseProgress::Stage(what) => v.stage(what),
+        DiagnoseProgress::Level { depth, max, nodes } => v.stage(&format!(
+            "search level {depth} of at most {max}: screening {nodes} effect set{}",
+            if nodes == 1 { "" } else { "s" }
+        )),
+        DiagnoseProgress::Refits { depth, done, total } => {
+            v.count(&format!("search level {depth}, joint refit"), done, total)
+        }
+    }
+}
 
 /// Runs `rshape diagnose`.
 pub fn run(a: &DiagnoseArgs) -> Result<i32> {
@@ -157,7 +177,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     };
     // A model of hundreds of modes refits two parameters per mode in every candidate of the
     // search, silent for minutes (issue 34: 1000 modes ran 300 s without a line): say so.
-    let view = (base.mode.len() >= LARGE_MODEL_MODES).then(|| {
+    let view = (base.mode.len() >= a.progress_from_modes).then(|| {
         let v = super::progress::FitProgressView::new("diagnose");
         v.stage(&format!(
             "a model of {} modes: the retune of every configured parameter, then the candidate search (each candidate refits them jointly; minutes at this size)",
@@ -165,7 +185,15 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         ));
         v
     });
-    let d = diagnose_channels(&base, &data, &settings)?;
+    let tell = |p: DiagnoseProgress| {
+        if let Some(v) = &view {
+            show_progress(v, p);
+        }
+    };
+    let options = DiagnoseOptions {
+        progress: view.is_some().then_some(&tell as _),
+    };
+    let d = diagnose_channels(&base, &data, &settings, &options)?;
     drop(view);
     if let (Some(what), Some(out)) = (a.apply, &a.write) {
         let rev = write_revision(

@@ -58,6 +58,12 @@ impl FitProgressView {
         ));
     }
 
+    /// Renders a count inside a long stage (`what`: `search level 2, joint refits`), at most
+    /// one line every few seconds when stderr is not a terminal.
+    pub fn count(&self, what: &str, done: usize, total: usize) {
+        self.show(format!("{}: {what} {done} of {total}", self.stage_label()));
+    }
+
     /// Announces a long stage at once (a line even when stderr is not a terminal): a large
     /// model's loop, whose dense eigenvalue problems give no report while they run.
     pub fn stage(&self, what: &str) {

@@ -25,6 +25,7 @@ use crate::diagnose::effects::candidates::sig;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
+use crate::diagnose::progress::{DiagnoseOptions, DiagnoseProgress::Stage};
 use crate::diagnose::report::{
     DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
 };
@@ -51,6 +52,7 @@ pub fn diagnose(base: &PhysicalModel, siso: &Siso, max_effects: usize) -> Result
             max_effects,
             ..Default::default()
         },
+        &Default::default(),
     )
 }
 
@@ -59,10 +61,12 @@ fn measures(m: &PhysicalModel, data: &Channels) -> Result<Measures> {
 }
 
 /// Diagnoses the channels `data` jointly: retune, search, final holdout, report.
+/// `options.progress` hears of each stage and search level as it begins.
 pub fn diagnose_channels(
     base: &PhysicalModel,
     data: &Channels,
     s: &SearchSettings,
+    options: &DiagnoseOptions<'_>,
 ) -> Result<Diagnosis> {
     let t0 = Instant::now();
     // Settings first: a bad one is an error even where the search would not run.
@@ -122,6 +126,7 @@ pub fn diagnose_channels(
     }
     let mut phases = Phases::default();
     // The configured model's screen does not need the retune: both at once.
+    options.tell(Stage("retune"));
     let (roots, first_screen) = phases.time("retune", || {
         rayon::join(|| roots(base, data), || screen_configured(base, data))
     });
@@ -132,7 +137,13 @@ pub fn diagnose_channels(
     let moved = changes(base, &root_model, data);
     // Information criteria use the least-squares costs (the polish may raise `measures.v`).
     let v_ret = retuned_node.v_fit;
-    let mut res = search(vec![configured, retuned_node], data, s, Some(first_screen))?;
+    let mut res = search(
+        vec![configured, retuned_node],
+        data,
+        s,
+        Some(first_screen),
+        options,
+    )?;
     for p in &res.phases.0 {
         phases.add(p.phase, p.seconds, p.count);
     }
@@ -145,9 +156,11 @@ pub fn diagnose_channels(
         v_ret,
         min_delta_bic: s.min_delta_bic,
     };
+    options.tell(Stage("first level"));
     let mut candidates = phases.time("first level", || ranked_candidates(&root, &res, data))?;
     // The chosen set, its final holdout, backward elimination, last refit, runner-ups, ties.
     // When the holdout drops part of the chosen set, the next-best sets are tried.
+    options.tell(Stage("holdout"));
     let crate::diagnose::search::holdout::Passing {
         mut node,
         holdout,
@@ -160,6 +173,7 @@ pub fn diagnose_channels(
     })?;
     // Runner-ups and ties are then relative to the set kept.
     res.chosen = replaced_by.unwrap_or(res.chosen);
+    options.tell(Stage("backward elimination"));
     let eliminated = phases.time("backward elimination", || {
         crate::diagnose::search::backward::eliminate(
             base,
@@ -169,6 +183,7 @@ pub fn diagnose_channels(
             s.min_delta_bic,
         )
     })?;
+    options.tell(Stage("final refit"));
     let dampings_not_identified = phases.time("final refit", || {
         crate::diagnose::search::final_refit::final_refit(&mut node, base, data)
     })?;
@@ -180,12 +195,14 @@ pub fn diagnose_channels(
     );
     let runner_up = runner_ups(&res);
     let chosen_labels = node.labels();
+    options.tell(Stage("ties"));
     let ties = phases.time("ties", || {
         let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
         ties.extend(candidate_ties(&mut candidates, &ties, data));
         ties
     });
     let after = node.measures;
+    options.tell(Stage("peak account"));
     let (peaks, peaks_not_listed) = phases.time("peak account", || {
         crate::diagnose::search::peaks::account(
             &crate::diagnose::search::peaks::Outcome {

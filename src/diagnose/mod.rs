@@ -41,6 +41,7 @@ pub(crate) mod engine;
 pub(crate) mod factor_form;
 pub(crate) mod lsq;
 pub(crate) mod plant_form;
+pub(crate) mod progress;
 pub(crate) mod report;
 pub(crate) mod revision;
 pub(crate) mod search;
@@ -58,6 +59,7 @@ pub use lsq::lm::{lm, LmResult};
 pub use lsq::measures::Measures as ErrorMeasures;
 pub use lsq::retune::{cost, refit_nominal, retune, retune_within, NominalRefit};
 pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSION_TOL};
+pub use progress::{DiagnoseOptions, DiagnoseProgress, DiagnoseProgressFn};
 pub use report::{
     CandidateReport, DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout,
     Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,

@@ -267,16 +267,21 @@ fn attained_min(sq: &SquaredMagnitude, xa: f64, xb: f64, b2: f64) -> (f64, f64, 
     (best.0, best.1, n + 63)
 }
 
+/// The largest `(g/b)²` [`check_interval`] works with (see there).
+const GAIN2_CAP: f64 = 1e150;
+
 /// Proves (or refutes) `|r(jω)| ≥ bound·(1 − TOL)` on `[w_a, w_b]` and brackets the minimum
 /// of `|r|/bound` where it dips.
 pub fn check_interval(sq: &SquaredMagnitude, w_a: f64, w_b: f64, bound: f64) -> IntervalCheck {
     // Prescaled: the bound goes into the gain as (g/b)², so that a bound of 1e-300 (whose
     // square underflows to 0) does not turn every ratio into inf and the proof into a
-    // spurious "did not close". A ratio beyond 1e300 is capped there: a smaller gain only
-    // makes the proof harder, so what is proved with the cap holds without it.
+    // spurious "did not close". A squared ratio beyond 1e150 is capped there: a smaller gain
+    // only makes the proof harder, so what is proved with the cap holds without it. The cap
+    // leaves room for the zero and pole norms the Bernstein test multiplies in (at 1e300,
+    // an order-4 r over a 1e-200 bound overflowed to inf there and the proof failed).
     let ratio = sq.gain2.sqrt() / bound;
     let scaled = SquaredMagnitude {
-        gain2: (ratio * ratio).min(1e300),
+        gain2: (ratio * ratio).min(GAIN2_CAP),
         zeros: sq.zeros.clone(),
         poles: sq.poles.clone(),
     };
@@ -421,6 +426,16 @@ mod tests {
         }
         let c = check_interval(&sq, 1.0, 2.0, 10.0 * r.mag(2.0));
         assert!(c.lower < 1.0 && c.attained < 0.2, "{c:?}");
+        // Order 4 with zeros far above the interval: the Bernstein test multiplies the
+        // capped (g/b)² by the zero norms (~1e24 here); a cap of 1e300 overflowed to inf and
+        // the proof failed for b = 1e-200 (`rshape fit --envelope`, orders 4–8 refused).
+        let far = [(-1000.0, 0.0); 4];
+        let r4 = zpk(1.0, &far, &[(-1.0, 0.0); 4]);
+        let sq4 = SquaredMagnitude::new(&r4);
+        for b in [1e-200, 1e-300] {
+            let c = check_interval(&sq4, 1.0, 2.0, b);
+            assert!(!c.capped && c.lower >= 1.0 - TOL, "b = {b}: {c:?}");
+        }
     }
 
     #[test]

@@ -21,6 +21,7 @@ mod figures_extreme;
 mod figures_glance;
 mod fuzz_inputs;
 mod hardening_iii;
+mod hardening_iii_gaps;
 mod hardening_iii_minor;
 mod kill_safety;
 mod output_modes;

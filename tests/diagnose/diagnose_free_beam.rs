@@ -77,7 +77,8 @@ fn chain(
     let mut m = start.clone();
     let mut out = Vec::new();
     for step in 1..=6 {
-        let d = diagnose_channels(&m, data, &SearchSettings::default()).unwrap();
+        let d =
+            diagnose_channels(&m, data, &SearchSettings::default(), &Default::default()).unwrap();
         eprintln!("step {step}: {:?} {}", d.verdict, d.message);
         for r in &d.refused {
             eprintln!("  refused: {:?}", r.refusal);

@@ -85,7 +85,7 @@ fn hopeless_children_are_given_up_and_the_data_are_still_explained() {
         max_effects: 1,
         ..Default::default()
     };
-    let d = diagnose_channels(&model(&CONFIGURED, 1.005), &data, &s).unwrap();
+    let d = diagnose_channels(&model(&CONFIGURED, 1.005), &data, &s, &Default::default()).unwrap();
     assert!(
         d.search.refits_given_up >= 1,
         "no refit given up ({} joint refits)",

@@ -70,7 +70,7 @@ fn a_shared_missing_mode_is_found_once_with_a_residue_per_output() {
         radius: r,
         radius_source: vec!["synthetic".into(); 2],
     };
-    let d = diagnose_channels(&b, &data, &SearchSettings::default()).unwrap();
+    let d = diagnose_channels(&b, &data, &SearchSettings::default(), &Default::default()).unwrap();
     println!("{}: chosen {:?} {:?}", d.message, d.chosen, d.final_effects);
     let modes: Vec<_> = d
         .final_effects

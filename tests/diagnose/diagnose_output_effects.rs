@@ -82,7 +82,13 @@ fn data(truth: &PhysicalModel, seed: u64) -> Channels {
 }
 
 fn run(truth: &PhysicalModel, seed: u64) -> Diagnosis {
-    let d = diagnose_channels(&base(), &data(truth, seed), &SearchSettings::default()).unwrap();
+    let d = diagnose_channels(
+        &base(),
+        &data(truth, seed),
+        &SearchSettings::default(),
+        &Default::default(),
+    )
+    .unwrap();
     println!(
         "seed {seed}: {} chosen {:?} {:?}",
         d.message, d.chosen, d.final_effects

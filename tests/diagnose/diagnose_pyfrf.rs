@@ -92,7 +92,7 @@ fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
         ..Default::default()
     };
     // Step 1 from the mass line: the 900 Hz mode (the largest peak).
-    let d1 = diagnose_channels(&mass_line(), &data, &s).unwrap();
+    let d1 = diagnose_channels(&mass_line(), &data, &s, &Default::default()).unwrap();
     let with_900 = d1.final_model.clone();
     assert_eq!(with_900.mode.len(), 1, "{}", d1.message);
     let f900 = with_900.mode[0].omega_n / TAU;
@@ -128,7 +128,7 @@ fn the_810_hz_mode_lowers_the_held_out_error_in_every_split_and_is_kept() {
         );
     }
     // The diagnosis from the model with the 900 Hz mode adds the 810 Hz mode and keeps it.
-    let d2 = diagnose_channels(&with_900, &data, &s).unwrap();
+    let d2 = diagnose_channels(&with_900, &data, &s, &Default::default()).unwrap();
     println!("{}\n{:?}\n{:?}", d2.message, d2.holdout, d2.dropped);
     assert!(d2.dropped.is_empty(), "{:?}", d2.dropped);
     let f: Vec<f64> = d2
@@ -167,7 +167,7 @@ fn walk(data: &Channels, max_steps: usize) -> Vec<Diagnosis> {
             beam: 3,
             ..Default::default()
         };
-        let d = diagnose_channels(&m, data, &s).unwrap();
+        let d = diagnose_channels(&m, data, &s, &Default::default()).unwrap();
         let modes: Vec<String> = d
             .final_model
             .mode
@@ -387,7 +387,7 @@ fn step_1_raises_the_invalid_fraction_only_against_the_configured_model() {
         beam: 3,
         ..Default::default()
     };
-    let d1 = diagnose_channels(&accelerance_mass_line(), &data, &s).unwrap();
+    let d1 = diagnose_channels(&accelerance_mass_line(), &data, &s, &Default::default()).unwrap();
     let m1 = &d1.final_model.mode[0];
     let (wn, z) = (m1.omega_n, m1.zeta);
     let (rms0, inv0) = (d1.before.misfit_rms, d1.before.invalid_fraction);

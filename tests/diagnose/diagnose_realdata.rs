@@ -34,7 +34,8 @@ fn ballscrew_from_a_rough_rigid_body_finds_the_axial_mode_in_band() {
         beam: 2,
         ..Default::default()
     };
-    let d = diagnose_channels(c.physical.as_ref().unwrap(), &data, &s).unwrap();
+    let d =
+        diagnose_channels(c.physical.as_ref().unwrap(), &data, &s, &Default::default()).unwrap();
     println!("{}", d.message);
     // The retune fixes the 6× gain error (the issue's "mode at 37 rad/s with ζ = 1e-4 and a
     // negative residue" does not appear).

@@ -37,7 +37,13 @@ fn data() -> Channels {
 
 #[test]
 fn a_bad_min_delta_bic_is_refused_even_on_a_consistent_model() {
-    let ok = diagnose_channels(&model(), &data(), &SearchSettings::default()).expect("valid");
+    let ok = diagnose_channels(
+        &model(),
+        &data(),
+        &SearchSettings::default(),
+        &Default::default(),
+    )
+    .expect("valid");
     assert!(
         ok.message.contains("nothing needs to be added"),
         "{}",
@@ -48,7 +54,7 @@ fn a_bad_min_delta_bic_is_refused_even_on_a_consistent_model() {
             min_delta_bic: x,
             ..Default::default()
         };
-        let e = diagnose_channels(&model(), &data(), &s).unwrap_err();
+        let e = diagnose_channels(&model(), &data(), &s, &Default::default()).unwrap_err();
         assert_eq!(
             e.to_string(),
             format!("SearchSettings.min_delta_bic = {shown}: must be a finite number ≥ 0")
@@ -58,6 +64,6 @@ fn a_bad_min_delta_bic_is_refused_even_on_a_consistent_model() {
         beam: 0,
         ..Default::default()
     };
-    let e = diagnose_channels(&model(), &data(), &s).unwrap_err();
+    let e = diagnose_channels(&model(), &data(), &s, &Default::default()).unwrap_err();
     assert_eq!(e.to_string(), "SearchSettings.beam = 0: must be at least 1");
 }

@@ -23,6 +23,7 @@ mod diagnose_holdout;
 mod diagnose_honest_report;
 mod diagnose_mimo;
 mod diagnose_output_effects;
+mod diagnose_progress;
 mod diagnose_pyfrf;
 mod diagnose_realdata;
 mod diagnose_retune_changes;

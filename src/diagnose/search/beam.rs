@@ -283,7 +283,9 @@ pub fn search(
     data: &Channels,
     s: &SearchSettings,
     mut first_screen: Option<Vec<Screened>>,
+    options: &crate::diagnose::progress::DiagnoseOptions<'_>,
 ) -> Result<SearchResult> {
+    use crate::diagnose::progress::DiagnoseProgress::{Level, Refits};
     s.validate()?;
     let mut level: Vec<usize> = (0..roots.len()).collect();
     // The configured model: the anchor of every refit's boxes.
@@ -299,6 +301,11 @@ pub fn search(
         if level.iter().any(|i| nodes[*i].measures.consistent()) {
             break;
         }
+        options.tell(Level {
+            depth,
+            max: s.max_effects,
+            nodes: level.len(),
+        });
         let mut children: Vec<Node> = Vec::new();
         // Every node of the level is screened, then the children of all of them are refit in
         // one batch: independent computations in parallel (rayon's indexed collects keep
@@ -335,6 +342,7 @@ pub fn search(
             })
             .collect();
         let t_refit = std::time::Instant::now();
+        let finished = std::sync::atomic::AtomicUsize::new(0);
         let done: Vec<Result<Option<(Refit, Measures)>>> = jobs
             .par_iter()
             .map(|&(li, j)| {
@@ -361,6 +369,14 @@ pub fn search(
                 let (v_fit, n_params) = (r.v_after, r.n_params);
                 settle(r.model, &anchor, data)
                     .map(|(model, m)| Some(((model, m, v_fit, n_params), before)))
+            })
+            .inspect(|_| {
+                let n = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                options.tell(Refits {
+                    depth,
+                    done: n,
+                    total: jobs.len(),
+                });
             })
             .collect();
         phases.add("joint refits", t_refit.elapsed().as_secs_f64(), jobs.len());

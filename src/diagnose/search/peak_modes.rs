@@ -254,7 +254,8 @@ mod tests {
     fn a_refused_mains_peak_does_not_hide_the_modes_beside_it() {
         let (d, base) = (data(), model(&[0]));
         let s = SearchSettings::default();
-        let r = crate::diagnose::engine::diagnose_channels(&base, &d, &s).unwrap();
+        let r =
+            crate::diagnose::engine::diagnose_channels(&base, &d, &s, &Default::default()).unwrap();
         let modes: Vec<f64> = r.final_model.mode.iter().map(|m| m.omega_n / TAU).collect();
         let has = |f: f64| modes.iter().any(|x| (x / f - 1.0).abs() < 1e-3);
         assert!(has(137.3) && has(263.7), "{modes:?}: {}", r.message);
@@ -279,7 +280,8 @@ mod tests {
     fn passing_modes_are_also_proposed_together_in_one_step() {
         let (d, base) = (data_with((0.01, 0.02)), model(&[0]));
         let s = SearchSettings::default();
-        let r = crate::diagnose::engine::diagnose_channels(&base, &d, &s).unwrap();
+        let r =
+            crate::diagnose::engine::diagnose_channels(&base, &d, &s, &Default::default()).unwrap();
         let modes: Vec<f64> = r.final_model.mode.iter().map(|m| m.omega_n / TAU).collect();
         let has = |f: f64| modes.iter().any(|x| (x / f - 1.0).abs() < 1e-3);
         assert!(has(137.3) && has(263.7), "{modes:?}: {}", r.message);
