@@ -24,8 +24,8 @@ fn norm(a: &[Complex64]) -> f64 {
     a.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt()
 }
 
-/// `σ_max(T)` for `T` with `cols` columns, given `t(x) = T·x` and `th(y) = Tᴴ·y`; `start` is
-/// the first Krylov vector (any nonzero vector; a deterministic one is used when `None`).
+/// `σ_max(T)` for `T` with `cols` columns, given `t(x) = T·x` and `th(y) = Tᴴ·y`; the first
+/// Krylov vector is a fixed one with no zero component (results are reproducible).
 pub(crate) fn largest_singular_value(
     cols: usize,
     t: impl Fn(&[Complex64]) -> Vec<Complex64>,
