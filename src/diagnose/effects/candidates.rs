@@ -51,6 +51,13 @@ impl Cand {
         with_effect!(self, e => e.n_params(n_ch))
     }
 
+    /// True when the candidate can change channel `entry`: an additive term changes every
+    /// channel, a path effect those its selection hits ([`Sel::hits`]; its `modify` leaves
+    /// the others as they are).
+    pub fn acts_on(&self, entry: (usize, usize)) -> bool {
+        with_effect!(self, e => e.sel().is_none_or(|s| s.hits(entry)))
+    }
+
     /// True for effects that multiply the model (spread over the band): the path effects.
     pub fn multiplicative(&self) -> bool {
         with_effect!(self, e => e.sel().is_some())

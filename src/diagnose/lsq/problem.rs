@@ -28,6 +28,10 @@ pub struct Problem<'a> {
     rigid_rho: Vec<Vec<f64>>,
     /// The record's lower bound on ζ ([`super::resolution::band_floor`]).
     pub(crate) zeta_floor: f64,
+    /// The weighted residual of the base model, `(G_d − core₀·path₀)/σ`, `[ch][k]`: the rows
+    /// of [`Problem::residual`] on a channel no effect of the model acts on (a path effect
+    /// on one input leaves the other channels as they are), computed once.
+    e0: Vec<Vec<Complex64>>,
 }
 
 /// A model: the base plus effects with their internal parameters (concatenated).
@@ -70,8 +74,8 @@ impl<'a> Problem<'a> {
     /// Sets up the problem.
     pub fn new(base: &'a PhysicalModel, data: &'a Channels) -> Result<Self> {
         check_shapes(base, data)?;
-        let mut core0 = Vec::new();
-        let mut path0 = Vec::new();
+        let mut core0: Vec<Vec<Complex64>> = Vec::new();
+        let mut path0: Vec<Vec<Complex64>> = Vec::new();
         let cores: Vec<DMatrix<Complex64>> =
             data.omega.iter().map(|w| base.eval_core(*w)).collect();
         for e in &data.entries {
@@ -87,19 +91,29 @@ impl<'a> Problem<'a> {
         };
         let mode_rho = table(base.mode.len(), Cand::ModeShift);
         let rigid_rho = table(base.rigid_body.len(), Cand::Friction);
+        let inv_sigma: Vec<Vec<f64>> = data
+            .radius
+            .iter()
+            .map(|r| r.iter().map(|x| std::f64::consts::SQRT_2 / x).collect())
+            .collect();
+        // The same expression as the residual's, so a cached row is the row it replaces.
+        let e0 = (0..data.n_ch())
+            .map(|ch| {
+                (0..data.len())
+                    .map(|k| (data.g[ch][k] - core0[ch][k] * path0[ch][k]) * inv_sigma[ch][k])
+                    .collect()
+            })
+            .collect();
         Ok(Self {
             base,
             data,
             mode_rho,
             rigid_rho,
-            inv_sigma: data
-                .radius
-                .iter()
-                .map(|r| r.iter().map(|x| std::f64::consts::SQRT_2 / x).collect())
-                .collect(),
+            inv_sigma,
             core0,
             path0,
             zeta_floor: super::resolution::band_floor(data),
+            e0,
         })
     }
 
@@ -220,6 +234,15 @@ impl<'a> Problem<'a> {
         out.clear();
         let nat = self.naturals_of(mods);
         for ch in 0..self.n_ch() {
+            let entry = self.data.entries[ch];
+            if !mods.cands.iter().any(|c| c.acts_on(entry)) {
+                for &k in mask {
+                    let e = self.e0[ch][k];
+                    out.push(e.re);
+                    out.push(e.im);
+                }
+                continue;
+            }
             for &k in mask {
                 let (c, p) = self.parts_nat(mods, &nat, ch, Some(k), self.data.omega[k]);
                 let e = (self.data.g[ch][k] - c * p) * self.inv_sigma[ch][k];
