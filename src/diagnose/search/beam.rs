@@ -29,7 +29,6 @@
 use crate::diagnose::admissible::Refusal;
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
 use crate::diagnose::lsq::retune::{retune, retune_or_give_up};
 use crate::diagnose::report::Phases;
@@ -341,9 +340,22 @@ pub fn search(
                     .chain(e.multi.iter().map(move |_| (li, None)))
             })
             .collect();
+        // Each job's judge (likelihood, admissibility): against the node, or, for the
+        // configured model, the better of it and its retune.
+        let reference_of = |li: usize| {
+            let node = &nodes[level[li]];
+            if node.configured && nodes[1].v_fit < node.v_fit {
+                nodes[1].measures
+            } else {
+                node.measures
+            }
+        };
         let t_refit = std::time::Instant::now();
         let finished = std::sync::atomic::AtomicUsize::new(0);
-        let done: Vec<Result<Option<(Refit, Measures)>>> = jobs
+        // Each job refit and judged (the child and the refusal), `None` when the refit gave
+        // up; the judges are independent too, so they run beside the refits.
+        type Judged = Option<(Option<Node>, Option<Refusal>)>;
+        let done: Vec<Result<Judged>> = jobs
             .par_iter()
             .map(|&(li, j)| {
                 let node = &nodes[level[li]];
@@ -367,8 +379,20 @@ pub fn search(
                     return Ok(None);
                 }
                 let (v_fit, n_params) = (r.v_after, r.n_params);
-                settle(r.model, &anchor, data)
-                    .map(|(model, m)| Some(((model, m, v_fit, n_params), before)))
+                let (model, m) = settle(r.model, &anchor, data)?;
+                let refit: Refit = (model, m, v_fit, n_params);
+                let reference = reference_of(li);
+                let judge = Judge {
+                    data,
+                    min_delta_bic: s.min_delta_bic,
+                    allow_mains: s.allow_mains,
+                    anchor: &anchor,
+                    retuned: &nodes[1].model,
+                    reference: &reference,
+                    ref_v: e.ref_v,
+                    depth,
+                };
+                Ok(Some(judge_child(&judge, node, &group, refit, before)))
             })
             .inspect(|_| {
                 let n = finished.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -380,27 +404,10 @@ pub fn search(
             })
             .collect();
         phases.add("joint refits", t_refit.elapsed().as_secs_f64(), jobs.len());
-        // The refits in job order: node by node, candidate by candidate, then the group.
+        // The judged refits in job order: node by node, candidate by candidate, then the
+        // group.
         let mut done = done.into_iter();
         for (&ni, e) in level.iter().zip(&expansions) {
-            let node = nodes[ni].clone();
-            // Physical admissibility of a joint refit is judged against the node (or, for
-            // the configured model, the better of it and its retune).
-            let reference = if node.configured && nodes[1].v_fit < node.v_fit {
-                nodes[1].measures
-            } else {
-                node.measures
-            };
-            let judge = Judge {
-                data,
-                min_delta_bic: s.min_delta_bic,
-                allow_mains: s.allow_mains,
-                anchor: &anchor,
-                retuned: &nodes[1].model,
-                reference: &reference,
-                ref_v: e.ref_v,
-                depth,
-            };
             let mut note = |refusal: &Option<Refusal>| {
                 if let Some(r) = refusal {
                     let seen = refused.iter().any(|(_, x): &(usize, Refusal)| {
@@ -425,16 +432,15 @@ pub fn search(
                 }
                 let mut child_node = None;
                 let mut first_refusal = None;
-                if let Some(refit) = go.then(|| done.next()).flatten() {
+                if let Some(judged) = go.then(|| done.next()).flatten() {
                     joint_refits += 1;
-                    let Some((refit, before)) = refit? else {
+                    let Some((child, refusal)) = judged? else {
                         gave_up += 1;
                         if depth == 1 && ni == 0 && !extra {
                             first_level.push((sc.clone(), None, None));
                         }
                         continue;
                     };
-                    let (child, refusal) = judge_child(&judge, &node, &[sc], refit, before);
                     note(&refusal);
                     first_refusal = refusal;
                     if let Some(c) = child {
@@ -447,20 +453,18 @@ pub fn search(
                 }
             }
             if let Some(group) = &e.multi {
-                let refit = done.next().expect("a refit per job");
+                let judged = done.next().expect("a refit per job");
                 joint_refits += 1;
-                let Some((refit, before)) = refit? else {
+                let Some((child, refusal)) = judged? else {
                     gave_up += 1;
                     continue;
                 };
-                let added: Vec<&Screened> = group.iter().collect();
                 multi_modes_hz.push(
-                    added
+                    group
                         .iter()
                         .map(|sc| sc.mods.theta[0].exp() / std::f64::consts::TAU)
                         .collect(),
                 );
-                let (child, refusal) = judge_child(&judge, &node, &added, refit, before);
                 note(&refusal);
                 children.extend(child);
             }
