@@ -105,11 +105,38 @@ where
 /// forward-difference Jacobian used at this point instead.
 pub type JacobianFn<'a> = dyn Fn(&[f64], &[f64], &mut DMatrix<f64>) -> bool + 'a;
 
+/// The normal equations supplied by the caller: `normal(θ, r(θ))` returns `(JᵀJ, Jᵀr)` of
+/// the residual's Jacobian at `θ` (from a structure the caller knows, without forming the
+/// tall `J`: [`crate::diagnose::lsq::varpro::VarPro::normal`]), or `None` to have the
+/// Jacobian ([`JacobianFn`], else forward differences) used at this point.
+pub type NormalFn<'a> = dyn Fn(&[f64], &[f64]) -> Option<(DMatrix<f64>, DVector<f64>)> + 'a;
+
 /// [`lm_box`] with a Jacobian supplied by the caller (an analytic or variable-projection
 /// one, as the retune uses); the forward-difference one wherever `jac` declines.
 #[allow(clippy::too_many_arguments)]
 pub fn lm_box_jac<F>(
     f: F,
+    jac_fn: &JacobianFn<'_>,
+    theta0: &[f64],
+    typ: &[f64],
+    lo: &[f64],
+    hi: &[f64],
+    settings: &LmSettings,
+) -> LmResult
+where
+    F: Fn(&[f64], &mut Vec<f64>),
+{
+    lm_box_normal(f, &|_, _| None, jac_fn, theta0, typ, lo, hi, settings)
+}
+
+/// [`lm_box_jac`] with the normal equations `(JᵀJ, Jᵀr)` supplied by the caller where it
+/// can ([`NormalFn`]); `JᵀJ` and `Jᵀr` from the Jacobian (`jac_fn`, else forward
+/// differences) wherever `normal` declines.  Only `JᵀJ` and `Jᵀr` enter a step, so the
+/// iteration is the same.
+#[allow(clippy::too_many_arguments)]
+pub fn lm_box_normal<F>(
+    f: F,
+    normal: &NormalFn<'_>,
     jac_fn: &JacobianFn<'_>,
     theta0: &[f64],
     typ: &[f64],
@@ -134,9 +161,13 @@ where
     };
     let mut v = ss(&r);
     let m = r.len();
-    let mut jac = DMatrix::<f64>::zeros(m, n);
+    // Formed only where the caller's normal equations decline (`m × n` may be large).
+    let mut jac = DMatrix::<f64>::zeros(0, n);
     let mut rp = Vec::new();
     let jacobian = |theta: &[f64], r: &[f64], jac: &mut DMatrix<f64>, rp: &mut Vec<f64>| {
+        if jac.nrows() != m {
+            *jac = DMatrix::zeros(m, n);
+        }
         if jac_fn(theta, r, jac) {
             return;
         }
@@ -151,6 +182,16 @@ where
             t[i] = theta[i];
         }
     };
+    // `(JᵀJ, Jᵀr)` at θ: the caller's, else from the Jacobian (one transposed copy for both
+    // products: the blocked product beats dot products).
+    let normal_eq = |theta: &[f64], r: &[f64], jac: &mut DMatrix<f64>, rp: &mut Vec<f64>| {
+        if let Some(ne) = normal(theta, r) {
+            return ne;
+        }
+        jacobian(theta, r, jac, rp);
+        let jt = jac.transpose();
+        (&jt * &*jac, &jt * DVector::from_column_slice(r))
+    };
     if n == 0 || !v.is_finite() {
         return LmResult {
             theta,
@@ -159,7 +200,7 @@ where
             abandoned: false,
         };
     }
-    jacobian(&theta, &r, &mut jac, &mut rp);
+    let (mut jtj, mut g) = normal_eq(&theta, &r, &mut jac, &mut rp);
     let mut lambda = 1e-3;
     let mut trial = Vec::new();
     let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -175,10 +216,6 @@ where
             abandoned = true;
             break;
         }
-        // One transposed copy for both products (the blocked product beats dot products).
-        let jt = jac.transpose();
-        let jtj = &jt * &jac;
-        let g = &jt * DVector::from_column_slice(&r);
         let dmax = (0..n).map(|i| jtj[(i, i)]).fold(0.0, f64::max).max(1e-300);
         // Active bounds: a parameter on a bound that the descent direction pushes outward is
         // held there (its row and column leave the step), so the projection of the step
@@ -277,9 +314,8 @@ where
         if !improved {
             break;
         }
-        jacobian(&theta, &r, &mut jac, &mut rp);
+        (jtj, g) = normal_eq(&theta, &r, &mut jac, &mut rp);
     }
-    let jtj = jac.transpose() * &jac;
     LmResult {
         theta,
         v,

@@ -23,7 +23,7 @@
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
+use crate::diagnose::lsq::lm::{lm_box_normal, LmSettings};
 use crate::diagnose::lsq::slots::{
     anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
     MODE_BOX,
@@ -299,8 +299,9 @@ fn refit_holding(
             mask,
             typ: &typ,
         };
-        let res = lm_box_jac(
+        let res = lm_box_normal(
             resid,
+            &|th: &[f64], r: &[f64]| vp.normal(th, r),
             &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| vp.jacobian(th, j),
             &theta0,
             &typ,

@@ -199,6 +199,90 @@ impl VarPro<'_> {
         }
     }
 
+    /// The normal equations `(JᵀJ, Jᵀr)` of [`VarPro::jacobian`]'s `J` at `θ` against the
+    /// residual `r`, without forming `J` (`m × K`, `m` the rows): with `J = u + Q c`
+    /// (`u = −U`, `c = z − Qᵀu`, `z = −Z`) and `QᵀQ = I`,
+    ///
+    /// `JᵀJ = uᵀu − (Qᵀu)ᵀ(Qᵀu) + zᵀz`,   `Jᵀr = uᵀr + cᵀ(Qᵀr)`,
+    ///
+    /// and `uᵀu` is summed channel by channel over the columns that are not zero there (an
+    /// input gain's `A_k` lives on its input's channels only): `Σ_ch n_ch² · rows` instead
+    /// of `K² m`.  One least-squares block over every row only (one output, or SISO);
+    /// `None` otherwise, where a block is rank-deficient or a value is not finite.
+    pub fn normal(&self, th: &[f64], r: &[f64]) -> Option<(DMatrix<f64>, DVector<f64>)> {
+        let mm = self.model(th);
+        let (a, y) = design(&mm, self.lin, self.data, self.mask);
+        let rows_per_ch = 2 * self.mask.len();
+        let m = a.nrows();
+        if r.len() != m {
+            return None;
+        }
+        let fact = factor(&a, self.lin, self.data, rows_per_ch)?;
+        let [b] = fact.as_slice() else {
+            return None;
+        };
+        if b.rows.len() != m || b.rows.iter().enumerate().any(|(i, r)| i != *r) {
+            return None;
+        }
+        let n = self.lin.len();
+        let mut x = DVector::<f64>::zeros(n);
+        let qty = b.q.tr_mul(&y);
+        let zsol = b.r.solve_upper_triangular(&qty)?;
+        for (i, j) in b.cols.iter().enumerate() {
+            x[*j] = zsol[i] / b.scale[i];
+        }
+        if x.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let res = &y - &a * &x;
+        let kk = self.nl.len();
+        let mut u = DMatrix::<f64>::zeros(m, kk);
+        let mut t_all = DMatrix::<f64>::zeros(n, kk);
+        for k in 0..kk {
+            self.d_design(
+                &mm,
+                &a,
+                th,
+                k,
+                &x,
+                &res,
+                -1.0,
+                u.column_mut(k).as_mut_slice(),
+                t_all.column_mut(k).as_mut_slice(),
+            );
+        }
+        let w = DMatrix::from_fn(b.cols.len(), kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
+        let z = b.r.tr_solve_upper_triangular(&w)?;
+        let qtu = b.q.tr_mul(&u);
+        let mut jtj = z.tr_mul(&z) - qtu.tr_mul(&qtu);
+        // `uᵀu` channel by channel, over the columns not zero on the channel's rows.
+        for ch in 0..self.data.n_ch() {
+            let rows = ch * rows_per_ch..(ch + 1) * rows_per_ch;
+            let nz: Vec<usize> = (0..kk)
+                .filter(|k| {
+                    u.column(*k)
+                        .rows_range(rows.clone())
+                        .iter()
+                        .any(|v| *v != 0.0)
+                })
+                .collect();
+            if nz.is_empty() {
+                continue;
+            }
+            let sub = DMatrix::from_fn(rows_per_ch, nz.len(), |i, j| u[(rows.start + i, nz[j])]);
+            let p = sub.transpose() * &sub;
+            for (i, a) in nz.iter().enumerate() {
+                for (j, c) in nz.iter().enumerate() {
+                    jtj[(*a, *c)] += p[(i, j)];
+                }
+            }
+        }
+        let rv = DVector::from_column_slice(r);
+        let c = z - &qtu;
+        let g = u.tr_mul(&rv) + c.tr_mul(&b.q.tr_mul(&rv));
+        (jtj.iter().all(|v| v.is_finite()) && g.iter().all(|v| v.is_finite())).then_some((jtj, g))
+    }
+
     /// Fills `jac` with `∂r/∂θ` at `θ` (the residual `r = y − A x`, rows as
     /// [`crate::diagnose::lsq::slots::design`]); `false` when a block is rank-deficient or the solution is
     /// not finite.
@@ -385,6 +469,45 @@ pub(super) mod tests {
     fn the_jacobian_matches_central_differences_of_the_projected_residual() {
         let nl = assert_jacobian_matches(&model(1.0), &channels(&model(1.07)));
         assert!(nl.len() >= 10, "{nl:?}");
+    }
+
+    /// The normal equations formed without `J` against `JᵀJ` and `Jᵀr` of the Jacobian
+    /// itself (one output, three inputs: every kind of nonlinear slot, input gains on one
+    /// channel each), at a point off the optimum (`r` not small).
+    #[test]
+    fn the_normal_equations_match_those_of_the_jacobian() {
+        let (start, data) = (model(1.0), channels(&model(1.07)));
+        let (lin, nl) = slots(&start, &data);
+        let mask: Vec<usize> = (0..data.len()).collect();
+        let th: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
+        let typ: Vec<f64> = th.iter().map(|x| x.abs().max(1e-3)).collect();
+        let vp = VarPro {
+            start: &start,
+            nl: &nl,
+            lin: &lin,
+            data: &data,
+            mask: &mask,
+            typ: &typ,
+        };
+        let mut m = vp.model(&th);
+        let r = solve_linear_res(&mut m, &lin, &data, &mask);
+        assert!(r.norm() > 1.0, "{}", r.norm());
+        let mut jac = DMatrix::zeros(r.len(), nl.len());
+        assert!(vp.jacobian(&th, &mut jac));
+        let (jtj, g) = vp.normal(&th, r.as_slice()).expect("one block");
+        let (jtj0, g0) = (jac.transpose() * &jac, jac.transpose() * &r);
+        assert!(
+            (&jtj - &jtj0).norm() <= 1e-10 * jtj0.norm(),
+            "{:e}",
+            (&jtj - &jtj0).norm() / jtj0.norm()
+        );
+        assert!(
+            (&g - &g0).norm() <= 1e-9 * g0.norm(),
+            "{:e}",
+            (&g - &g0).norm() / g0.norm()
+        );
+        // A wrong residual length declines.
+        assert!(vp.normal(&th, &r.as_slice()[1..]).is_none());
     }
 
     /// Two copies of one mode make the design rank-deficient: the Jacobian declines (the
