@@ -169,11 +169,52 @@ impl<'a> Problem<'a> {
         nat
     }
 
+    /// Per effect of `mods` on channel `ch`: where its natural parameters start in `nat`,
+    /// how many, and the residue of the configured term it changes (the same at every
+    /// datum, so a residual looks them up once per channel).
+    fn channel_terms(&self, mods: &Mods, ch: usize) -> Vec<(usize, usize, f64)> {
+        let entry = self.data.entries[ch];
+        let n_ch = self.n_ch();
+        let mut off = 0;
+        mods.cands
+            .iter()
+            .map(|c| {
+                let n = c.n_params(n_ch);
+                // The residues of the configured terms are cached; the others' are not (0
+                // for every effect that changes no configured term).
+                let rho = match c.stands() {
+                    Stands::ConfiguredMode(i) => self.mode_rho[ch][i],
+                    Stands::FrictionPole(i) => self.rigid_rho[ch][i],
+                    Stands::AddedMode
+                    | Stands::AddedPoleAtZero(_)
+                    | Stands::Feedthrough
+                    | Stands::AddedPathEffect => c.base_residue(self.base, entry),
+                };
+                off += n;
+                (off - n, n, rho)
+            })
+            .collect()
+    }
+
     /// [`Problem::parts`] with the natural parameters `nat` of `mods` computed once.
     fn parts_nat(
         &self,
         mods: &Mods,
         nat: &[f64],
+        ch: usize,
+        k: Option<usize>,
+        omega: f64,
+    ) -> (Complex64, Complex64) {
+        let terms = self.channel_terms(mods, ch);
+        self.parts_at(mods, nat, &terms, ch, k, omega)
+    }
+
+    /// [`Problem::parts_nat`] with the channel's [`Problem::channel_terms`] given.
+    fn parts_at(
+        &self,
+        mods: &Mods,
+        nat: &[f64],
+        terms: &[(usize, usize, f64)],
         ch: usize,
         k: Option<usize>,
         omega: f64,
@@ -186,20 +227,7 @@ impl<'a> Problem<'a> {
                 path_at(self.base, omega, entry),
             ),
         };
-        let mut off = 0;
-        let n_ch = self.n_ch();
-        for c in &mods.cands {
-            let n = c.n_params(n_ch);
-            // The residues of the configured terms are cached; the others' are not (0 for
-            // every effect that changes no configured term).
-            let rho = match c.stands() {
-                Stands::ConfiguredMode(i) => self.mode_rho[ch][i],
-                Stands::FrictionPole(i) => self.rigid_rho[ch][i],
-                Stands::AddedMode
-                | Stands::AddedPoleAtZero(_)
-                | Stands::Feedthrough
-                | Stands::AddedPathEffect => c.base_residue(self.base, entry),
-            };
+        for (c, &(off, n, rho)) in mods.cands.iter().zip(terms) {
             c.modify_natural(
                 &nat[off..off + n],
                 rho,
@@ -210,7 +238,6 @@ impl<'a> Problem<'a> {
                 &mut core,
                 &mut path,
             );
-            off += n;
         }
         (core, path)
     }
@@ -220,9 +247,11 @@ impl<'a> Problem<'a> {
         let nat = self.naturals_of(mods);
         (0..self.n_ch())
             .map(|ch| {
+                let terms = self.channel_terms(mods, ch);
                 (0..self.f())
                     .map(|k| {
-                        let (c, p) = self.parts_nat(mods, &nat, ch, Some(k), self.data.omega[k]);
+                        let (c, p) =
+                            self.parts_at(mods, &nat, &terms, ch, Some(k), self.data.omega[k]);
                         c * p
                     })
                     .collect()
@@ -243,8 +272,9 @@ impl<'a> Problem<'a> {
                 }
                 continue;
             }
+            let terms = self.channel_terms(mods, ch);
             for &k in mask {
-                let (c, p) = self.parts_nat(mods, &nat, ch, Some(k), self.data.omega[k]);
+                let (c, p) = self.parts_at(mods, &nat, &terms, ch, Some(k), self.data.omega[k]);
                 let e = (self.data.g[ch][k] - c * p) * self.inv_sigma[ch][k];
                 out.push(e.re);
                 out.push(e.im);
