@@ -28,9 +28,9 @@ pub struct Problem<'a> {
     rigid_rho: Vec<Vec<f64>>,
     /// The record's lower bound on ζ ([`super::resolution::band_floor`]).
     pub(crate) zeta_floor: f64,
-    /// The weighted residual of the base model, `(G_d − core₀·path₀)/σ`, `[ch][k]`: the rows
-    /// of [`Problem::residual`] on a channel no effect of the model acts on (a path effect
-    /// on one input leaves the other channels as they are), computed once.
+    /// The weighted residual of the base model, `(G_d − core₀·path₀)/σ`, `[ch][k]`: a
+    /// channel no effect of the model acts on (a path effect on one input leaves the other
+    /// channels as they are) keeps these rows, computed once ([`Problem::residual`]).
     e0: Vec<Vec<Complex64>>,
 }
 
@@ -259,17 +259,21 @@ impl<'a> Problem<'a> {
             .collect()
     }
 
+    /// The weighted residual `(G_d − Ĝ)/σ` (real and imaginary parts, channel by channel) on
+    /// the data in `mask`, with the rows of the channels no effect of `mods` acts on folded
+    /// into one last row, the root of their sum of squares (none when every channel is acted
+    /// on): the cost `Σ r²` is the whole residual's (to rounding), and the other rows'
+    /// derivatives are the whole residual's (the folded rows do not depend on the
+    /// parameters).  A fit of a path effect on one input of nine carries a ninth of the rows.
     pub(crate) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
         out.clear();
         let nat = self.naturals_of(mods);
+        let mut fixed: Option<f64> = None;
         for ch in 0..self.n_ch() {
             let entry = self.data.entries[ch];
             if !mods.cands.iter().any(|c| c.acts_on(entry)) {
-                for &k in mask {
-                    let e = self.e0[ch][k];
-                    out.push(e.re);
-                    out.push(e.im);
-                }
+                let e0 = &self.e0[ch];
+                *fixed.get_or_insert(0.0) += mask.iter().map(|k| e0[*k].norm_sqr()).sum::<f64>();
                 continue;
             }
             let terms = self.channel_terms(mods, ch);
@@ -280,6 +284,7 @@ impl<'a> Problem<'a> {
                 out.push(e.im);
             }
         }
+        out.extend(fixed.map(f64::sqrt));
     }
 
     pub(crate) fn v(&self, mods: &Mods, mask: &[usize]) -> f64 {
@@ -424,6 +429,60 @@ impl<'a> Problem<'a> {
 mod tests {
     use super::*;
     use crate::model::physical::{EffectKind, EffectSpec, Gains, ModeSpec};
+
+    /// A delay on input 2 of three: the residual keeps that channel's rows and folds the
+    /// other two into one row; its cost is the whole residual's, summed here datum by datum
+    /// through [`Problem::parts`] (the per-datum route, no cache, no folding).
+    #[test]
+    fn the_folded_residual_has_the_whole_cost() {
+        use crate::diagnose::effects::candidates::Sel;
+        let base = PhysicalModel {
+            mode: vec![ModeSpec {
+                name: None,
+                omega_n: 900.0,
+                zeta: 0.01,
+                mass: 1.0,
+                input_gain: Gains::Vector(vec![1.0, -0.4, 0.7]),
+                output_gain: Gains::Scalar(3e4),
+            }],
+            ..Default::default()
+        };
+        let omega = crate::system::logspace(100.0, 3000.0, 80);
+        let data = Channels::of_model(
+            &base,
+            omega,
+            vec![(0, 0), (0, 1), (0, 2)],
+            1.1,
+            (0.02, 1e-3),
+        );
+        let p = Problem::new(&base, &data).expect("problem");
+        let mask: Vec<usize> = (0..data.len()).step_by(3).collect();
+        let mods = Mods {
+            cands: vec![Cand::Delay(Sel::Input(1))],
+            theta: vec![3e-4],
+        };
+        let mut r = Vec::new();
+        p.residual(&mods, &mask, &mut r);
+        assert_eq!(r.len(), 2 * mask.len() + 1);
+        let mut whole = 0.0;
+        for ch in 0..3 {
+            for &k in &mask {
+                let (c, pa) = p.parts(&mods, ch, Some(k), data.omega[k]);
+                whole += 2.0 * ((data.g[ch][k] - c * pa).norm() / data.radius[ch][k]).powi(2);
+            }
+        }
+        let v: f64 = r.iter().map(|x| x * x).sum();
+        assert!(whole > 1.0, "{whole}");
+        assert!((v - whole).abs() <= 1e-12 * whole, "{v} vs {whole}");
+        assert_eq!(p.v(&mods, &mask), v);
+        // The delay's own channel: the rows of the datum-by-datum route.
+        for (q, &k) in mask.iter().enumerate() {
+            let (c, pa) = p.parts(&mods, 1, Some(k), data.omega[k]);
+            let e = (data.g[1][k] - c * pa) * p.inv_sigma[1][k];
+            assert!((r[2 * q] - e.re).abs() <= 1e-12 * e.norm().max(1.0));
+            assert!((r[2 * q + 1] - e.im).abs() <= 1e-12 * e.norm().max(1.0));
+        }
+    }
 
     /// The analytic Jacobian of a lone added mode against fourth-order central differences
     /// of the residual itself (one output, three inputs, a delay on the path so `P ≠ 1`).
