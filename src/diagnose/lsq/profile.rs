@@ -8,7 +8,8 @@
 //! [`super::retune::retune_holding`]) is followed upward from `ζ_f` by factors of `√2`
 //! until `V_p(ζ) − V_p(ζ_f)` exceeds `½ χ²₁(0.95) · s` (the likelihood-ratio 95 % interval,
 //! `−2 ln L = 2V`; `s = max(1, V/F)` widens it where the residual itself exceeds the stated
-//! noise, a quasi-likelihood scale).  The supported interval is `[ζ_f, ζ_u]`, `ζ_u` by linear
+//! noise, a quasi-likelihood scale; `V/F` is taken as the larger of the whole band's and that
+//! of the lines around the mode, [`near_lines`], where a local lack of fit says as much).  The supported interval is `[ζ_f, ζ_u]`, `ζ_u` by linear
 //! interpolation in `ln ζ` between the last point inside and the first outside.
 //!
 //! The damping is **not identified** when `ζ_u/ζ_f > exp(1.96/3)` — a 95 % interval wider
@@ -19,7 +20,7 @@
 //! says "not identified: measure denser lines around f".
 
 use super::channels::Channels;
-use super::resolution::zeta_range;
+use super::resolution::{spacing_at, zeta_range};
 use super::retune::{cost, retune_holding};
 use super::slots::Nl;
 use crate::model::physical::PhysicalModel;
@@ -36,6 +37,8 @@ pub const AT_FLOOR: f64 = 1.05;
 pub fn flat_ratio() -> f64 {
     (1.959_963_984_540_054 / 3.0f64).exp()
 }
+/// Half-width of the lines that see a mode, in line spacings (at least 2 % of its frequency).
+const NEAR_LINES: f64 = 10.0;
 /// No profile above this damping (the refit's own upper bound is 0.7).
 const ZETA_TOP: f64 = 0.5;
 
@@ -78,6 +81,14 @@ pub fn modes_at_floor(m: &PhysicalModel, data: &Channels) -> Vec<usize> {
         .collect()
 }
 
+/// The lines that see a mode at `w` (rad/s): within `max(2 %, NEAR_LINES spacings)` of it.
+pub fn near_lines(data: &Channels, w: f64) -> Vec<usize> {
+    let half = (0.02 * w).max(NEAR_LINES * spacing_at(&data.omega, w));
+    (0..data.omega.len())
+        .filter(|&i| (data.omega[i] - w).abs() <= half)
+        .collect()
+}
+
 /// The profile of mode `k`'s damping in `m` (a least-squares fit on every datum of `data`,
 /// built from `anchor`, whose boxes every refit keeps), from the record's floor upward.
 pub fn zeta_profile(
@@ -97,7 +108,15 @@ pub fn zeta_profile(
     };
     let (m0, v0) = at(m, floor);
     let v0 = v0.min(cost(m, data, &(0..data.len()).collect::<Vec<_>>()));
-    let scale = (v0 / data.n_data() as f64).max(1.0);
+    // The residual's level where ζ is seen (the lines around the mode) may exceed the
+    // whole band's: a term the model lacks there (pyuff's 51.5 Hz mode, whose data carry a
+    // phase no real-residue term makes) makes the likelihood's curvature overstate what the
+    // data say of ζ.  The larger of the two levels widens the interval.
+    let near = near_lines(data, w);
+    let f_near = (near.len() * data.n_ch()).max(1) as f64;
+    let scale = (v0 / data.n_data() as f64)
+        .max(cost(&m0, data, &near) / f_near)
+        .max(1.0);
     let threshold = HALF_CHI2_1_95 * scale;
     let mut points = vec![(floor, 0.0)];
     let mut upper = ZETA_TOP;
