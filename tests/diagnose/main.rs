@@ -29,5 +29,6 @@ mod diagnose_realdata;
 mod diagnose_retune_changes;
 mod diagnose_scan;
 mod diagnose_settings;
+mod diagnose_stop_explained;
 mod diagnose_ties;
 mod diagnose_twomass;
