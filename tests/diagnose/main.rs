@@ -26,6 +26,7 @@ mod diagnose_output_effects;
 mod diagnose_progress;
 mod diagnose_pyfrf;
 mod diagnose_realdata;
+mod diagnose_residual_mode;
 mod diagnose_retune_changes;
 mod diagnose_scan;
 mod diagnose_settings;
