@@ -16,6 +16,7 @@ mod diagnose_close_modes;
 mod diagnose_ema_reference;
 mod diagnose_free_beam;
 mod diagnose_give_up;
+mod diagnose_group_path;
 mod diagnose_hidden;
 mod diagnose_hidden_accelerance;
 mod diagnose_hidden_robot;
