@@ -236,6 +236,76 @@ mod tests {
     }
 
     #[test]
+    fn a_lack_of_fit_around_the_mode_widens_the_interval_by_its_own_level() {
+        // A mode at 460.5 Hz between 1 Hz lines whose data carry a residue rotated by 0.15
+        // rad (no real-residue term makes it), beside a well-modelled mode at 800 Hz that
+        // dominates most of the band 300–1000 Hz: the lack of fit sits around 460 Hz.
+        let (w1, w2) = (TAU * 460.5, TAU * 800.0);
+        let omega: Vec<f64> = (300..=1000).map(|k| TAU * k as f64).collect();
+        let mut model = one_mode(w1, 1e-6, 2.0e4);
+        model.mode.push(one_mode(w2, 0.01, 2.0e6).mode[0].clone());
+        let rot = Complex64::from_polar(1.0, 0.15);
+        let g: Vec<Complex64> = omega
+            .iter()
+            .map(|w| {
+                let s = Complex64::new(0.0, *w);
+                2.0e4 * rot / (s * s + 2e-6 * w1 * s + w1 * w1)
+                    + 2.0e6 / (s * s + 0.02 * w2 * s + w2 * w2)
+            })
+            .collect();
+        let radius: Vec<f64> = g.iter().map(|x| 0.01 * x.norm()).collect();
+        let data = Channels {
+            path: "test".into(),
+            radius_source: vec![String::new()],
+            omega: omega.clone(),
+            entries: vec![(0, 0)],
+            g: vec![g.clone()],
+            radius: vec![radius.clone()],
+        };
+        let floor = zeta_range(&data, w1).floor;
+        let mut m = model.clone();
+        m.mode[0].zeta = floor;
+        let p = zeta_profile(&m, &m, &data, 0);
+        // The level of the lines within ±10 Hz, by brute force: the 800 Hz mode as
+        // generated, the 460 Hz mode at the floor with ω_n on a grid and its real residue in
+        // closed form (weighted least squares).
+        let near: Vec<usize> = (0..omega.len())
+            .filter(|&k| (omega[k] - w1).abs() <= TAU * 10.0 + 1e-9)
+            .collect();
+        let local = (-400..=400)
+            .map(|j| {
+                let w = w1 * (1.0 + 2.5e-7 * j as f64);
+                let (mut num, mut den) = (0.0, 0.0);
+                let basis = |k: usize| one_mode(w, floor, 1.0).eval(omega[k])[(0, 0)];
+                let rest = |k: usize| one_mode(w2, 0.01, 2.0e6).eval(omega[k])[(0, 0)];
+                for &k in &near {
+                    let wk = 2.0 / (radius[k] * radius[k]);
+                    num += wk * (basis(k).conj() * (g[k] - rest(k))).re;
+                    den += wk * basis(k).norm_sqr();
+                }
+                let rho = num / den;
+                near.iter()
+                    .map(|&k| 2.0 * ((g[k] - rest(k) - rho * basis(k)).norm() / radius[k]).powi(2))
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min)
+            / near.len() as f64;
+        assert!(local > 10.0, "the construction: local V/F {local}");
+        let scale = p.threshold / HALF_CHI2_1_95;
+        // The refit also moves the 800 Hz mode a little: within 10 %.
+        assert!(
+            (scale / local - 1.0).abs() < 0.1,
+            "scale {scale} vs local V/F {local}"
+        );
+        // Far above the whole band's own level (most lines fit).
+        let whole = cost(&m, &data, &(0..data.len()).collect::<Vec<_>>()) / data.n_data() as f64;
+        assert!(
+            scale > 3.0 * whole.max(1.0),
+            "scale {scale}, whole band {whole}"
+        );
+    }
+
+    #[test]
     fn a_damping_the_lines_resolve_is_not_at_the_floor() {
         let w = TAU * 460.5;
         let omega: Vec<f64> = (430..=490).map(|k| TAU * k as f64).collect();
