@@ -121,6 +121,9 @@ fn a_mode_above_the_band_is_added_as_a_residual_term() {
     assert!(d.steps.iter().all(|s| s.effect != "mode"));
     let fe = &d.final_effects[0];
     assert_eq!(fe.effect, "residual term: mode above the band");
+    // Its frequency and residue, no damping (the band does not measure it).
+    assert!(!fe.params.contains_key("zeta"), "{fe:?}");
+    assert!(fe.params.contains_key("rho"), "{fe:?}");
     let w = fe.params["omega_n"];
     assert!(w > 1.05 * TAU * 400.0, "{w}");
     // The written model: the two configured modes where they were, and the pseudo-mode,

@@ -3,8 +3,9 @@
 //! is the first term of the modes above the band, `ρ/(ω_n² − ω²) ≈ ρ/ω_n² (1 + ω²/ω_n² + …)`;
 //! a mode not far above the band top bends the in-band error more than a constant follows,
 //! and the residual left by `D` is structured towards the top.  This term is that mode,
-//! `ρ_ch/(s² + 2ζ₀ω_n s + ω_n²)` with `ω_n` above the band and a fixed small damping `ζ₀`
-//! (the band does not see it); θ = [ln ω_n, ρ_1 … ρ_C].  It is a **residual term**: its
+//! `ρ_ch/(s² + 2ζ₀ω_n s + ω_n²)` with `ω_n` above the band and a small damping `ζ₀` (the
+//! band does not see it: held in the screen, free in the joint refits, never reported);
+//! θ = [ln ω_n, ρ_1 … ρ_C].  It is a **residual term**: its
 //! frequency stands for the modes above the band, it is not an identified mode (the mode
 //! rules of `diagnose::admissible` do not apply; ΔBIC, the holdout and the negligible rule
 //! do).  Tried only on a model that has the upper residual already.
