@@ -62,7 +62,8 @@ pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSIO
 pub use progress::{DiagnoseOptions, DiagnoseProgress, DiagnoseProgressFn};
 pub use report::{
     CandidateReport, DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout,
-    Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
+    Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, ResidualAccount, Retuned,
+    SearchStats, Step, Tie,
 };
 pub use revision::{params_text, write_revision, Apply, Revise, Revision};
 pub use search::backward::eliminate;
