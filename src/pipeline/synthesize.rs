@@ -144,6 +144,30 @@ pub fn run(
     data: Option<&Path>,
     controller_path: &Path,
 ) -> Result<SynthesisOutcome> {
+    run_with_stages(
+        config,
+        config_path,
+        rs,
+        settings,
+        data,
+        controller_path,
+        &|_| (),
+    )
+}
+
+/// [`run`], telling `stage` what it starts: the controller, then each stage of its proof
+/// ([`stab::run_with_stages`], prefixed `proof: `); on a model of hundreds of modes each is
+/// seconds to minutes of dense linear algebra (issue 34).
+pub fn run_with_stages(
+    config: &Config,
+    config_path: &Path,
+    rs: &[(String, TransferFunction)],
+    settings: &SynthesisSettings,
+    data: Option<&Path>,
+    controller_path: &Path,
+    stage: &dyn Fn(&str),
+) -> Result<SynthesisOutcome> {
+    let proof_stage = |what: &str| stage(&format!("proof: {what}"));
     let ncf = plant_factors(config, config_path)?;
     for (label, r) in rs {
         if !r.is_unit() {
@@ -152,6 +176,10 @@ pub fn run(
             )));
         }
     }
+    stage(&format!(
+        "the Glover–McFarlane controller ({} plant states: two Riccati equations)",
+        ncf.plant.states()
+    ));
     let mut gm = match &settings.weights {
         None => synthesize(&ncf, settings.gamma_factor)?,
         Some(w) => {
@@ -175,6 +203,7 @@ pub fn run(
                 ..Default::default()
             };
             // A failure falls back to the Glover–McFarlane controller, with a note.
+            stage(&format!("the H∞ controller with the {label} r as weight"));
             match crate::synthesis::synthesize_weighted(&ncf, r, &ws) {
                 Ok(h) => {
                     // The proof must be able to run on it (a controller spanning many
@@ -184,7 +213,8 @@ pub fn run(
                         k: h.k.clone(),
                         feedback: Feedback::Negative,
                     };
-                    match stab::run(config, &probe, rs, data) {
+                    let probe_stage = |what: &str| stage(&format!("trial proof: {what}"));
+                    match stab::run_with_stages(config, &probe, rs, data, &probe_stage) {
                         Ok(_) => {
                             gm.k = h.k.clone();
                             Some((label.clone(), h))
@@ -235,7 +265,7 @@ pub fn run(
         k: gm.k.clone(),
         feedback: Feedback::Negative,
     };
-    let stability = stab::run(config, &controller, rs, data)?;
+    let stability = stab::run_with_stages(config, &controller, rs, data, &proof_stage)?;
     let mut notes: Vec<String> = fallback.into_iter().collect();
     let normalized = config.factorization.realization.is_some();
     if !normalized {

@@ -179,12 +179,31 @@ pub fn analyze_with_stages(
     grid: &[f64],
     stage: &dyn Fn(&str),
 ) -> Result<(RobustStability, GridCurve)> {
+    analyze_gridded(f, controller, rs, &|_| grid.to_vec(), stage)
+}
+
+/// [`analyze_with_stages`] on the grid `grid(poles)` chosen from the closed-loop poles (the
+/// loop realized and its poles computed once: on a model of a thousand modes each is
+/// minutes).
+pub fn analyze_gridded(
+    f: &Factorization,
+    controller: &Controller,
+    rs: &[(String, TransferFunction)],
+    grid: &dyn Fn(&[Complex64]) -> Vec<f64>,
+    stage: &dyn Fn(&str),
+) -> Result<(RobustStability, GridCurve)> {
     let k = controller_fits(f, controller)?;
+    stage("the loop's realization");
     let t = theorem1_system(f, &k)?;
     let n = t.states();
     stage(&format!("closed-loop poles ({n} states)"));
     let poles = eigenvalues(&t.a, "closed-loop poles")?;
     let abscissa = spectral_abscissa(&poles);
+    let grid = &grid(&poles)[..];
+    stage(&format!(
+        "the grid curve sigma_max(T(jw)) at {} frequencies",
+        grid.len()
+    ));
     let internally_stable = abscissa < 0.0;
     let normalized = f.realization.is_some();
     let kev = FreqEvaluator::new(&k);

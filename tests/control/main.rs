@@ -10,6 +10,7 @@ mod closed_loop_stability_large;
 mod hinf_large_modal;
 mod hinf_near_d;
 mod iss_reduction;
+mod modal_cascade_rows;
 mod stability;
 mod stability_special;
 mod synthesize;

@@ -37,6 +37,21 @@ use rayon::prelude::*;
 /// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
 pub(crate) const GIVE_UP_AFTER: usize = 10;
 
+/// Most accepted Levenberg–Marquardt steps of a retune.
+pub(crate) const MAX_ITERATIONS: usize = 200;
+
+/// Hears a long retune count what it does (a model of hundreds of modes refits for minutes,
+/// issue 34): `(what, done, total)` with `what` one of [`PLACING`] (the rough placement,
+/// mode by mode) and [`ITERATING`] (the joint refit's Levenberg–Marquardt iterations, of at
+/// most [`MAX_ITERATIONS`]).
+pub(crate) type RetuneTell<'a> = &'a (dyn Fn(&'static str, usize, usize) + Sync);
+
+/// What [`RetuneTell`] hears during the rough placement: `done` of `total` modes placed.
+pub const PLACING: &str = "rough placement, mode";
+
+/// What [`RetuneTell`] hears during the joint refit: iteration `done` of at most `total`.
+pub const ITERATING: &str = "joint refit, iteration";
+
 /// The result of a refit.
 #[derive(Debug, Clone)]
 pub struct NominalRefit {
@@ -151,6 +166,17 @@ pub fn retune(
     retune_within(m, m, data, mask, rough)
 }
 
+/// [`retune`] on every datum, telling `tell` its counts ([`RetuneTell`]): the root of
+/// `diagnose`, the one refit a large model is silent in for minutes otherwise.
+pub(crate) fn retune_telling(
+    m: &PhysicalModel,
+    data: &Channels,
+    rough: bool,
+    tell: RetuneTell<'_>,
+) -> NominalRefit {
+    refit_holding(m, m, data, None, rough, None, &[], Some(tell)).0
+}
+
 /// [`retune`] with the boxes of the configured parameters around their values in `anchor`,
 /// the configured model `m` was built from (effects added to it keep boxes around their
 /// current values).  A chain of refits (every node of the search, the holdouts) then cannot
@@ -177,7 +203,7 @@ pub(crate) fn retune_or_give_up(
     rough: bool,
     give_up: Option<f64>,
 ) -> (NominalRefit, bool) {
-    refit_holding(m, anchor, data, mask, rough, give_up, &[])
+    refit_holding(m, anchor, data, mask, rough, give_up, &[], None)
 }
 
 /// [`retune_within`] on every datum with the nonlinear slots `hold` kept at their values in
@@ -188,9 +214,10 @@ pub(crate) fn retune_holding(
     data: &Channels,
     hold: &[Nl],
 ) -> NominalRefit {
-    refit_holding(m, anchor, data, None, false, None, hold).0
+    refit_holding(m, anchor, data, None, false, None, hold, None).0
 }
 
+#[allow(clippy::too_many_arguments)]
 fn refit_holding(
     m: &PhysicalModel,
     anchor: &PhysicalModel,
@@ -199,7 +226,13 @@ fn refit_holding(
     rough: bool,
     give_up: Option<f64>,
     hold: &[Nl],
+    tell: Option<RetuneTell<'_>>,
 ) -> (NominalRefit, bool) {
+    let tell = |what: &'static str, done: usize, total: usize| {
+        if let Some(t) = tell {
+            t(what, done, total);
+        }
+    };
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
     let (lin, mut nl) = slots(m, data);
@@ -258,6 +291,7 @@ fn refit_holding(
             start.mode[i].omega_n = best.1;
             start.mode[i].zeta = best.2;
             v_start = solve_linear(&mut start, &lin, data, mask);
+            tell(PLACING, i + 1, m.mode.len());
         }
     }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
@@ -299,16 +333,22 @@ fn refit_holding(
             mask,
             typ: &typ,
         };
+        // One Jacobian per accepted step: the iteration count the listener hears.
+        let iterations = std::sync::atomic::AtomicUsize::new(0);
         let res = lm_box_jac(
             resid,
-            &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| vp.jacobian(th, j),
+            &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| {
+                let k = iterations.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                tell(ITERATING, k, MAX_ITERATIONS);
+                vp.jacobian(th, j)
+            },
             &theta0,
             &typ,
             &lo,
             &hi,
             &LmSettings {
                 give_up: give_up.map(|v| (GIVE_UP_AFTER, v)),
-                ..LmSettings::likelihood(200)
+                ..LmSettings::likelihood(MAX_ITERATIONS)
             },
         );
         abandoned = res.abandoned;
