@@ -113,3 +113,37 @@ fn compare_run(bencher: Bencher, k: usize) {
     let siso = rshape::diagnose::prepare(&config, &data, None, None).expect("prepare");
     bencher.bench(|| rshape::diagnose::compare(&config, &model, &siso).expect("compare"));
 }
+
+/// Sizes of the structured routes of issue 34's fourth session: the loop realized row by row
+/// (`modal_system` from 50 modal coordinates; the whole-matrix staircase had not finished
+/// the 1000-mode loop in 600 s) and the retune of `diagnose`'s root (1000 modes on 200 data:
+/// the linear slots already fit the data, so the retune is their least squares).
+const ROW_SIZES: &[usize] = &[200, 1000];
+
+#[divan::bench(args = ROW_SIZES, sample_count = 1)]
+fn loop_realization(bencher: Bencher, k: usize) {
+    if k > ROW_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, controller, _dir) = inputs(k);
+    let kk = controller.negative_feedback_gain();
+    bencher.bench(|| rshape::stability::theorem1_system(&config.factorization, &kk).expect("T"));
+}
+
+#[divan::bench(args = ROW_SIZES, sample_count = 1)]
+fn diagnose_root_retune(bencher: Bencher, k: usize) {
+    // 200 modes is a full rough placement and joint refit (seconds to a minute): only in
+    // `cargo bench`; under `cargo test` the settled 1000-mode case is the check.
+    if k == ROW_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, _controller, _dir) = inputs(k);
+    let data =
+        rshape::data::read_frf_csv(config.data.as_deref().expect("data file")).expect("data");
+    let siso = rshape::diagnose::prepare(&config, &data, None, None).expect("prepare");
+    let channels = rshape::diagnose::Channels::from_siso(&siso).expect("channels");
+    let model = config.physical.clone().expect("[physical]");
+    bencher.bench(|| rshape::diagnose::retune(&model, &channels, None, true));
+}

@@ -29,8 +29,8 @@ pub(crate) mod factor_loop;
 pub(crate) mod theorem1;
 
 pub use factor_loop::{
-    gang_of_four, modal_cascade, modal_system, plant_system, t_sigma_max, theorem1_system,
-    CASCADE_ROWS_FROM,
+    gang_of_four, gang_sigma_max, modal_cascade, modal_system, plant_system, t_sigma_max,
+    theorem1_system, CASCADE_ROWS_FROM,
 };
 pub use theorem1::{
     analyze, analyze_gridded, analyze_with_stages, closed_loop_poles, controller_fits, decide,

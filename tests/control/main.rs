@@ -11,6 +11,7 @@ mod hinf_large_modal;
 mod hinf_near_d;
 mod iss_reduction;
 mod modal_cascade_rows;
+mod progress_stages;
 mod stability;
 mod stability_special;
 mod synthesize;

@@ -23,7 +23,7 @@
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
+use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings, V_TOL};
 use crate::diagnose::lsq::slots::{
     anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
     MODE_BOX,
@@ -256,7 +256,13 @@ fn refit_holding(
     let w_max = *data.omega.last().expect("data");
     let mut start = m.clone();
     let mut v_start = solve_linear(&mut start, &lin, data, mask);
-    if rough {
+    // The linear slots alone already fit the data (as they do, generically, once they are at
+    // least as many as the real data: 1000 modes on 200 data, issue 34): no move of the
+    // nonlinear ones can gain what the Levenberg–Marquardt stopping rule would act on, and
+    // each grid point and finite-difference Jacobian column would be a full least squares
+    // (the rank-deficient route): hours at that size. The linear solution is the refit.
+    let settled = v_start < V_TOL;
+    if rough && !settled {
         for i in 0..m.mode.len() {
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
@@ -313,7 +319,7 @@ fn refit_holding(
         (mm, v)
     };
     let mut abandoned = false;
-    let best = if nl.is_empty() {
+    let best = if nl.is_empty() || settled {
         (start.clone(), v_start)
     } else {
         // VarPro residual: the weighted complex error with the linear slots solved.
