@@ -112,13 +112,19 @@ pub(crate) fn solve_linear_res(
 fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
     let n = a.ncols();
     let scale = crate::system::linalg::equilibrate_columns(&mut a);
+    if a.nrows() < n {
+        let mut x = min_norm_solve(a, y);
+        for (xi, s) in x.iter_mut().zip(&scale) {
+            *xi /= s;
+        }
+        return x;
+    }
     let qr = a.qr();
     let r = qr.r();
     // Qᵀy by the Householder reflections (no explicit Q).
     let mut qty = y;
     qr.q_tr_mul(&mut qty);
-    // More parameters than rows (a 1000-mode model on 200 data panicked here, issue 34): R
-    // has only `rows` pivots; the trailing parameters stay 0 (a basic least-squares solution).
+    // At least as many rows as parameters here (fewer went to `min_norm_solve`).
     let k = r.nrows().min(n);
     let rmax = (0..k).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
     let mut x = DVector::<f64>::zeros(n);
@@ -136,6 +142,32 @@ fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
         *xi /= s;
     }
     x
+}
+
+/// More parameters than rows (a 1000-mode model on 200 data, issue 34): the least-norm
+/// solution of `A x = y` (in the equilibrated columns), `Aᵀ = Q R`, `Rᵀ z = y`, `x = Q z`,
+/// which fits every row when `A` has full row rank (a row with a negligible pivot is left
+/// unfitted). Every column takes part, where the basic solution of the square QR kept the
+/// first `rows` columns only (the modes of the lowest frequencies, badly conditioned on the
+/// whole band).
+fn min_norm_solve(a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
+    let rows = a.nrows();
+    let qr = a.transpose().qr();
+    let r = qr.r();
+    let rmax = (0..rows).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    // Rᵀ z = y, forward substitution.
+    let mut z = DVector::<f64>::zeros(rows);
+    for i in 0..rows {
+        if !(r[(i, i)].abs() > 1e-12 * rmax) {
+            continue;
+        }
+        let mut acc = y[i];
+        for j in 0..i {
+            acc -= r[(j, i)] * z[j];
+        }
+        z[i] = acc / r[(i, i)];
+    }
+    qr.q() * z
 }
 
 /// Cost `V` of `m` on the data at `mask`.
@@ -400,8 +432,9 @@ pub fn refit_nominal(
 
 #[cfg(test)]
 mod tests {
-    /// Fewer rows than parameters: no panic, and the answer fits the data exactly (the
-    /// system is consistent), with the parameters beyond the rows at 0.
+    /// Fewer rows than parameters: no panic, the answer fits the data exactly (the system is
+    /// consistent), and it is the least-norm one in the equilibrated columns, checked by the
+    /// normal equations of the rows: `x̃ = Bᵀ(BBᵀ)⁻¹y`, `B = A·diag(1/‖aⱼ‖)`, `x = x̃/‖aⱼ‖`.
     #[test]
     fn qr_solve_with_more_parameters_than_rows() {
         use nalgebra::{DMatrix, DVector};
@@ -410,7 +443,12 @@ mod tests {
         let x = super::qr_solve(a.clone(), y.clone());
         assert_eq!(x.len(), 4);
         assert!((&a * &x - &y).norm() < 1e-12, "{x}");
-        assert_eq!((x[2], x[3]), (0.0, 0.0));
+        let norms: Vec<f64> = a.column_iter().map(|c| c.norm()).collect();
+        let b = DMatrix::from_fn(2, 4, |i, j| a[(i, j)] / norms[j]);
+        let xt = b.transpose() * (&b * b.transpose()).try_inverse().unwrap() * &y;
+        for j in 0..4 {
+            assert!((x[j] - xt[j] / norms[j]).abs() < 1e-12, "{x} vs {xt}");
+        }
     }
 
     use super::*;
