@@ -288,12 +288,13 @@ fn refit_holding(
     let w_max = *data.omega.last().expect("data");
     let mut start = m.clone();
     let mut v_start = solve_linear(&mut start, &lin, data, mask);
-    // The linear slots alone already fit the data (as they do, generically, once they are at
-    // least as many as the real data: 1000 modes on 200 data, issue 34): no move of the
-    // nonlinear ones can gain what the Levenberg–Marquardt stopping rule would act on, and
-    // each grid point and finite-difference Jacobian column would be a full least squares
-    // (the rank-deficient route): hours at that size. The linear solution is the refit.
-    let settled = v_start < V_TOL;
+    // Settled: the linear slots alone already fit the data below what the Levenberg–Marquardt
+    // stopping rule acts on, or they are at least as many as the real data values (1000
+    // modes on 200 data, issue 34): then no ω_n, ζ or other nonlinear parameter is
+    // identified by the data, and each grid point and finite-difference Jacobian column would
+    // be a full rank-deficient least squares (hours at that size). The linear least-norm
+    // solution is the refit.
+    let settled = v_start < V_TOL || lin.len() >= 2 * mask.len() * data.n_ch();
     if rough && !settled {
         for i in 0..m.mode.len() {
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
