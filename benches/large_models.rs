@@ -9,7 +9,12 @@
 //! * `closed_loop_poles`: that plus the eigenvalues (the internal-stability verdict);
 //! * `stability_run`: `pipeline::stability::run` (poles, the grid, the exact H∞ norms);
 //! * `compare_run`: `diagnose::compare` on the model's 200 noisy data (Theorem 4's μ
-//!   envelope, what `compare` and each step of `diagnose` pay).
+//!   envelope, what `compare` and each step of `diagnose` pay);
+//! * `loop_realization` (200, 1000 modes): `theorem1_system`, the loop realized row by row
+//!   from 50 modal coordinates (fourth session; the whole-matrix staircase had not finished
+//!   the 1000-mode loop in 600 s);
+//! * `diagnose_root_retune` (200, 1000 modes): the retune at `diagnose`'s root from a rough
+//!   start (1000 modes on 200 data: settled, the output gains' least-norm fit only).
 //!
 //! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
 //! smallest size of the two long benches runs, as a check that the measurement works).

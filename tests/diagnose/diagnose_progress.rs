@@ -138,16 +138,25 @@ fn progress_reports_stages_levels_and_every_refit() {
 /// The counts inside the `retune` stage (issue 34: at 1000 modes it was minutes without a
 /// line): each configured mode placed once, in order (the rough placement goes mode by
 /// mode), then the joint refit's iterations 1, 2, … of at most 200; all of it after the
-/// `retune` stage begins and before the search's first level.
+/// `retune` stage begins and before the search's first level (or the next stage).
 fn check_retune_counts(heard: &[DiagnoseProgress], modes: usize) {
     let start = heard
         .iter()
         .position(|p| *p == DiagnoseProgress::Stage("retune"))
         .unwrap();
+    // The search's first level, or the next stage (a retune that explains the data ends
+    // the run before any search), or the end.
     let first_level = heard
         .iter()
-        .position(|p| matches!(p, DiagnoseProgress::Level { .. }))
-        .unwrap();
+        .enumerate()
+        .position(|(i, p)| {
+            i > start
+                && matches!(
+                    p,
+                    DiagnoseProgress::Level { .. } | DiagnoseProgress::Stage(_)
+                )
+        })
+        .unwrap_or(heard.len());
     let (mut placed, mut iterations) = (Vec::new(), Vec::new());
     for (i, p) in heard.iter().enumerate() {
         if let DiagnoseProgress::Retune { what, done, total } = *p {
