@@ -127,7 +127,7 @@ pub fn run(
     run_with_stages(config, controller, rs, data, &|_| ())
 }
 
-/// [`run`], telling `stage` what it starts (see [`analyze_with_stages`]).
+/// [`run`], telling `stage` what it starts (see [`crate::stability::analyze_with_stages`]).
 pub fn run_with_stages(
     config: &Config,
     controller: &Controller,

@@ -39,7 +39,7 @@ pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
 }
 
 /// From this many modal coordinates on, [`modal_system`] of a diagonal `M̃` realizes the
-/// cascade one row at a time ([`Rows::Cascade`]): the same poles (hidden modes of the
+/// cascade one row at a time (`M̃ᵢᵢ⁻¹·[Ñᵢ  1]`, stacked): the same poles (hidden modes of the
 /// factors included), without the staircase reduction of a system with `n + m` inputs and
 /// `2n` states (1000 modes: minutes, issue 34). Below it, the whole-matrix cascade (the
 /// figures of small models unchanged to the last digit).

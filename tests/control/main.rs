@@ -6,6 +6,11 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+/// The large-model structure of the benches (one copy for every file of this binary).
+#[path = "../../benches/support/modes.rs"]
+#[allow(dead_code)]
+mod modes;
+
 mod closed_loop_stability_large;
 mod hinf_large_modal;
 mod hinf_near_d;

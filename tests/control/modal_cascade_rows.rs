@@ -6,9 +6,7 @@
 //! eigenvalues (the factors' hidden modes included), the same frequency response, and the
 //! same closed-loop poles with the bench's controller.
 
-#[path = "../../benches/support/modes.rs"]
-#[allow(dead_code)]
-mod modes;
+use crate::modes;
 
 use num_complex::Complex64;
 use rshape::model::{Config, Controller};

@@ -4,9 +4,7 @@
 //! computed once), the pole count announced equal to the poles reported, the proof of
 //! `synthesize` announced stage by stage, and the same numbers as without a listener.
 
-#[path = "../../benches/support/modes.rs"]
-#[allow(dead_code)]
-mod modes;
+use crate::modes;
 
 use rshape::model::{Config, Controller};
 use rshape::pipeline::stability::{run as stability, run_with_stages as stability_with};

@@ -46,10 +46,12 @@ pub(crate) const MAX_ITERATIONS: usize = 200;
 /// most [`MAX_ITERATIONS`]).
 pub(crate) type RetuneTell<'a> = &'a (dyn Fn(&'static str, usize, usize) + Sync);
 
-/// What [`RetuneTell`] hears during the rough placement: `done` of `total` modes placed.
+/// What a retune's listener hears during the rough placement (`done` of `total` modes placed;
+/// [`crate::diagnose::DiagnoseProgress::Retune`]).
 pub const PLACING: &str = "rough placement, mode";
 
-/// What [`RetuneTell`] hears during the joint refit: iteration `done` of at most `total`.
+/// What a retune's listener hears during the joint refit (iteration `done` of at most `total`;
+/// [`crate::diagnose::DiagnoseProgress::Retune`]).
 pub const ITERATING: &str = "joint refit, iteration";
 
 /// The result of a refit.
@@ -158,7 +160,8 @@ fn min_norm_solve(a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
     // Rᵀ z = y, forward substitution.
     let mut z = DVector::<f64>::zeros(rows);
     for i in 0..rows {
-        if !(r[(i, i)].abs() > 1e-12 * rmax) {
+        // A NaN pivot counts as negligible too.
+        if r[(i, i)].abs().is_nan() || r[(i, i)].abs() <= 1e-12 * rmax {
             continue;
         }
         let mut acc = y[i];
