@@ -16,6 +16,11 @@
 //! * `diagnose_root_retune` (200, 1000 modes): the retune at `diagnose`'s root from a rough
 //!   start (1000 modes on 200 data: settled, the output gains' least-norm fit only).
 //!
+//! Fourth session (`cargo bench --bench large_models -- loop_realization diagnose_root_retune
+//! --sample-count 1`, load 6–8): `loop_realization` 200 / 1000 modes 63 ms / 2.6 s (the
+//! whole-matrix staircase: > 600 s at 1000); `diagnose_root_retune` 4.6 s / 0.12 s (1000
+//! modes: 20–40 s per mode placed before).
+//!
 //! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
 //! smallest size of the two long benches runs, as a check that the measurement works).
 //!
