@@ -129,7 +129,10 @@ pub fn diagnose_channels(
     // The configured model's screen does not need the retune: both at once.
     options.tell(Stage("retune"));
     let (roots, first_screen) = phases.time("retune", || {
-        rayon::join(|| roots(base, data), || screen_configured(base, data))
+        rayon::join(
+            || roots(base, data, options),
+            || screen_configured(base, data),
+        )
     });
     let [configured, retuned_node] = roots?;
     let first_screen = first_screen?;
