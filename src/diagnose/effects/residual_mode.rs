@@ -11,8 +11,8 @@
 //! do).  Tried only on a model that has the upper residual already.
 
 use crate::diagnose::effects::effect::{
-    fmt_w, log_grid, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si,
-    Site, Stands, Writer,
+    fmt_w, log_grid, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site,
+    Stands, Writer,
 };
 use crate::diagnose::effects::mode::mode_term;
 use crate::model::physical::{ModeSpec, PhysicalModel};
@@ -42,10 +42,7 @@ impl Effect for ResidualMode {
 
     /// On a model with the upper residual and no pseudo-mode yet.
     fn tried(base: &PhysicalModel) -> Vec<Self> {
-        let has = base
-            .mode
-            .iter()
-            .any(|m| is_pseudo_mode(m.name.as_deref()));
+        let has = base.mode.iter().any(|m| is_pseudo_mode(m.name.as_deref()));
         if base.feedthrough.is_some() && !has {
             vec![ResidualMode]
         } else {
@@ -216,7 +213,10 @@ mod tests {
                 &mut path,
             );
             let exact = rho / Complex64::new(w * w - om * om, 2.0 * PSEUDO_ZETA * w * om);
-            assert!((core - exact).norm() < 1e-12 * exact.norm(), "{om}: {core} vs {exact}");
+            assert!(
+                (core - exact).norm() < 1e-12 * exact.norm(),
+                "{om}: {core} vs {exact}"
+            );
             // Nearly real: the band sees its frequency, not its damping.
             let undamped = rho / (w * w - om * om);
             assert!((core.re / undamped - 1.0).abs() < 1e-3, "{om}");
