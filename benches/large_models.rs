@@ -9,7 +9,17 @@
 //! * `closed_loop_poles`: that plus the eigenvalues (the internal-stability verdict);
 //! * `stability_run`: `pipeline::stability::run` (poles, the grid, the exact H∞ norms);
 //! * `compare_run`: `diagnose::compare` on the model's 200 noisy data (Theorem 4's μ
-//!   envelope, what `compare` and each step of `diagnose` pay).
+//!   envelope, what `compare` and each step of `diagnose` pay);
+//! * `loop_realization` (200, 1000 modes): `theorem1_system`, the loop realized row by row
+//!   from 50 modal coordinates (fourth session; the whole-matrix staircase had not finished
+//!   the 1000-mode loop in 600 s);
+//! * `diagnose_root_retune` (200, 1000 modes): the retune at `diagnose`'s root from a rough
+//!   start (1000 modes on 200 data: settled, the output gains' least-norm fit only).
+//!
+//! Fourth session (`cargo bench --bench large_models -- loop_realization diagnose_root_retune
+//! --sample-count 1`, load 6–8): `loop_realization` 200 / 1000 modes 63 ms / 2.6 s (the
+//! whole-matrix staircase: > 600 s at 1000); `diagnose_root_retune` 4.6 s / 0.12 s (1000
+//! modes: 20–40 s per mode placed before).
 //!
 //! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
 //! smallest size of the two long benches runs, as a check that the measurement works).
@@ -112,4 +122,38 @@ fn compare_run(bencher: Bencher, k: usize) {
     let model = rshape::diagnose::PlantModel::from_config(&config);
     let siso = rshape::diagnose::prepare(&config, &data, None, None).expect("prepare");
     bencher.bench(|| rshape::diagnose::compare(&config, &model, &siso).expect("compare"));
+}
+
+/// Sizes of the structured routes of issue 34's fourth session: the loop realized row by row
+/// (`modal_system` from 50 modal coordinates; the whole-matrix staircase had not finished
+/// the 1000-mode loop in 600 s) and the retune of `diagnose`'s root (1000 modes on 200 data:
+/// the linear slots already fit the data, so the retune is their least squares).
+const ROW_SIZES: &[usize] = &[200, 1000];
+
+#[divan::bench(args = ROW_SIZES, sample_count = 1)]
+fn loop_realization(bencher: Bencher, k: usize) {
+    if k > ROW_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, controller, _dir) = inputs(k);
+    let kk = controller.negative_feedback_gain();
+    bencher.bench(|| rshape::stability::theorem1_system(&config.factorization, &kk).expect("T"));
+}
+
+#[divan::bench(args = ROW_SIZES, sample_count = 1)]
+fn diagnose_root_retune(bencher: Bencher, k: usize) {
+    // 200 modes is a full rough placement and joint refit (seconds to a minute): only in
+    // `cargo bench`; under `cargo test` the settled 1000-mode case is the check.
+    if k == ROW_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, _controller, _dir) = inputs(k);
+    let data =
+        rshape::data::read_frf_csv(config.data.as_deref().expect("data file")).expect("data");
+    let siso = rshape::diagnose::prepare(&config, &data, None, None).expect("prepare");
+    let channels = rshape::diagnose::Channels::from_siso(&siso).expect("channels");
+    let model = config.physical.clone().expect("[physical]");
+    bencher.bench(|| rshape::diagnose::retune(&model, &channels, None, true));
 }

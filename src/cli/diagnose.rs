@@ -113,6 +113,9 @@ fn show_progress(v: &super::progress::FitProgressView, p: DiagnoseProgress) {
             "search level {depth} of at most {max}: screening {nodes} effect set{}",
             if nodes == 1 { "" } else { "s" }
         )),
+        DiagnoseProgress::Retune { what, done, total } => {
+            v.count(&format!("retune, {what}"), done, total)
+        }
         DiagnoseProgress::Refits { depth, done, total } => {
             v.count(&format!("search level {depth}, joint refit"), done, total)
         }

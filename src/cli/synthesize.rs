@@ -72,9 +72,6 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         v
     });
     synthesize::plant_factors(&config, &a.config)?;
-    if let Some(v) = &view {
-        v.stage("the controller, then its Theorem 1 proof (exact H∞ norms of the loop)");
-    }
     let (mut rs, fit_input) = a.bounds.bounds(&a.config, &config)?;
     let inputs: Vec<&Path> = std::iter::once(a.config.as_path())
         .chain(a.bounds.files())
@@ -102,11 +99,28 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     };
     let controller_path = a.out.join("controller.toml");
     let data = a.bounds.data.as_deref();
+    let stage = |what: &str| {
+        if let Some(v) = &view {
+            v.stage(what);
+        }
+    };
     let prove = |rs: &[(String, crate::system::TransferFunction)]| {
-        synthesize::run(&config, &a.config, rs, &settings, data, &controller_path)
+        synthesize::run_with_stages(
+            &config,
+            &a.config,
+            rs,
+            &settings,
+            data,
+            &controller_path,
+            &stage,
+        )
     };
     let dry = prove(&rs)?;
-    drop(view);
+    // The bar cleared for the fit's own display (a second proof with the fitted r still
+    // prints its stage lines when stderr is not a terminal).
+    if let Some(v) = &view {
+        v.finish();
+    }
     // Without --fit the run above is the outcome; with it, r is fitted in memory and the
     // proof repeated with the fitted r added, all before anything is written (a refusal,
     // e.g. --reduce on an unstable H∞ controller, leaves no r.json behind).

@@ -117,6 +117,7 @@ pub fn diagnose_channels(
             retuned_in_chosen: Default::default(),
             refused: vec![],
             dampings_not_identified: vec![],
+            residual: None,
             cost_test: Some([n as f64, before.v]),
             peaks: vec![],
             peaks_not_listed: 0,
@@ -128,7 +129,10 @@ pub fn diagnose_channels(
     // The configured model's screen does not need the retune: both at once.
     options.tell(Stage("retune"));
     let (roots, first_screen) = phases.time("retune", || {
-        rayon::join(|| roots(base, data), || screen_configured(base, data))
+        rayon::join(
+            || roots(base, data, options),
+            || screen_configured(base, data),
+        )
     });
     let [configured, retuned_node] = roots?;
     let first_screen = first_screen?;
@@ -237,13 +241,17 @@ pub fn diagnose_channels(
         message += "; ";
         message += &d.reason;
     }
+    let mut residual = None;
     if verdict == DiagnoseVerdict::NoEffectFound {
         let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
         let white =
             crate::diagnose::lsq::whiteness::whiteness(&z, node.n_params, (data.len() / 50).max(5));
-        message += &stop_explanation(&res.refused, &white, |k| {
-            data.omega[k] / std::f64::consts::TAU
-        });
+        let hz = |k: usize| data.omega[k] / std::f64::consts::TAU;
+        message += &stop_explanation(&res.refused, &white, hz);
+        residual = white
+            .level
+            .is_finite()
+            .then(|| residual_account(&white, hz));
     }
     Ok(Diagnosis {
         verdict,
@@ -281,6 +289,7 @@ pub fn diagnose_channels(
             })
             .collect(),
         dampings_not_identified,
+        residual,
         cost_test: Some([n as f64 - node.n_params as f64 / 2.0, after.v]),
         peaks,
         peaks_not_listed,
@@ -439,6 +448,33 @@ fn stop_explanation(
         out += &white.explain(hz);
     }
     out
+}
+
+/// The stop's residual for the JSON (`residual`): the same cases as
+/// [`crate::diagnose::lsq::whiteness::Whiteness::explain`] says in words.
+fn residual_account(
+    w: &crate::diagnose::lsq::whiteness::Whiteness,
+    hz: impl Fn(usize) -> f64,
+) -> crate::diagnose::report::ResidualAccount {
+    let high = w.level > crate::diagnose::lsq::whiteness::LEVEL_HIGH;
+    let kind = match (w.white, high) {
+        (true, false) => "white_at_noise",
+        (true, true) => "scatter_above_noise",
+        (false, _) => "structured",
+    };
+    // The explanation names a concentration only where it stands out (V per datum > 2).
+    let at = w.worst.filter(|(_, _, m)| !w.white && *m > 2.0);
+    crate::diagnose::report::ResidualAccount {
+        level: w.level,
+        ljung_box_q: w.q,
+        q_critical: w.q_crit,
+        lags: w.lags,
+        white: w.white,
+        kind,
+        concentrated_hz: at.map(|(a, b, _)| [hz(a), hz(b)]),
+        concentrated_level: at.map(|(_, _, m)| m),
+        std_factor_times: (w.white && high).then(|| w.level.sqrt()),
+    }
 }
 
 /// The one-paragraph summary of a verdict, from the measures of the configured, the retuned

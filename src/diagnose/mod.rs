@@ -57,12 +57,16 @@ pub use factor_form::physical_from_factors;
 pub use lsq::channels::{misfit_channels, Channels};
 pub use lsq::lm::{lm, LmResult};
 pub use lsq::measures::Measures as ErrorMeasures;
-pub use lsq::retune::{cost, refit_nominal, retune, retune_within, NominalRefit};
+pub use lsq::retune::{
+    cost, refit_nominal, retune, retune_within, NominalRefit, ITERATING as RETUNE_ITERATING,
+    PLACING as RETUNE_PLACING,
+};
 pub use plant_form::{physical_from_config, physical_from_tf, plant_tf, CONVERSION_TOL};
 pub use progress::{DiagnoseOptions, DiagnoseProgress, DiagnoseProgressFn};
 pub use report::{
     CandidateReport, DampingInterval, DiagnoseVerdict, Diagnosis, EffectSet, FinalEffect, Holdout,
-    Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, Retuned, SearchStats, Step, Tie,
+    Peak, PeakFate, PeakProbe, PhaseTime, Phases, RefusedEffect, ResidualAccount, Retuned,
+    SearchStats, Step, Tie,
 };
 pub use revision::{params_text, write_revision, Apply, Revise, Revision};
 pub use search::backward::eliminate;

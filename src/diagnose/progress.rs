@@ -20,6 +20,19 @@ pub enum DiagnoseProgress {
         /// Effect sets screened at this level.
         nodes: usize,
     },
+    /// Inside the `retune` stage (the configured parameters refit from a rough start, the
+    /// longest silent part of a model of hundreds of modes): `what` is
+    /// [`crate::diagnose::RETUNE_PLACING`] (`done` of `total` modes placed by their grid) or
+    /// [`crate::diagnose::RETUNE_ITERATING`] (iteration `done` of the joint refit, at most
+    /// `total`).
+    Retune {
+        /// Which count.
+        what: &'static str,
+        /// Done so far.
+        done: usize,
+        /// The most there will be.
+        total: usize,
+    },
     /// A joint refit of level `depth` finished: `done` of `total`.
     Refits {
         /// The level, 1-based.

@@ -420,6 +420,10 @@ pub struct Diagnosis {
     /// Modes of the final model whose damping the data do not identify: the likelihood is
     /// flat from the record's floor up (`lsq::profile`).
     pub dampings_not_identified: Vec<DampingInterval>,
+    /// When nothing admissible passes (`no_effect_found`): what the remaining misfit is
+    /// (`lsq::whiteness`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residual: Option<ResidualAccount>,
     /// Expected `V` of a right model (`F − n_θ/2`, F complex data), and the achieved `V`.
     pub cost_test: Option<[f64; 2]>,
     /// Every peak of the residual that stands out of the noise, with its fate (at most
@@ -432,6 +436,36 @@ pub struct Diagnosis {
     /// The final model (effects added, everything refit jointly).
     #[serde(skip)]
     pub final_model: PhysicalModel,
+}
+
+/// What the residual of a stop is (`lsq::whiteness`), for the verdict `no_effect_found`: its
+/// level against the stated noise and whether it is white along frequency.
+#[derive(Debug, Clone, Serialize)]
+pub struct ResidualAccount {
+    /// `V/E[V]`: 1 at the stated noise.
+    pub level: f64,
+    /// The complex Ljung–Box statistic `Q` over `lags` lags per channel, and its
+    /// `1 − α` quantile (α = 1e-3).
+    pub ljung_box_q: f64,
+    /// The quantile `Q` is compared with.
+    pub q_critical: f64,
+    /// Lags per channel.
+    pub lags: usize,
+    /// `Q ≤ q_critical`: no structure is left along frequency.
+    pub white: bool,
+    /// `white_at_noise` (nothing more to find), `scatter_above_noise` (white but above the
+    /// stated σ: a `std_factor`), `structured` (missing dynamics).
+    pub kind: &'static str,
+    /// Where a structured residual concentrates, Hz (absent when white or spread).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub concentrated_hz: Option<[f64; 2]>,
+    /// `V` per datum there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub concentrated_level: Option<f64>,
+    /// For `scatter_above_noise`: the factor `√(V/E[V])` by which `std_factor` (or the
+    /// noise radius) would have to grow to cover the scatter.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std_factor_times: Option<f64>,
 }
 
 /// A damping the data do not identify (`lsq::profile`): every `ζ` from

@@ -8,7 +8,7 @@ use crate::model::controller::Controller;
 use crate::model::{Config, FactorizationKind};
 use crate::plot::stability::{stability_svg, StabilityInput};
 use crate::report::fmt::fmt_g;
-use crate::stability::{analyze_with_stages, GridCurve, RobustStability, Verdict};
+use crate::stability::{analyze_gridded, GridCurve, RobustStability, Verdict};
 use crate::system::{logspace, TransferFunction};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -127,7 +127,7 @@ pub fn run(
     run_with_stages(config, controller, rs, data, &|_| ())
 }
 
-/// [`run`], telling `stage` what it starts (see [`analyze_with_stages`]).
+/// [`run`], telling `stage` what it starts (see [`crate::stability::analyze_with_stages`]).
 pub fn run_with_stages(
     config: &Config,
     controller: &Controller,
@@ -135,9 +135,14 @@ pub fn run_with_stages(
     data: Option<&Path>,
     stage: &dyn Fn(&str),
 ) -> Result<StabilityOutcome> {
-    let poles = check_controller(config, controller)?;
-    let g = grid(config, data, &poles);
-    let (report, curve) = analyze_with_stages(&config.factorization, controller, rs, &g, stage)?;
+    // The grid needs the poles only without data: the loop and its poles once, in `analyze`.
+    let (report, curve) = analyze_gridded(
+        &config.factorization,
+        controller,
+        rs,
+        &|poles| grid(config, data, poles),
+        stage,
+    )?;
     let robust = report.internally_stable && report.margins.iter().all(|m| m.robust);
     Ok(StabilityOutcome {
         report,

@@ -31,6 +31,24 @@ pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
     if let Some(ncf) = &f.realization {
         return Ok(ncf.plant_and_m_inverse());
     }
+    if f.states() >= CASCADE_ROWS_FROM && f.m.is_diagonal() {
+        // `J` once for all rows (its poles once, as in the whole-matrix cascade).
+        return Ok(modal_rows(f, Rows::Cascade)?.series(&j_and_identity(f)));
+    }
+    modal_cascade(f)
+}
+
+/// From this many modal coordinates on, [`modal_system`] of a diagonal `M̃` realizes the
+/// cascade one row at a time (`M̃ᵢᵢ⁻¹·[Ñᵢ  1]`, stacked): the same poles (hidden modes of the
+/// factors included), without the staircase reduction of a system with `n + m` inputs and
+/// `2n` states (1000 modes: minutes, issue 34). Below it, the whole-matrix cascade (the
+/// figures of small models unchanged to the last digit).
+pub const CASCADE_ROWS_FROM: usize = 50;
+
+/// The cascade `M̃⁻¹·[Ñ·J  I]` of the whole matrices, made minimal factor by factor: what
+/// [`modal_system`] is below [`CASCADE_ROWS_FROM`] modal coordinates (or for a
+/// non-diagonal `M̃`), and the dense route its row-by-row realization is checked against.
+pub fn modal_cascade(f: &Factorization) -> Result<StateSpace> {
     let (n, m) = (f.states(), f.inputs());
     let rows: Vec<Vec<TransferFunction>> = (0..n)
         .map(|i| {
@@ -57,12 +75,29 @@ pub fn modal_system(f: &Factorization) -> Result<StateSpace> {
 /// realization of that cascade kept all 4 states per mode (the hidden ones nearly
 /// uncontrollable and unobservable), and the filter Riccati equation of the plant did not
 /// converge (`synthesize` failed, issue 34 item 9).
-fn modal_rows(f: &Factorization) -> Result<StateSpace> {
+///
+/// With [`Rows::Cascade`] each row is instead the cascade `M̃ᵢᵢ⁻¹·[Ñᵢ  1]` without the
+/// cancellation (4 states per mode, its hidden modes kept): the realization of
+/// [`modal_system`] for a large diagonal `M̃`, block by block.
+pub(crate) fn modal_rows(f: &Factorization, how: Rows) -> Result<StateSpace> {
     let (n, m) = (f.states(), f.inputs());
     let mut blocks = Vec::with_capacity(n);
     for i in 0..n {
         let mii = f.m.entry(i, i);
         let nrow: Vec<&TransferFunction> = (0..m).map(|j| f.n.entry(i, j)).collect();
+        if how == Rows::Cascade {
+            let row: Vec<TransferFunction> = nrow
+                .iter()
+                .map(|t| (*t).clone())
+                .chain(std::iter::once(TransferFunction::gain(1.0)))
+                .collect();
+            let s = StateSpace::from_tf_matrix(&TfMatrix::from_rows(vec![row]).expect("one row"))
+                .minimal(1e-12);
+            let mi =
+                StateSpace::from_tf_matrix(&TfMatrix::diagonal(vec![mii.clone()])).minimal(1e-12);
+            blocks.push(mi.inverse("M̃")?.series(&s));
+            continue;
+        }
         if nrow.iter().all(|t| t.den == mii.den) {
             // The common case (a [physical] mode: Ñᵢ = b·s^k/q, M̃ᵢᵢ = d/q): cancel q exactly,
             // `M̃ᵢᵢ⁻¹·[Ñᵢ  1] = [b·s^k  q]/d`, and realize that row of one denominator.
@@ -88,6 +123,23 @@ fn modal_rows(f: &Factorization) -> Result<StateSpace> {
         let mi = StateSpace::from_tf_matrix(&TfMatrix::diagonal(vec![mii.clone()])).minimal(1e-12);
         blocks.push(mi.inverse("M̃")?.series(&s).minimal(1e-12).balanced());
     }
+    Ok(stack_rows(&blocks, m))
+}
+
+/// How [`modal_rows`] realizes a row.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Rows {
+    /// `q` cancelled exactly where `Ñᵢ` has the denominator of `M̃ᵢᵢ` (2 states per mode):
+    /// the same transfer function, the factors' hidden modes left out.
+    Cancelled,
+    /// The cascade `M̃ᵢᵢ⁻¹·[Ñᵢ  1]` (the hidden modes kept): the poles of the loop.
+    Cascade,
+}
+
+/// The rows `M̃ᵢᵢ⁻¹·[Ñᵢ(·J)  1]` (inputs `[u; wᵢ]`, output `ξᵢ`) stacked into one system with
+/// inputs `[u; w]`, block-diagonal `A`.
+fn stack_rows(blocks: &[StateSpace], m: usize) -> StateSpace {
+    let n = blocks.len();
     let total: usize = blocks.iter().map(StateSpace::states).sum();
     let mut a = DMatrix::zeros(total, total);
     let mut b = DMatrix::zeros(total, m + n);
@@ -104,7 +156,7 @@ fn modal_rows(f: &Factorization) -> Result<StateSpace> {
         d[(i, m + i)] = blk.d[(0, m)];
         at += k;
     }
-    Ok(StateSpace { a, b, c, d })
+    StateSpace { a, b, c, d }
 }
 
 /// `K·C`: the controller reading the modal signal through the output matrix `C`.
@@ -160,7 +212,7 @@ pub fn theorem1_norm_system(
     if full.states() < ROW_NORMS_FROM || f.realization.is_some() || !f.m.is_diagonal() {
         return Ok(full.clone());
     }
-    let ms = modal_rows(f)?.series(&j_and_identity(f));
+    let ms = modal_rows(f, Rows::Cancelled)?.series(&j_and_identity(f));
     let closed = negative_feedback(&ms, &controller_on_modes(f, k), f.inputs())?;
     Ok(j_and_identity(f).series(&closed))
 }
@@ -170,7 +222,7 @@ pub fn theorem1_norm_system(
 /// modal system. The Theorem 1 loop keeps [`modal_system`] (its hidden modes included).
 pub fn plant_system(f: &Factorization) -> Result<StateSpace> {
     let ms = if f.realization.is_none() && f.m.is_diagonal() {
-        modal_rows(f)?.series(&j_and_identity(f))
+        modal_rows(f, Rows::Cancelled)?.series(&j_and_identity(f))
     } else {
         modal_system(f)?
     };
@@ -205,6 +257,54 @@ pub fn gang_of_four(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
         d,
     };
     negative_feedback(&plant, k, m)
+}
+
+/// `σ_max` of the gang of four `[−K; I](I + GK)⁻¹[I  G]` at `jω` ([`gang_of_four`], whose
+/// H∞ norm is `1/b(G,K)`) from the factor values: `G = C·M̃⁻¹·Ñ·J` with a diagonal `M̃`
+/// divided entry by entry (`O(n·m)`, no dense `n × n` solve), else by [`Factorization::plant`].
+/// `None` where `M̃` or `I + GK` is singular or `K` has a pole at `jω`. For the start and the
+/// local polish of `b(G,K)`'s Hamiltonian iteration on a large loop (an exact value at
+/// rounding: it never exceeds the norm but by rounding).
+pub fn gang_sigma_max(f: &Factorization, k: &FreqEvaluator, omega: f64) -> Option<f64> {
+    let kw = k.freq(omega)?;
+    let g = if f.realization.is_none() && f.m.is_diagonal() {
+        let n = f.states();
+        let mut u = f.n.freq(omega);
+        for i in 0..n {
+            let d = f.m.entry(i, i).freq(omega);
+            if d.norm() == 0.0 || !(d.re.is_finite() && d.im.is_finite()) {
+                return None;
+            }
+            let mut row = u.row_mut(i);
+            row /= d;
+        }
+        for (j, t) in f.j.iter().enumerate() {
+            let jj = t.freq(omega);
+            let mut col = u.column_mut(j);
+            col *= jj;
+        }
+        f.c.map(|x| Complex64::new(x, 0.0)) * u
+    } else {
+        f.plant(omega)?
+    };
+    let (p, m) = g.shape();
+    let s = (DMatrix::identity(p, p) + &g * &kw)
+        .lu()
+        .solve(&DMatrix::identity(p, p))?;
+    // [−K; I]·S·[I  G]
+    let left = {
+        let mut l = DMatrix::zeros(m + p, p);
+        l.view_mut((0, 0), (m, p)).copy_from(&(-(&kw * &s)));
+        l.view_mut((m, 0), (p, p)).copy_from(&s);
+        l
+    };
+    let mut right = DMatrix::zeros(p, p + m);
+    right
+        .view_mut((0, 0), (p, p))
+        .copy_from(&DMatrix::identity(p, p));
+    right.view_mut((0, p), (p, m)).copy_from(&g);
+    let v = crate::system::linalg::spectral_norm(&(left * right));
+    v.is_finite().then_some(v)
 }
 
 /// `σ_max(T(jω))` from the factor values, `T = [−J·K·C; I](M̃ + Ñ·J·K·C)⁻¹` (module

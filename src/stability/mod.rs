@@ -23,12 +23,16 @@
 //! and the grid curve [`GridCurve`] of [`MarginRow`]s, cross-checked within
 //! [`CROSS_CHECK_RTOL`]), [`decide`] (the verdict from the norm's bounds), and the systems
 //! it is computed on: [`theorem1_system`] (`r·T` of condition 2), [`gang_of_four`],
-//! [`plant_system`], [`modal_system`] and the grid value [`t_sigma_max`].
+//! [`plant_system`], [`modal_system`] (for a large diagonal `M̃` row by row; the whole-matrix
+//! [`modal_cascade`] below [`CASCADE_ROWS_FROM`]) and the grid value [`t_sigma_max`].
 pub(crate) mod factor_loop;
 pub(crate) mod theorem1;
 
-pub use factor_loop::{gang_of_four, modal_system, plant_system, t_sigma_max, theorem1_system};
+pub use factor_loop::{
+    gang_of_four, gang_sigma_max, modal_cascade, modal_system, plant_system, t_sigma_max,
+    theorem1_system, CASCADE_ROWS_FROM,
+};
 pub use theorem1::{
-    analyze, analyze_with_stages, closed_loop_poles, controller_fits, decide, GridCurve, MarginRow,
-    RobustStability, Verdict, CROSS_CHECK_RTOL,
+    analyze, analyze_gridded, analyze_with_stages, closed_loop_poles, controller_fits, decide,
+    GridCurve, MarginRow, RobustStability, Verdict, CROSS_CHECK_RTOL,
 };

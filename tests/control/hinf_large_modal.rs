@@ -7,9 +7,7 @@
 //! mode. The grid never exceeds the proven upper bound, comes within 1e-6 of the norm, and
 //! the norm is attained where the iteration says.
 
-#[path = "../../benches/support/modes.rs"]
-#[allow(dead_code)]
-mod modes;
+use crate::modes;
 
 use rshape::model::{Config, Controller};
 use rshape::system::{hinf_norm, logspace, FreqEvaluator};

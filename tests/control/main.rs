@@ -6,10 +6,17 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+/// The large-model structure of the benches (one copy for every file of this binary).
+#[path = "../../benches/support/modes.rs"]
+#[allow(dead_code)]
+mod modes;
+
 mod closed_loop_stability_large;
 mod hinf_large_modal;
 mod hinf_near_d;
 mod iss_reduction;
+mod modal_cascade_rows;
+mod progress_stages;
 mod stability;
 mod stability_special;
 mod synthesize;

@@ -4,7 +4,7 @@
 
 use num_complex::Complex64;
 use rshape::diagnose::{diagnose_channels, Channels, DiagnoseOptions, DiagnoseProgress};
-use rshape::diagnose::{DiagnoseVerdict, SearchSettings};
+use rshape::diagnose::{DiagnoseVerdict, SearchSettings, RETUNE_ITERATING, RETUNE_PLACING};
 use rshape::model::physical::{Gains, ModeSpec, PhysicalModel};
 use std::sync::Mutex;
 
@@ -103,6 +103,7 @@ fn progress_reports_stages_levels_and_every_refit() {
         }
     }
     assert_eq!(levels[0], (1, 2), "{heard:?}");
+    check_retune_counts(&heard, base.mode.len());
     assert!(
         levels.windows(2).all(|w| w[1].0 == w[0].0 + 1),
         "{levels:?}"
@@ -132,4 +133,104 @@ fn progress_reports_stages_levels_and_every_refit() {
     let quiet = diagnose_channels(&base, &data, &s, &Default::default()).unwrap();
     assert_eq!(quiet.chosen, d.chosen);
     assert_eq!(quiet.after.v, d.after.v);
+}
+
+/// The counts inside the `retune` stage (issue 34: at 1000 modes it was minutes without a
+/// line): each configured mode placed once, in order (the rough placement goes mode by
+/// mode), then the joint refit's iterations 1, 2, … of at most 200; all of it after the
+/// `retune` stage begins and before the search's first level (or the next stage).
+fn check_retune_counts(heard: &[DiagnoseProgress], modes: usize) {
+    let start = heard
+        .iter()
+        .position(|p| *p == DiagnoseProgress::Stage("retune"))
+        .unwrap();
+    // The search's first level, or the next stage (a retune that explains the data ends
+    // the run before any search), or the end.
+    let first_level = heard
+        .iter()
+        .enumerate()
+        .position(|(i, p)| {
+            i > start
+                && matches!(
+                    p,
+                    DiagnoseProgress::Level { .. } | DiagnoseProgress::Stage(_)
+                )
+        })
+        .unwrap_or(heard.len());
+    let (mut placed, mut iterations) = (Vec::new(), Vec::new());
+    for (i, p) in heard.iter().enumerate() {
+        if let DiagnoseProgress::Retune { what, done, total } = *p {
+            assert!(start < i && i < first_level, "{heard:?}");
+            match what {
+                w if w == RETUNE_PLACING => {
+                    assert_eq!(total, modes);
+                    assert!(
+                        iterations.is_empty(),
+                        "placement after the refit: {heard:?}"
+                    );
+                    placed.push(done);
+                }
+                w if w == RETUNE_ITERATING => {
+                    assert_eq!(total, 200);
+                    iterations.push(done);
+                }
+                w => panic!("unknown retune count {w}"),
+            }
+        }
+    }
+    assert_eq!(placed, (1..=modes).collect::<Vec<_>>(), "{heard:?}");
+    assert!(!iterations.is_empty(), "{heard:?}");
+    assert_eq!(iterations, (1..=iterations.len()).collect::<Vec<_>>());
+}
+
+/// Three configured modes: the retune tells each placed in order.
+#[test]
+fn retune_counts_every_mode_placed_in_order() {
+    let base = PhysicalModel {
+        mode: vec![mode(300.0, 1e5), mode(600.0, 4e5), mode(1200.0, 1e6)],
+        ..Default::default()
+    };
+    let (_, data) = case();
+    let s = SearchSettings {
+        max_effects: 1,
+        beam: 1,
+        ..Default::default()
+    };
+    let heard = Mutex::new(Vec::new());
+    let listen = |p: DiagnoseProgress| heard.lock().unwrap().push(p);
+    let options = DiagnoseOptions {
+        progress: Some(&listen),
+    };
+    diagnose_channels(&base, &data, &s, &options).unwrap();
+    check_retune_counts(&heard.into_inner().unwrap(), 3);
+}
+
+/// More output gains than real data (three modes, one datum: 3 linear slots, 2 rows, as 1000
+/// modes on 200 data): the linear slots alone fit the datum, so the retune is their least
+/// squares and moves no `ω_n` or `ζ` (before, every grid point and every finite-difference
+/// Jacobian column was a full rank-deficient least squares: hours at 1000 modes). The cost,
+/// recomputed from the model, is that exact fit's.
+#[test]
+fn retune_settles_when_the_linear_slots_already_fit_the_data() {
+    let base = PhysicalModel {
+        mode: vec![mode(300.0, 1e5), mode(600.0, 4e5), mode(1200.0, 1e6)],
+        ..Default::default()
+    };
+    let (_, full) = case();
+    let k = 20;
+    let one = Channels {
+        path: full.path.clone(),
+        omega: vec![full.omega[k]],
+        entries: full.entries.clone(),
+        g: vec![vec![full.g[0][k]]],
+        radius: vec![vec![full.radius[0][k]]],
+        radius_source: full.radius_source.clone(),
+    };
+    let r = rshape::diagnose::retune(&base, &one, None, true);
+    assert!(r.v_before > 1.0, "{}", r.v_before);
+    assert!(r.v_after < 1e-2, "{}", r.v_after);
+    assert!((rshape::diagnose::cost(&r.model, &one, &[0]) - r.v_after).abs() < 1e-6);
+    for (a, b) in r.model.mode.iter().zip(&base.mode) {
+        assert_eq!((a.omega_n, a.zeta), (b.omega_n, b.zeta));
+    }
 }

@@ -3,7 +3,8 @@
 //! * `effect`: the [`effect::Effect`] trait each effect implements, with what every effect
 //!   shares (the channel selection `Sel`, the ζ bounds, a term's residue);
 //! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
-//!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`), registered below;
+//!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`, `residual_mode`),
+//!   registered below;
 //! * `path`, `configured`, `coefficient` and `factor`: the four recurring shapes, a path
 //!   effect on one parameter (`delay`, `lag`, `nmp_zero`, `zoh`: `OnPath`, `on_path!`), a
 //!   refit of one parameter of a configured mode (`mode_shift`, `damping`: `RefitsMode`,
@@ -152,4 +153,7 @@ register! { $
     ModeShift(usize) => mode_shift::ModeShift,
     /// Changed damping of mode `i`; θ = [ln ζ].
     Damping(usize) => damping::Damping,
+    /// A pseudo-mode above the band, a residual term (tried once the upper residual is in
+    /// the model); θ = [ln ω_n, ρ_1 … ρ_C].
+    ResidualMode => residual_mode::ResidualMode,
 }

@@ -8,7 +8,8 @@
 //! [`super::retune::retune_holding`]) is followed upward from `ζ_f` by factors of `√2`
 //! until `V_p(ζ) − V_p(ζ_f)` exceeds `½ χ²₁(0.95) · s` (the likelihood-ratio 95 % interval,
 //! `−2 ln L = 2V`; `s = max(1, V/F)` widens it where the residual itself exceeds the stated
-//! noise, a quasi-likelihood scale).  The supported interval is `[ζ_f, ζ_u]`, `ζ_u` by linear
+//! noise, a quasi-likelihood scale; `V/F` is taken as the larger of the whole band's and that
+//! of the lines around the mode, [`near_lines`], where a local lack of fit says as much).  The supported interval is `[ζ_f, ζ_u]`, `ζ_u` by linear
 //! interpolation in `ln ζ` between the last point inside and the first outside.
 //!
 //! The damping is **not identified** when `ζ_u/ζ_f > exp(1.96/3)` — a 95 % interval wider
@@ -19,7 +20,7 @@
 //! says "not identified: measure denser lines around f".
 
 use super::channels::Channels;
-use super::resolution::zeta_range;
+use super::resolution::{spacing_at, zeta_range};
 use super::retune::{cost, retune_holding};
 use super::slots::Nl;
 use crate::model::physical::PhysicalModel;
@@ -36,6 +37,8 @@ pub const AT_FLOOR: f64 = 1.05;
 pub fn flat_ratio() -> f64 {
     (1.959_963_984_540_054 / 3.0f64).exp()
 }
+/// Half-width of the lines that see a mode, in line spacings (at least 2 % of its frequency).
+const NEAR_LINES: f64 = 10.0;
 /// No profile above this damping (the refit's own upper bound is 0.7).
 const ZETA_TOP: f64 = 0.5;
 
@@ -78,6 +81,14 @@ pub fn modes_at_floor(m: &PhysicalModel, data: &Channels) -> Vec<usize> {
         .collect()
 }
 
+/// The lines that see a mode at `w` (rad/s): within `max(2 %, NEAR_LINES spacings)` of it.
+pub fn near_lines(data: &Channels, w: f64) -> Vec<usize> {
+    let half = (0.02 * w).max(NEAR_LINES * spacing_at(&data.omega, w));
+    (0..data.omega.len())
+        .filter(|&i| (data.omega[i] - w).abs() <= half)
+        .collect()
+}
+
 /// The profile of mode `k`'s damping in `m` (a least-squares fit on every datum of `data`,
 /// built from `anchor`, whose boxes every refit keeps), from the record's floor upward.
 pub fn zeta_profile(
@@ -97,7 +108,15 @@ pub fn zeta_profile(
     };
     let (m0, v0) = at(m, floor);
     let v0 = v0.min(cost(m, data, &(0..data.len()).collect::<Vec<_>>()));
-    let scale = (v0 / data.n_data() as f64).max(1.0);
+    // The residual's level where ζ is seen (the lines around the mode) may exceed the
+    // whole band's: a term the model lacks there (pyuff's 51.5 Hz mode, whose data carry a
+    // phase no real-residue term makes) makes the likelihood's curvature overstate what the
+    // data say of ζ.  The larger of the two levels widens the interval.
+    let near = near_lines(data, w);
+    let f_near = (near.len() * data.n_ch()).max(1) as f64;
+    let scale = (v0 / data.n_data() as f64)
+        .max(cost(&m0, data, &near) / f_near)
+        .max(1.0);
     let threshold = HALF_CHI2_1_95 * scale;
     let mut points = vec![(floor, 0.0)];
     let mut upper = ZETA_TOP;
@@ -214,6 +233,76 @@ mod tests {
         // supported interval spans more than the covariance rule allows.
         assert!(p.flat(), "{p:?}");
         assert!((p.midpoint() - (floor * p.upper).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_lack_of_fit_around_the_mode_widens_the_interval_by_its_own_level() {
+        // A mode at 460.5 Hz between 1 Hz lines whose data carry a residue rotated by 0.15
+        // rad (no real-residue term makes it), beside a well-modelled mode at 800 Hz that
+        // dominates most of the band 300–1000 Hz: the lack of fit sits around 460 Hz.
+        let (w1, w2) = (TAU * 460.5, TAU * 800.0);
+        let omega: Vec<f64> = (300..=1000).map(|k| TAU * k as f64).collect();
+        let mut model = one_mode(w1, 1e-6, 2.0e4);
+        model.mode.push(one_mode(w2, 0.01, 2.0e6).mode[0].clone());
+        let rot = Complex64::from_polar(1.0, 0.15);
+        let g: Vec<Complex64> = omega
+            .iter()
+            .map(|w| {
+                let s = Complex64::new(0.0, *w);
+                2.0e4 * rot / (s * s + 2e-6 * w1 * s + w1 * w1)
+                    + 2.0e6 / (s * s + 0.02 * w2 * s + w2 * w2)
+            })
+            .collect();
+        let radius: Vec<f64> = g.iter().map(|x| 0.01 * x.norm()).collect();
+        let data = Channels {
+            path: "test".into(),
+            radius_source: vec![String::new()],
+            omega: omega.clone(),
+            entries: vec![(0, 0)],
+            g: vec![g.clone()],
+            radius: vec![radius.clone()],
+        };
+        let floor = zeta_range(&data, w1).floor;
+        let mut m = model.clone();
+        m.mode[0].zeta = floor;
+        let p = zeta_profile(&m, &m, &data, 0);
+        // The level of the lines within ±10 Hz, by brute force: the 800 Hz mode as
+        // generated, the 460 Hz mode at the floor with ω_n on a grid and its real residue in
+        // closed form (weighted least squares).
+        let near: Vec<usize> = (0..omega.len())
+            .filter(|&k| (omega[k] - w1).abs() <= TAU * 10.0 + 1e-9)
+            .collect();
+        let local = (-400..=400)
+            .map(|j| {
+                let w = w1 * (1.0 + 2.5e-7 * j as f64);
+                let (mut num, mut den) = (0.0, 0.0);
+                let basis = |k: usize| one_mode(w, floor, 1.0).eval(omega[k])[(0, 0)];
+                let rest = |k: usize| one_mode(w2, 0.01, 2.0e6).eval(omega[k])[(0, 0)];
+                for &k in &near {
+                    let wk = 2.0 / (radius[k] * radius[k]);
+                    num += wk * (basis(k).conj() * (g[k] - rest(k))).re;
+                    den += wk * basis(k).norm_sqr();
+                }
+                let rho = num / den;
+                near.iter()
+                    .map(|&k| 2.0 * ((g[k] - rest(k) - rho * basis(k)).norm() / radius[k]).powi(2))
+                    .sum::<f64>()
+            })
+            .fold(f64::INFINITY, f64::min)
+            / near.len() as f64;
+        assert!(local > 10.0, "the construction: local V/F {local}");
+        let scale = p.threshold / HALF_CHI2_1_95;
+        // The refit also moves the 800 Hz mode a little: within 10 %.
+        assert!(
+            (scale / local - 1.0).abs() < 0.1,
+            "scale {scale} vs local V/F {local}"
+        );
+        // Far above the whole band's own level (most lines fit).
+        let whole = cost(&m, &data, &(0..data.len()).collect::<Vec<_>>()) / data.n_data() as f64;
+        assert!(
+            scale > 3.0 * whole.max(1.0),
+            "scale {scale}, whole band {whole}"
+        );
     }
 
     #[test]

@@ -23,7 +23,7 @@
 //! cost is `V = Σ|G_d − G(θ)|²/σ²`, `σ = r/√2`; the refit never raises it.
 
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::lm::{lm_box_normal, LmSettings};
+use crate::diagnose::lsq::lm::{lm_box_normal, LmSettings, V_TOL};
 use crate::diagnose::lsq::slots::{
     anchor_value, block_matrix, blocks, bounds, design, get_nl, set_lin, set_nl, slots, Lin, Nl,
     MODE_BOX,
@@ -36,6 +36,23 @@ use rayon::prelude::*;
 
 /// Iterations after which [`retune_or_give_up`] gives up a refit still above its cost.
 pub(crate) const GIVE_UP_AFTER: usize = 10;
+
+/// Most accepted Levenberg–Marquardt steps of a retune.
+pub(crate) const MAX_ITERATIONS: usize = 200;
+
+/// Hears a long retune count what it does (a model of hundreds of modes refits for minutes,
+/// issue 34): `(what, done, total)` with `what` one of [`PLACING`] (the rough placement,
+/// mode by mode) and [`ITERATING`] (the joint refit's Levenberg–Marquardt iterations, of at
+/// most [`MAX_ITERATIONS`]).
+pub(crate) type RetuneTell<'a> = &'a (dyn Fn(&'static str, usize, usize) + Sync);
+
+/// What a retune's listener hears during the rough placement (`done` of `total` modes placed;
+/// [`crate::diagnose::DiagnoseProgress::Retune`]).
+pub const PLACING: &str = "rough placement, mode";
+
+/// What a retune's listener hears during the joint refit (iteration `done` of at most `total`;
+/// [`crate::diagnose::DiagnoseProgress::Retune`]).
+pub const ITERATING: &str = "joint refit, iteration";
 
 /// The result of a refit.
 #[derive(Debug, Clone)]
@@ -97,13 +114,19 @@ pub(crate) fn solve_linear_res(
 fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
     let n = a.ncols();
     let scale = crate::system::linalg::equilibrate_columns(&mut a);
+    if a.nrows() < n {
+        let mut x = min_norm_solve(a, y);
+        for (xi, s) in x.iter_mut().zip(&scale) {
+            *xi /= s;
+        }
+        return x;
+    }
     let qr = a.qr();
     let r = qr.r();
     // Qᵀy by the Householder reflections (no explicit Q).
     let mut qty = y;
     qr.q_tr_mul(&mut qty);
-    // More parameters than rows (a 1000-mode model on 200 data panicked here, issue 34): R
-    // has only `rows` pivots; the trailing parameters stay 0 (a basic least-squares solution).
+    // At least as many rows as parameters here (fewer went to `min_norm_solve`).
     let k = r.nrows().min(n);
     let rmax = (0..k).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
     let mut x = DVector::<f64>::zeros(n);
@@ -121,6 +144,33 @@ fn qr_solve(mut a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
         *xi /= s;
     }
     x
+}
+
+/// More parameters than rows (a 1000-mode model on 200 data, issue 34): the least-norm
+/// solution of `A x = y` (in the equilibrated columns), `Aᵀ = Q R`, `Rᵀ z = y`, `x = Q z`,
+/// which fits every row when `A` has full row rank (a row with a negligible pivot is left
+/// unfitted). Every column takes part, where the basic solution of the square QR kept the
+/// first `rows` columns only (the modes of the lowest frequencies, badly conditioned on the
+/// whole band).
+fn min_norm_solve(a: DMatrix<f64>, y: DVector<f64>) -> DVector<f64> {
+    let rows = a.nrows();
+    let qr = a.transpose().qr();
+    let r = qr.r();
+    let rmax = (0..rows).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    // Rᵀ z = y, forward substitution.
+    let mut z = DVector::<f64>::zeros(rows);
+    for i in 0..rows {
+        // A NaN pivot counts as negligible too.
+        if r[(i, i)].abs().is_nan() || r[(i, i)].abs() <= 1e-12 * rmax {
+            continue;
+        }
+        let mut acc = y[i];
+        for j in 0..i {
+            acc -= r[(j, i)] * z[j];
+        }
+        z[i] = acc / r[(i, i)];
+    }
+    qr.q() * z
 }
 
 /// Cost `V` of `m` on the data at `mask`.
@@ -151,6 +201,17 @@ pub fn retune(
     retune_within(m, m, data, mask, rough)
 }
 
+/// [`retune`] on every datum, telling `tell` its counts ([`RetuneTell`]): the root of
+/// `diagnose`, the one refit a large model is silent in for minutes otherwise.
+pub(crate) fn retune_telling(
+    m: &PhysicalModel,
+    data: &Channels,
+    rough: bool,
+    tell: RetuneTell<'_>,
+) -> NominalRefit {
+    refit_holding(m, m, data, None, rough, None, &[], Some(tell)).0
+}
+
 /// [`retune`] with the boxes of the configured parameters around their values in `anchor`,
 /// the configured model `m` was built from (effects added to it keep boxes around their
 /// current values).  A chain of refits (every node of the search, the holdouts) then cannot
@@ -177,7 +238,7 @@ pub(crate) fn retune_or_give_up(
     rough: bool,
     give_up: Option<f64>,
 ) -> (NominalRefit, bool) {
-    refit_holding(m, anchor, data, mask, rough, give_up, &[])
+    refit_holding(m, anchor, data, mask, rough, give_up, &[], None)
 }
 
 /// [`retune_within`] on every datum with the nonlinear slots `hold` kept at their values in
@@ -188,9 +249,10 @@ pub(crate) fn retune_holding(
     data: &Channels,
     hold: &[Nl],
 ) -> NominalRefit {
-    refit_holding(m, anchor, data, None, false, None, hold).0
+    refit_holding(m, anchor, data, None, false, None, hold, None).0
 }
 
+#[allow(clippy::too_many_arguments)]
 fn refit_holding(
     m: &PhysicalModel,
     anchor: &PhysicalModel,
@@ -199,7 +261,13 @@ fn refit_holding(
     rough: bool,
     give_up: Option<f64>,
     hold: &[Nl],
+    tell: Option<RetuneTell<'_>>,
 ) -> (NominalRefit, bool) {
+    let tell = |what: &'static str, done: usize, total: usize| {
+        if let Some(t) = tell {
+            t(what, done, total);
+        }
+    };
     let all: Vec<usize> = (0..data.len()).collect();
     let mask = mask.unwrap_or(&all);
     let (lin, mut nl) = slots(m, data);
@@ -223,7 +291,14 @@ fn refit_holding(
     let w_max = *data.omega.last().expect("data");
     let mut start = m.clone();
     let mut v_start = solve_linear(&mut start, &lin, data, mask);
-    if rough {
+    // Settled: the linear slots alone already fit the data below what the Levenberg–Marquardt
+    // stopping rule acts on, or they are at least as many as the real data values (1000
+    // modes on 200 data, issue 34): then no ω_n, ζ or other nonlinear parameter is
+    // identified by the data, and each grid point and finite-difference Jacobian column would
+    // be a full rank-deficient least squares (hours at that size). The linear least-norm
+    // solution is the refit.
+    let settled = v_start < V_TOL || lin.len() >= 2 * mask.len() * data.n_ch();
+    if rough && !settled {
         for i in 0..m.mode.len() {
             let (w0, z0) = (start.mode[i].omega_n, start.mode[i].zeta);
             let mut best = (v_start, w0, z0);
@@ -258,6 +333,7 @@ fn refit_holding(
             start.mode[i].omega_n = best.1;
             start.mode[i].zeta = best.2;
             v_start = solve_linear(&mut start, &lin, data, mask);
+            tell(PLACING, i + 1, m.mode.len());
         }
     }
     let theta0: Vec<f64> = nl.iter().map(|s| get_nl(&start, *s)).collect();
@@ -279,7 +355,7 @@ fn refit_holding(
         (mm, v)
     };
     let mut abandoned = false;
-    let best = if nl.is_empty() {
+    let best = if nl.is_empty() || settled {
         (start.clone(), v_start)
     } else {
         // VarPro residual: the weighted complex error with the linear slots solved.
@@ -299,17 +375,32 @@ fn refit_holding(
             mask,
             typ: &typ,
         };
+        // One count per accepted step's derivatives: the iteration count the listener hears.
+        let iterations = std::sync::atomic::AtomicUsize::new(0);
+        let tick = || {
+            let k = iterations.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            tell(ITERATING, k, MAX_ITERATIONS);
+        };
         let res = lm_box_normal(
             resid,
-            &|th: &[f64], r: &[f64]| vp.normal(th, r),
-            &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| vp.jacobian(th, j),
+            &|th: &[f64], r: &[f64]| {
+                let normal = vp.normal(th, r);
+                if normal.is_some() {
+                    tick();
+                }
+                normal
+            },
+            &|th: &[f64], _: &[f64], j: &mut DMatrix<f64>| {
+                tick();
+                vp.jacobian(th, j)
+            },
             &theta0,
             &typ,
             &lo,
             &hi,
             &LmSettings {
                 give_up: give_up.map(|v| (GIVE_UP_AFTER, v)),
-                ..LmSettings::likelihood(200)
+                ..LmSettings::likelihood(MAX_ITERATIONS)
             },
         );
         abandoned = res.abandoned;
@@ -355,8 +446,9 @@ pub fn refit_nominal(
 
 #[cfg(test)]
 mod tests {
-    /// Fewer rows than parameters: no panic, and the answer fits the data exactly (the
-    /// system is consistent), with the parameters beyond the rows at 0.
+    /// Fewer rows than parameters: no panic, the answer fits the data exactly (the system is
+    /// consistent), and it is the least-norm one in the equilibrated columns, checked by the
+    /// normal equations of the rows: `x̃ = Bᵀ(BBᵀ)⁻¹y`, `B = A·diag(1/‖aⱼ‖)`, `x = x̃/‖aⱼ‖`.
     #[test]
     fn qr_solve_with_more_parameters_than_rows() {
         use nalgebra::{DMatrix, DVector};
@@ -365,7 +457,12 @@ mod tests {
         let x = super::qr_solve(a.clone(), y.clone());
         assert_eq!(x.len(), 4);
         assert!((&a * &x - &y).norm() < 1e-12, "{x}");
-        assert_eq!((x[2], x[3]), (0.0, 0.0));
+        let norms: Vec<f64> = a.column_iter().map(|c| c.norm()).collect();
+        let b = DMatrix::from_fn(2, 4, |i, j| a[(i, j)] / norms[j]);
+        let xt = b.transpose() * (&b * b.transpose()).try_inverse().unwrap() * &y;
+        for j in 0..4 {
+            assert!((x[j] - xt[j] / norms[j]).abs() < 1e-12, "{x} vs {xt}");
+        }
     }
 
     use super::*;

@@ -227,11 +227,13 @@ pub(crate) fn bounds(
     match s {
         Nl::ModeW(i) => {
             let (mut lo, mut hi) = (x0 - MODE_BOX.ln(), x0 + MODE_BOX.ln());
-            let added = m.mode[i]
-                .name
-                .as_deref()
-                .is_some_and(|n| n.starts_with(ADDED_NOTE));
-            if added {
+            let name = m.mode[i].name.as_deref();
+            let added = name.is_some_and(|n| n.starts_with(ADDED_NOTE));
+            if crate::diagnose::effects::residual_mode::is_pseudo_mode(name) {
+                // A pseudo-mode above the band (a residual term) stays above it.
+                lo = lo.max((crate::diagnose::effects::residual_mode::ABOVE.0 * w_max).ln());
+                hi = hi.max(lo);
+            } else if added {
                 lo = lo.max(w_min.ln());
                 hi = hi.min(w_max.ln()).max(lo);
             }

@@ -16,6 +16,7 @@
 
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::effects::candidates::ADDED_NOTE;
+use crate::diagnose::effects::residual_mode::is_pseudo_mode;
 use crate::model::physical::{ModeSpec, PhysicalModel};
 
 /// Weight of the shape term `1 − MAC` against `|ln(ω_f/ω_b)|`: two modes 5 % apart with
@@ -203,19 +204,22 @@ pub fn align_from(
     effects: &[(Cand, Vec<f64>)],
 ) -> PhysicalModel {
     let base = refs[0];
-    let added_w: Vec<f64> = effects
+    // The added modes, and the pseudo-modes above the band (residual terms), each named by
+    // its own effect.
+    let added: Vec<(Cand, f64)> = effects
         .iter()
-        .filter(|(c, th)| *c == Cand::Mode && !th.is_empty())
-        .map(|(_, th)| th[0].exp())
+        .filter(|(c, th)| matches!(c, Cand::Mode | Cand::ResidualMode) && !th.is_empty())
+        .map(|(c, th)| (*c, th[0].exp()))
         .collect();
-    let (matched, unmatched) = match joint_assignment(refs, m, &added_w) {
-        Some(a) => a,
+    let added_w: Vec<f64> = added.iter().map(|a| a.1).collect();
+    let (matched, unmatched, by_effect) = match joint_assignment(refs, m, &added_w) {
+        Some((a, b)) => (a, b, true),
         None => {
             let Some(matched) = configured_modes_from(refs, m) else {
                 return m.clone();
             };
             let unmatched = (0..m.mode.len()).filter(|j| !matched.contains(j)).collect();
-            (matched, unmatched)
+            (matched, unmatched, false)
         }
     };
     let mut out = m.clone();
@@ -226,9 +230,20 @@ pub fn align_from(
             name: b.name.clone(),
             ..m.mode[j].clone()
         })
-        .chain(unmatched.iter().map(|&j| ModeSpec {
-            name: Some(format!("{ADDED_NOTE}: {}", Cand::Mode.label())),
-            ..m.mode[j].clone()
+        .chain(unmatched.iter().enumerate().map(|(k, &j)| {
+            // Without the joint assignment a pseudo-mode keeps its name: it lies above the
+            // band, where no configured or added mode is.
+            let cand = if by_effect {
+                added[k].0
+            } else if is_pseudo_mode(m.mode[j].name.as_deref()) {
+                Cand::ResidualMode
+            } else {
+                Cand::Mode
+            };
+            ModeSpec {
+                name: Some(format!("{ADDED_NOTE}: {}", cand.label())),
+                ..m.mode[j].clone()
+            }
         }))
         .collect();
     out

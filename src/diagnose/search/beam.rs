@@ -1,7 +1,7 @@
 //! The search over effect sets: a beam search over effect sequences with a joint refit of
 //! every parameter at every node.
 //!
-//! * **Root**: the configured model retuned from a rough start ([`retune`] with the mode
+//! * **Root**: the configured model retuned from a rough start ([`crate::diagnose::lsq::retune::retune`] with the mode
 //!   grid). When it explains the data, nothing is added.
 //! * **Expansion** of a node: every candidate is fitted alone on the node's model and
 //!   scored by `ΔBIC = 2(V_node − V) − n·ln(2F)`; the best `beam + 1` that pass the screen
@@ -30,7 +30,7 @@ use crate::diagnose::admissible::Refusal;
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::problem::Problem;
-use crate::diagnose::lsq::retune::{retune, retune_or_give_up};
+use crate::diagnose::lsq::retune::retune_or_give_up;
 use crate::diagnose::report::Phases;
 use crate::diagnose::search::child::{judge as judge_child, Judge, Refit};
 use crate::diagnose::search::holdout::same_set;
@@ -241,9 +241,16 @@ fn bic(v: f64, n: usize, data: &Channels) -> f64 {
     2.0 * v + n as f64 * (2.0 * data.n_data() as f64).ln()
 }
 
-/// The two roots: the configured model as it is, and retuned from a rough start.
-pub fn roots(base: &PhysicalModel, data: &Channels) -> Result<[Node; 2]> {
-    let r = retune(base, data, None, true);
+/// The two roots: the configured model as it is, and retuned from a rough start (its
+/// counts told to `options`' listener, [`crate::diagnose::DiagnoseProgress::Retune`]).
+pub fn roots(
+    base: &PhysicalModel,
+    data: &Channels,
+    options: &crate::diagnose::progress::DiagnoseOptions<'_>,
+) -> Result<[Node; 2]> {
+    use crate::diagnose::progress::DiagnoseProgress::Retune;
+    let tell = |what, done, total| options.tell(Retune { what, done, total });
+    let r = crate::diagnose::lsq::retune::retune_telling(base, data, true, &tell);
     let m0 = Problem::new(base, data)?.measures(&Default::default());
     let v_fit = r.v_after;
     let (model, measures) = settle(

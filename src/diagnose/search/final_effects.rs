@@ -198,6 +198,12 @@ pub fn final_effects(
                 }
             }
         }
+        if *c == Cand::ResidualMode {
+            // A residual term: its damping is where the refit left it above the band, not a
+            // measured damping; it is not reported.
+            params.remove("zeta");
+            sigma.remove("zeta");
+        }
         out.push(FinalEffect {
             effect: label,
             params,

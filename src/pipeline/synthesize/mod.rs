@@ -3,7 +3,7 @@
 //! proof by the Theorem 1 test of the stability pipeline ([`super::stability`]) for every
 //! bound `r` → exports (`controller.toml` in the form `stability --controller` reads,
 //! `controller.json`, `.m`/`.py`/`.jl`, `synthesis.json`, `stability.svg`/`.json`), each
-//! written atomically.
+//! written atomically (`exports.rs`); the printed summary is [`text()`] (`text.rs`).
 
 use super::stability::{self as stab, StabilityOutcome};
 use crate::error::{Error, Result};
@@ -13,12 +13,16 @@ use crate::report::fmt::fmt_g;
 use crate::synthesis::{synthesize, GmController};
 use crate::system::eig::{eigenvalues, spectral_abscissa};
 use crate::system::ncf::NormalizedLcf;
-use crate::system::{StateSpace, TransferFunction};
-use nalgebra::DMatrix;
+use crate::system::TransferFunction;
 use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
+
+mod exports;
+mod text;
+
+pub use exports::{controller_toml, method_label, synthesis_json, write_outputs};
+pub use text::text;
 
 /// Settings of the synthesis.
 #[derive(Debug, Clone)]
@@ -144,6 +148,30 @@ pub fn run(
     data: Option<&Path>,
     controller_path: &Path,
 ) -> Result<SynthesisOutcome> {
+    run_with_stages(
+        config,
+        config_path,
+        rs,
+        settings,
+        data,
+        controller_path,
+        &|_| (),
+    )
+}
+
+/// [`run`], telling `stage` what it starts: the controller, then each stage of its proof
+/// ([`stab::run_with_stages`], prefixed `proof: `); on a model of hundreds of modes each is
+/// seconds to minutes of dense linear algebra (issue 34).
+pub fn run_with_stages(
+    config: &Config,
+    config_path: &Path,
+    rs: &[(String, TransferFunction)],
+    settings: &SynthesisSettings,
+    data: Option<&Path>,
+    controller_path: &Path,
+    stage: &dyn Fn(&str),
+) -> Result<SynthesisOutcome> {
+    let proof_stage = |what: &str| stage(&format!("proof: {what}"));
     let ncf = plant_factors(config, config_path)?;
     for (label, r) in rs {
         if !r.is_unit() {
@@ -152,6 +180,10 @@ pub fn run(
             )));
         }
     }
+    stage(&format!(
+        "the Glover–McFarlane controller ({} plant states: two Riccati equations)",
+        ncf.plant.states()
+    ));
     let mut gm = match &settings.weights {
         None => synthesize(&ncf, settings.gamma_factor)?,
         Some(w) => {
@@ -175,6 +207,7 @@ pub fn run(
                 ..Default::default()
             };
             // A failure falls back to the Glover–McFarlane controller, with a note.
+            stage(&format!("the H∞ controller with the {label} r as weight"));
             match crate::synthesis::synthesize_weighted(&ncf, r, &ws) {
                 Ok(h) => {
                     // The proof must be able to run on it (a controller spanning many
@@ -184,7 +217,8 @@ pub fn run(
                         k: h.k.clone(),
                         feedback: Feedback::Negative,
                     };
-                    match stab::run(config, &probe, rs, data) {
+                    let probe_stage = |what: &str| stage(&format!("trial proof: {what}"));
+                    match stab::run_with_stages(config, &probe, rs, data, &probe_stage) {
                         Ok(_) => {
                             gm.k = h.k.clone();
                             Some((label.clone(), h))
@@ -235,7 +269,7 @@ pub fn run(
         k: gm.k.clone(),
         feedback: Feedback::Negative,
     };
-    let stability = stab::run(config, &controller, rs, data)?;
+    let stability = stab::run_with_stages(config, &controller, rs, data, &proof_stage)?;
     let mut notes: Vec<String> = fallback.into_iter().collect();
     let normalized = config.factorization.realization.is_some();
     if !normalized {
@@ -309,306 +343,6 @@ pub fn run(
         reduction,
         hinf,
     })
-}
-
-fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
-    (0..m.nrows())
-        .map(|i| m.row(i).iter().copied().collect())
-        .collect()
-}
-
-fn toml_matrix(m: &DMatrix<f64>) -> String {
-    let r: Vec<String> = rows(m)
-        .iter()
-        .map(|r| {
-            let v: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
-            format!("[{}]", v.join(", "))
-        })
-        .collect();
-    format!("[{}]", r.join(",\n     "))
-}
-
-/// The method of the controller as the outputs name it, and its `γ` line: `H∞ (the fitted r
-/// as weight)` with the H∞ `γ` and `γ_opt`, or `Glover–McFarlane` with its `γ`, `γ_min` and
-/// `b_opt`.
-pub fn method_label(o: &SynthesisOutcome) -> (String, String) {
-    match &o.hinf {
-        Some((label, h)) => (
-            format!("H∞ (the {label} r as weight)"),
-            format!(
-                "gamma = {:?} (gamma_opt = {:?}, ||r*T||_inf = {:?})",
-                h.gamma, h.gamma_opt, h.gamma_achieved
-            ),
-        ),
-        None => (
-            "Glover–McFarlane".to_string(),
-            format!(
-                "b_opt = {:?}, gamma = {:?} (gamma_min = {:?})",
-                o.gm.b_opt, o.gm.gamma, o.gm.gamma_min
-            ),
-        ),
-    }
-}
-
-/// `controller.toml`: the `[controller]` table (`u = −K·y`) that `stability --controller`
-/// reads, headed by the method and its `γ` ([`method_label`]).
-pub fn controller_toml(k: &StateSpace, (method, gamma): &(String, String)) -> String {
-    format!(
-        "# {method} central controller from rshape synthesize:\n# {gamma}; loop u = -K y\n[controller]\nfeedback = \"negative\"\na = {}\nb = {}\nc = {}\nd = {}\n",
-        toml_matrix(&k.a),
-        toml_matrix(&k.b),
-        toml_matrix(&k.c),
-        toml_matrix(&k.d)
-    )
-}
-
-/// A matrix literal for MATLAB/Julia (`[1 2; 3 4]`) or numpy (`np.array([[1, 2], [3, 4]])`).
-fn literal(m: &DMatrix<f64>, python: bool) -> String {
-    if m.nrows() == 0 || m.ncols() == 0 {
-        return if python {
-            format!("np.zeros(({}, {}))", m.nrows(), m.ncols())
-        } else {
-            format!("zeros({}, {})", m.nrows(), m.ncols())
-        };
-    }
-    let r = rows(m);
-    if python {
-        let v: Vec<String> = r
-            .iter()
-            .map(|row| {
-                let e: Vec<String> = row.iter().map(|x| format!("{x:?}")).collect();
-                format!("[{}]", e.join(", "))
-            })
-            .collect();
-        format!("np.array([{}])", v.join(", "))
-    } else {
-        let v: Vec<String> = r
-            .iter()
-            .map(|row| {
-                let e: Vec<String> = row.iter().map(|x| format!("{x:?}")).collect();
-                e.join(" ")
-            })
-            .collect();
-        format!("[{}]", v.join("; "))
-    }
-}
-
-fn script(
-    k: &StateSpace,
-    (method, gamma): &(String, String),
-    comment: &str,
-    preamble: &str,
-    call: &str,
-    python: bool,
-) -> String {
-    let end = if python || comment == "#" { "" } else { ";" };
-    format!(
-        "{comment} {method} controller from rshape synthesize; loop u = -K y\n{comment} {gamma}\n{preamble}A = {}{end}\nB = {}{end}\nC = {}{end}\nD = {}{end}\nK = {call}{end}\n",
-        literal(&k.a, python),
-        literal(&k.b, python),
-        literal(&k.c, python),
-        literal(&k.d, python)
-    )
-}
-
-/// Writes the controller and the reports into `out` (atomically) and returns the files.
-pub fn write_outputs(out: &Path, o: &SynthesisOutcome) -> Result<Vec<PathBuf>> {
-    let k = &o.gm.k;
-    let state_space = serde_json::json!({
-        "A": rows(&k.a), "B": rows(&k.b), "C": rows(&k.c), "D": rows(&k.d),
-        "feedback": "negative",
-    });
-    let label = method_label(o);
-    let synthesis = synthesis_json(o);
-    let json = |v: &serde_json::Value| {
-        serde_json::to_string_pretty(v).map_err(|e| Error::Invalid(format!("json: {e}")))
-    };
-    let files = [
-        ("controller.toml", controller_toml(k, &label)),
-        ("controller.json", json(&state_space)?),
-        (
-            "controller.m",
-            script(k, &label, "%", "", "ss(A, B, C, D)", false),
-        ),
-        (
-            "controller.py",
-            script(
-                k,
-                &label,
-                "#",
-                "import numpy as np\nimport control as ct\n\n",
-                "ct.ss(A, B, C, D)",
-                true,
-            ),
-        ),
-        (
-            "controller.jl",
-            script(
-                k,
-                &label,
-                "#",
-                "using ControlSystems\n\n",
-                "ss(A, B, C, D)",
-                false,
-            ),
-        ),
-        ("synthesis.json", json(&synthesis)?),
-    ];
-    let mut written = Vec::new();
-    for (name, text) in files {
-        let p = out.join(name);
-        crate::util::write_atomic(&p, text.as_bytes())?;
-        written.push(p);
-    }
-    let head = match &o.hinf {
-        Some((_, h)) => format!(
-            "{} controller: γ = {} (γ_opt = {})",
-            label.0,
-            fmt_g(h.gamma),
-            fmt_g(h.gamma_opt)
-        ),
-        None => format!(
-            "Glover–McFarlane controller: γ = {} (γ_min = {}), b_opt = {}",
-            fmt_g(o.gm.gamma),
-            fmt_g(o.gm.gamma_min),
-            fmt_g(o.gm.b_opt)
-        ),
-    };
-    let title = match &o.hinf {
-        Some(_) => "Theorem 1: 1/σ_max(T) vs |r| — the synthesized H∞ controller",
-        None => "Theorem 1: 1/σ_max(T) vs |r| — the synthesized Glover–McFarlane controller",
-    };
-    written.extend(stab::write_outputs(out, &o.stability, title, &[head])?);
-    Ok(written)
-}
-
-/// The content of `synthesis.json`: method, `b_opt`, `γ_min`, `γ`, residuals, the
-/// controller's order and poles, the closed-loop poles, reduction, merit, one row per bound.
-pub fn synthesis_json(o: &SynthesisOutcome) -> serde_json::Value {
-    let k = &o.gm.k;
-    let rep = &o.stability.report;
-    let label = method_label(o);
-    // `gamma` is the controller's: the H∞ γ (with `gamma_opt`) or Glover–McFarlane's (with
-    // `gamma_min`); Glover–McFarlane's numbers stay under `glover_mcfarlane` either way.
-    let (gamma, gamma_opt, gamma_min) = match &o.hinf {
-        Some((_, h)) => (h.gamma, Some(h.gamma_opt), None),
-        None => (o.gm.gamma, None, Some(o.gm.gamma_min)),
-    };
-    serde_json::json!({
-        "method": if o.hinf.is_some() { "hinf_weighted" } else { "glover_mcfarlane" },
-        "method_label": label.0,
-        "hinf": o.hinf.as_ref().map(|(label, h)| serde_json::json!({"r": label, "synthesis": h})),
-        "glover_mcfarlane": {"b_opt": o.gm.b_opt, "gamma_min": o.gm.gamma_min, "gamma": o.gm.gamma},
-        "b_opt": o.gm.b_opt,
-        "gamma": gamma,
-        "gamma_opt": gamma_opt,
-        "gamma_min": gamma_min,
-        "gamma_factor": o.gm.gamma / o.gm.gamma_min,
-        "rho_xz": o.gm.rho,
-        "riccati_residuals": o.gm.riccati_residuals,
-        "b_gk": rep.b_gk,
-        "controller_order": k.states(),
-        "controller_poles": o.controller_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
-        "closed_loop_poles": rep.closed_loop_poles.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
-        "reduction": &o.reduction,
-        "merit": &o.merit,
-        "bounds": &o.bounds,
-        "robust": o.robust,
-        "notes": &o.notes,
-    })
-}
-
-/// The summary the CLI prints: the optimum, the controller, then the proof.
-pub fn text(o: &SynthesisOutcome) -> String {
-    let mut s = String::new();
-    if o.hinf.is_some() {
-        // The controller is the H∞ one (next line): Glover–McFarlane gives the reference
-        // b_opt only.
-        let _ = writeln!(
-            s,
-            "Glover–McFarlane (reference, not the controller): b_opt = {} (gamma_min = {})",
-            fmt_g(o.gm.b_opt),
-            fmt_g(o.gm.gamma_min),
-        );
-    } else {
-        let _ = writeln!(
-            s,
-            "Glover–McFarlane: b_opt = {} (gamma_min = {}), central controller at gamma = {} ({} states)",
-            fmt_g(o.gm.b_opt),
-            fmt_g(o.gm.gamma_min),
-            fmt_g(o.gm.gamma),
-            o.gm.k.states()
-        );
-    }
-    if let Some((label, h)) = &o.hinf {
-        let _ = writeln!(
-            s,
-            "H∞ synthesis with the {label} r as weight: gamma_opt = {} (alpha_opt = {}; {} gamma tests, {}), central controller at gamma = {} ({} states), its ||r*T||_inf = {} (alpha {})",
-            fmt_g(h.gamma_opt),
-            fmt_g(h.alpha_opt),
-            h.steps.len(),
-            match h.status {
-                crate::synthesis::hinf_weighted::IterationStatus::Converged => "converged",
-                crate::synthesis::hinf_weighted::IterationStatus::IterationCap => "iteration cap reached",
-                crate::synthesis::hinf_weighted::IterationStatus::RiccatiLimited => "Riccati-limited: gamma_opt is the controller's verified level",
-                crate::synthesis::hinf_weighted::IterationStatus::AtInfinity => "the optimum is the bound at omega = inf",
-            },
-            fmt_g(h.gamma),
-            h.k.states(),
-            fmt_g(h.gamma_achieved),
-            fmt_g(h.alpha_achieved)
-        );
-    }
-    if let Some(r) = &o.reduction {
-        let _ = writeln!(
-            s,
-            "reduced by balanced truncation: {} -> {} states (||K - Kr||_inf <= {}); the proof below is of the reduced controller",
-            r.from,
-            r.to,
-            fmt_g(r.error_bound)
-        );
-    }
-    for b in &o.bounds {
-        if let Some(a) = b.alpha_opt {
-            let _ = writeln!(
-                s,
-                "{} r{}: best attainable alpha = {}",
-                b.label,
-                if b.constant { " (constant)" } else { "" },
-                if b.constant {
-                    format!("b_opt/|r| = {}", fmt_g(a))
-                } else {
-                    format!("1/gamma_opt = {}", fmt_g(a))
-                }
-            );
-        }
-    }
-    for n in &o.notes {
-        let _ = writeln!(s, "{n}");
-    }
-    let _ = writeln!(
-        s,
-        "closed loop: bandwidth (sigma_max(S) = -3 dB) {}, peak sensitivity Ms = {}",
-        o.merit.bandwidth.map_or(
-            "none (sigma_max(S) never crosses -3 dB on the grid)".to_string(),
-            |b| format!("{} rad/s", fmt_g(b))
-        ),
-        fmt_g(o.merit.peak_sensitivity)
-    );
-    let _ = writeln!(s, "proof (Theorem 1 on the synthesized controller):");
-    s.push_str(&stab::text(&o.stability));
-    let _ = writeln!(
-        s,
-        "{}",
-        if o.bounds.is_empty() {
-            "no r given: nothing to prove beyond internal stability".to_string()
-        } else if o.robust {
-            "PROVEN robust for every r given".to_string()
-        } else {
-            "NOT proven robust for every r given".to_string()
-        }
-    );
-    s
 }
 
 /// Whether `r` is a constant.
