@@ -199,6 +199,35 @@ impl VarPro<'_> {
         }
     }
 
+    /// `(−U, −T)`, `U = [A_k x]_k` (`m × K`) and `T = [A_kᵀ r]_k` (`n × K`): the derivative
+    /// columns both [`VarPro::jacobian`] and [`VarPro::normal`] are built from.
+    fn negated_derivatives(
+        &self,
+        mm: &PhysicalModel,
+        a: &DMatrix<f64>,
+        th: &[f64],
+        x: &DVector<f64>,
+        res: &DVector<f64>,
+    ) -> (DMatrix<f64>, DMatrix<f64>) {
+        let kk = self.nl.len();
+        let mut u = DMatrix::<f64>::zeros(a.nrows(), kk);
+        let mut t = DMatrix::<f64>::zeros(self.lin.len(), kk);
+        for k in 0..kk {
+            self.d_design(
+                mm,
+                a,
+                th,
+                k,
+                x,
+                res,
+                -1.0,
+                u.column_mut(k).as_mut_slice(),
+                t.column_mut(k).as_mut_slice(),
+            );
+        }
+        (u, t)
+    }
+
     /// The normal equations `(JᵀJ, Jᵀr)` of [`VarPro::jacobian`]'s `J` at `θ` against the
     /// residual `r`, without forming `J` (`m × K`, `m` the rows): with `J = u + Q c`
     /// (`u = −U`, `c = z − Qᵀu`, `z = −Z`) and `QᵀQ = I`,
@@ -236,21 +265,7 @@ impl VarPro<'_> {
         }
         let res = &y - &a * &x;
         let kk = self.nl.len();
-        let mut u = DMatrix::<f64>::zeros(m, kk);
-        let mut t_all = DMatrix::<f64>::zeros(n, kk);
-        for k in 0..kk {
-            self.d_design(
-                &mm,
-                &a,
-                th,
-                k,
-                &x,
-                &res,
-                -1.0,
-                u.column_mut(k).as_mut_slice(),
-                t_all.column_mut(k).as_mut_slice(),
-            );
-        }
+        let (u, t_all) = self.negated_derivatives(&mm, &a, th, &x, &res);
         let w = DMatrix::from_fn(b.cols.len(), kk, |i, k| t_all[(b.cols[i], k)] / b.scale[i]);
         let z = b.r.tr_solve_upper_triangular(&w)?;
         let qtu = b.q.tr_mul(&u);
@@ -313,21 +328,7 @@ impl VarPro<'_> {
         // `∂r/∂θ = −(U + Q (Z − QᵀU))`, `U = [A_k x]_k`, `Z = R⁻ᵀ S T`, `T = [A_kᵀ r]_k`:
         // `U` and `T` are accumulated negated, so the sign needs no pass of its own.
         let kk = self.nl.len();
-        let mut u = DMatrix::<f64>::zeros(m, kk);
-        let mut t_all = DMatrix::<f64>::zeros(n, kk);
-        for k in 0..kk {
-            self.d_design(
-                &mm,
-                &a,
-                th,
-                k,
-                &x,
-                &res,
-                -1.0,
-                u.column_mut(k).as_mut_slice(),
-                t_all.column_mut(k).as_mut_slice(),
-            );
-        }
+        let (mut u, t_all) = self.negated_derivatives(&mm, &a, th, &x, &res);
         let single = matches!(fact.as_slice(), [b] if b.rows.len() == m
             && b.rows.iter().enumerate().all(|(i, r)| i == *r));
         if single {
