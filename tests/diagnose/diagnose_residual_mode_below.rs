@@ -183,8 +183,7 @@ fn a_true_rigid_body_stays_a_rigid_body() {
         max_effects: 1,
         ..Default::default()
     };
-    let d = diagnose_channels(&acc(0.8 * c_true, &[80.0]), &d_, &s, &Default::default())
-        .unwrap();
+    let d = diagnose_channels(&acc(0.8 * c_true, &[80.0]), &d_, &s, &Default::default()).unwrap();
     eprintln!("{}", d.message);
     // Tried (the model has a rigid body), and not chosen: the missing mode is.
     assert!(
@@ -208,5 +207,9 @@ fn a_true_rigid_body_stays_a_rigid_body() {
     let r = &m.rigid_body[0];
     let res = r.output_gain.to_vec(1)[0] * r.input_gain.to_vec(1)[0] / r.mass;
     assert!((res / c_true - 1.0).abs() < 0.01, "{res} vs {c_true}");
-    assert!(d.after.misfit_rms < 0.1 * d.before.misfit_rms, "{:?}", d.after);
+    assert!(
+        d.after.misfit_rms < 0.1 * d.before.misfit_rms,
+        "{:?}",
+        d.after
+    );
 }
