@@ -22,9 +22,7 @@ use num_complex::Complex64;
 #[derive(Debug, Clone, Copy)]
 pub struct ResidualMode;
 
-/// The damping written for the pseudo-mode: small, not fitted (above the band its damping
-/// does not show; `ζ₀ω_n` is far below its distance to the band top).
-pub const PSEUDO_ZETA: f64 = 0.01;
+pub use crate::diagnose::effects::effect::PSEUDO_ZETA;
 /// Its `ω_n` lies between these multiples of the band top.
 pub const ABOVE: (f64, f64) = (1.05, 10.0);
 

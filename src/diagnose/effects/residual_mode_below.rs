@@ -5,7 +5,7 @@
 //! not far below the band bottom bends the in-band error by its second term, `ω_n²/ω⁴`,
 //! which no `c/s²` follows, and the residual left by the lower residual is structured
 //! towards the bottom.  This term is that mode, `ρ_ch/(s² + 2ζ₀ω_n s + ω_n²)` with `ω_n`
-//! below the band and the small damping `ζ₀` of the pseudo-mode above (held in the screen,
+//! below the band and the small damping `ζ₀` of either pseudo-mode (held in the screen,
 //! free in the joint refits, never reported); θ = [ln ω_n, ρ_1 … ρ_C].  It is a **residual
 //! term**, not an identified mode (the mode rules of `diagnose::admissible` do not apply;
 //! ΔBIC, the holdout and the negligible rule do).  Tried only on a model that has the lower
@@ -15,10 +15,9 @@
 
 use crate::diagnose::effects::effect::{
     fmt_w, log_grid, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site,
-    Stands, Writer,
+    Stands, Writer, PSEUDO_ZETA,
 };
 use crate::diagnose::effects::mode::mode_term;
-use crate::diagnose::effects::residual_mode::PSEUDO_ZETA;
 use crate::model::physical::{ModeSpec, PhysicalModel};
 use num_complex::Complex64;
 
