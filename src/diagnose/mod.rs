@@ -23,7 +23,9 @@
 //!   proposed at each peak), `assign` (added modes matched to the refit's), `final_effects`,
 //!   `final_refit`;
 //! * on top: `engine` (the whole `diagnose`: entry points [`diagnose`],
-//!   [`diagnose_channels`], [`apply_candidate`]), `report` (what it reports), `changes` (the
+//!   [`diagnose_channels`], [`apply_candidate`]), `verdict` (the verdict and the stop
+//!   explanation in words), `report` (what it reports; the per-peak account in
+//!   `peak_account`), `changes` (the
 //!   parameter changes and their σ), [`admissible`] (physical admissibility of a refit),
 //!   `revision` (a revised config); beside them `compare` (per-frequency misfit normalized by
 //!   the noise radius, failing bands, error measures `misfit_rms`, `invalid_fraction`,
@@ -40,11 +42,13 @@ pub(crate) mod effects;
 pub(crate) mod engine;
 pub(crate) mod factor_form;
 pub(crate) mod lsq;
+pub(crate) mod peak_account;
 pub(crate) mod plant_form;
 pub(crate) mod progress;
 pub(crate) mod report;
 pub(crate) mod revision;
 pub(crate) mod search;
+pub(crate) mod verdict;
 
 pub use agreement::{data_vs_data, AgreementVerdict, DataAgreement};
 pub use changes::{changes, Changes, CommonGain, ParamChange};

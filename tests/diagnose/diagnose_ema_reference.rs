@@ -215,7 +215,14 @@ fn pyfrf_chain_ends_with_the_stabilization_diagram_modes() {
 ///   real-residue term makes; a local fit with a complex residue (LSFD's model,
 ///   `local_zeta.py`) identifies ζ 5.3e-4 (3.4–7.1e-4), but a complex residue of that size is
 ///   not the damping of a separated mode (see `local_zeta.py`), so it is not offered as an
-///   effect.
+///   effect.  Over the whole low band (10–200 Hz, `low_band_hypotheses.py`) the real-residue
+///   profile rises monotonically from ζ → 0: no estimator inside the interval (the profile's
+///   maximum is the floor; the log-midpoint or a likelihood mean is set by where the interval
+///   is cut) is the data's, and none is chosen to land on this mode.  No measurement-chain
+///   effect tried there identifies ζ: a delay or a response-side high-pass changes nothing, a
+///   force-side high-pass (f_c 3.9 Hz) takes 57 % of the excess misfit but leaves ζ at the
+///   floor, a close pair does not form, and even a constant (non-causal) phase on every
+///   channel (4.1°) leaves ζ at 1.9e-4, 3× below.
 /// * The diagram's weak 900.5 Hz pole (stable at 15 of 60 orders) is judged against the local
 ///   fit (ζ 1.19e-3, 1.06–1.34e-3 with either residue); the chain ends at 1.17e-3.
 /// * Step 3 adds a 4.9 µs input delay: not negligible by the rules (removing it and

@@ -286,18 +286,36 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 }
 
 /// The whole band, 20–5000 Hz (ten steps, about 60 s in release on a loaded 2-core machine):
-/// the modes found (900, 3664, 4126, 810, 4391, 2640, 851 Hz among them), nothing at a band
-/// edge, and every mode the issue lists (810, 851, 900, 2640, 3035, 3670, 4130/4160,
-/// 4390 Hz) either in the final model or named in the last step's per-peak account with its
-/// fate and a reason (docs/guide/discovery-walkthrough.md, section 6).
+/// the modes found (900, 3665, 3669, 3689, 4126, 810, 4391, 2640, 851 Hz among them), nothing
+/// at a band edge, and every mode the issue lists (810, 851, 900, 2640, 3035, 3670,
+/// 4130/4160, 4390 Hz) either in the final model or named in the last step's per-peak
+/// account with its fate and a reason (docs/guide/discovery-walkthrough.md, section 6).
+///
+/// Around 3670 Hz the data hold three modes (`tests/data/ema_reference/pyfrf_3665_local.py`,
+/// a local fit independent of rshape): a sharp one at 3668.9 Hz, one at 3689.3 Hz and a
+/// broader, weaker one at 3665.1 Hz (ζ 8.7e-4, the shoulder of the 3669 Hz peak; its residue
+/// has its neighbour's sign, V 36,944 → 17,590 with it).  Fails today (traced, release, this
+/// branch): step 2 adds 3669.6 Hz (ζ 1.8e-4); step 3's joint refit moves it to the
+/// single-mode compromise 3663.8 Hz (ζ 7.6e-4; a single mode's least-squares optimum there
+/// is 3664.7 Hz, ζ 6.6e-4); step 8 adds 3668.6 Hz and its joint refit moves the compromise
+/// mode on to the unexplained 3689 Hz peak; the walk ends (ten steps) with 3668.5 and
+/// 3689.2 Hz and the 3665 Hz mode missing.  No admissibility rule refused anything there:
+/// the greedy one-mode steps with free joint refits lose the weak mode when its compromise
+/// slot is taken over; the next steps add modes elsewhere (4694, 3009 Hz).  A longer walk
+/// (14 steps, measured once) does not find it either: steps 11–14 add 4163, 851 and
+/// 3035 Hz and a delay; the 3665 Hz shoulder is absorbed by the 3668.6 Hz mode's broadened
+/// damping (ζ 3.9e-4, against 2.0e-4 in the three-mode fit) and never shows as a residual
+/// peak of the per-peak account.
 #[test]
-#[ignore = "the whole band, ten steps: about 60 s in release; fails today (on main 8ef951d too): no mode within 3 Hz of 3664 Hz, the walk ends with 3668.5 and 3689.2 Hz"]
+#[ignore = "the whole band, ten steps: about 60 s in release; fails today: no mode within 3 Hz of 3664 Hz — the data hold three modes there (3665.1, 3668.9, 3689.3 Hz, pyfrf_3665_local.py), the walk ends with 3668.5 and 3689.2 Hz (the weak 3665 Hz mode lost when step 8's refit moves its compromise slot to 3689 Hz)"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);
     let last_step = steps.last().unwrap();
     let last = &last_step.final_model;
-    for f in [900.0, 3664.0, 4126.0, 810.0, 851.0, 2640.0, 4391.0] {
+    for f in [
+        900.0, 3664.0, 3668.9, 3689.3, 4126.0, 810.0, 851.0, 2640.0, 4391.0,
+    ] {
         assert!(has_mode(last, f, 3.0), "no mode at {f} Hz: {:?}", last.mode);
     }
     let w_max = TAU * 5000.0;

@@ -28,6 +28,7 @@ mod diagnose_progress;
 mod diagnose_pyfrf;
 mod diagnose_realdata;
 mod diagnose_residual_mode;
+mod diagnose_residual_mode_below;
 mod diagnose_retune_changes;
 mod diagnose_scan;
 mod diagnose_settings;

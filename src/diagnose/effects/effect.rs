@@ -59,6 +59,11 @@ pub fn residue(c: &Gains, b: &Gains, m: f64, p: usize, n_in: usize, e: (usize, u
     c.to_vec(p)[e.0] * b.to_vec(n_in)[e.1] / m
 }
 
+/// The damping written for a pseudo-mode above or below the band (`residual_mode`,
+/// `residual_mode_below`): small, not fitted (out of the band its damping does not show;
+/// `ζ₀ω_n` is far below its distance to the band's edge).
+pub const PSEUDO_ZETA: f64 = 0.01;
+
 /// One physical effect of the catalogue.  Every method is required: a new effect states each
 /// of them (no catch-all can give it another effect's answer).
 pub trait Effect: Copy {

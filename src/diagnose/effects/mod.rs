@@ -3,7 +3,8 @@
 //! * `effect`: the [`effect::Effect`] trait each effect implements, with what every effect
 //!   shares (the channel selection `Sel`, the ζ bounds, a term's residue);
 //! * one file per effect (`delay`, `lag`, `nmp_zero`, `zoh`, `gain`, `sign`, `mode`,
-//!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`, `residual_mode`),
+//!   `integrator`, `feedthrough`, `friction`, `mode_shift`, `damping`, `residual_mode`,
+//!   `residual_mode_below`),
 //!   registered below;
 //! * `path`, `configured`, `coefficient` and `factor`: the four recurring shapes, a path
 //!   effect on one parameter (`delay`, `lag`, `nmp_zero`, `zoh`: `OnPath`, `on_path!`), a
@@ -156,4 +157,7 @@ register! { $
     /// A pseudo-mode above the band, a residual term (tried once the upper residual is in
     /// the model); θ = [ln ω_n, ρ_1 … ρ_C].
     ResidualMode => residual_mode::ResidualMode,
+    /// A pseudo-mode below the band, a residual term (tried once the lower residual, a
+    /// rigid body, is in the model); θ = [ln ω_n, ρ_1 … ρ_C].
+    ResidualModeBelow => residual_mode_below::ResidualModeBelow,
 }

@@ -22,14 +22,20 @@ use num_complex::Complex64;
 #[derive(Debug, Clone, Copy)]
 pub struct ResidualMode;
 
-/// The damping written for the pseudo-mode: small, not fitted (above the band its damping
-/// does not show; `ζ₀ω_n` is far below its distance to the band top).
-pub const PSEUDO_ZETA: f64 = 0.01;
+pub use crate::diagnose::effects::effect::PSEUDO_ZETA;
 /// Its `ω_n` lies between these multiples of the band top.
 pub const ABOVE: (f64, f64) = (1.05, 10.0);
 
-/// True when a mode's name marks it as this pseudo-mode (written by `diagnose`).
+/// True when a mode's name marks it as a pseudo-mode (a residual term written by
+/// `diagnose`), this one above the band or its counterpart below it
+/// ([`super::residual_mode_below`]).
 pub fn is_pseudo_mode(name: Option<&str>) -> bool {
+    name.is_some_and(|n| n.ends_with(<ResidualMode as Effect>::NAME))
+        || super::residual_mode_below::is_pseudo_mode_below(name)
+}
+
+/// True when a mode's name marks it as this pseudo-mode, the one above the band.
+pub fn is_pseudo_mode_above(name: Option<&str>) -> bool {
     name.is_some_and(|n| n.ends_with(<ResidualMode as Effect>::NAME))
 }
 
@@ -42,7 +48,10 @@ impl Effect for ResidualMode {
 
     /// On a model with the upper residual and no pseudo-mode yet.
     fn tried(base: &PhysicalModel) -> Vec<Self> {
-        let has = base.mode.iter().any(|m| is_pseudo_mode(m.name.as_deref()));
+        let has = base
+            .mode
+            .iter()
+            .any(|m| is_pseudo_mode_above(m.name.as_deref()));
         if base.feedthrough.is_some() && !has {
             vec![ResidualMode]
         } else {

@@ -44,6 +44,8 @@ fn every_candidate(base: &PhysicalModel) -> Vec<Cand> {
         // Tried only once the model has the upper residual.
         Cand::ResidualMode,
     ]);
+    // The pseudo-mode below the band is tried: `base` has a rigid body (the lower residual).
+    assert!(v.contains(&Cand::ResidualModeBelow));
     v
 }
 
@@ -180,9 +182,9 @@ fn what_admissibility_reads_is_what_the_effect_wrote() {
         c.apply_to(&th, &entries, &mut w, "added by rshape diagnose: test");
         // The mode it added or changed, from the models.
         let changed = (0..w.mode.len()).find(|i| b.mode.get(*i) != Some(&w.mode[*i]));
-        // The pseudo-mode above the band is a residual term: it writes a mode that the mode
-        // rules do not judge, and owns no parameter the covariance rules would judge.
-        let residual_term = c == Cand::ResidualMode;
+        // A pseudo-mode above or below the band is a residual term: it writes a mode that the
+        // mode rules do not judge, and owns no parameter the covariance rules would judge.
+        let residual_term = matches!(c, Cand::ResidualMode | Cand::ResidualModeBelow);
         if residual_term {
             assert!(changed.is_some() && c.its_mode(&w).is_none());
         } else {

@@ -229,7 +229,11 @@ pub(crate) fn bounds(
             let (mut lo, mut hi) = (x0 - MODE_BOX.ln(), x0 + MODE_BOX.ln());
             let name = m.mode[i].name.as_deref();
             let added = name.is_some_and(|n| n.starts_with(ADDED_NOTE));
-            if crate::diagnose::effects::residual_mode::is_pseudo_mode(name) {
+            if crate::diagnose::effects::residual_mode_below::is_pseudo_mode_below(name) {
+                // A pseudo-mode below the band (a residual term) stays below it.
+                hi = hi.min((crate::diagnose::effects::residual_mode_below::BELOW.1 * w_min).ln());
+                lo = lo.min(hi);
+            } else if crate::diagnose::effects::residual_mode::is_pseudo_mode(name) {
                 // A pseudo-mode above the band (a residual term) stays above it.
                 lo = lo.max((crate::diagnose::effects::residual_mode::ABOVE.0 * w_max).ln());
                 hi = hi.max(lo);

@@ -17,6 +17,7 @@
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::effects::candidates::ADDED_NOTE;
 use crate::diagnose::effects::residual_mode::is_pseudo_mode;
+use crate::diagnose::effects::residual_mode_below::is_pseudo_mode_below;
 use crate::model::physical::{ModeSpec, PhysicalModel};
 
 /// Weight of the shape term `1 − MAC` against `|ln(ω_f/ω_b)|`: two modes 5 % apart with
@@ -204,11 +205,13 @@ pub fn align_from(
     effects: &[(Cand, Vec<f64>)],
 ) -> PhysicalModel {
     let base = refs[0];
-    // The added modes, and the pseudo-modes above the band (residual terms), each named by
-    // its own effect.
+    // The added modes, and the pseudo-modes above or below the band (residual terms), each
+    // named by its own effect.
     let added: Vec<(Cand, f64)> = effects
         .iter()
-        .filter(|(c, th)| matches!(c, Cand::Mode | Cand::ResidualMode) && !th.is_empty())
+        .filter(|(c, th)| {
+            matches!(c, Cand::Mode | Cand::ResidualMode | Cand::ResidualModeBelow) && !th.is_empty()
+        })
         .map(|(c, th)| (*c, th[0].exp()))
         .collect();
     let added_w: Vec<f64> = added.iter().map(|a| a.1).collect();
@@ -231,10 +234,12 @@ pub fn align_from(
             ..m.mode[j].clone()
         })
         .chain(unmatched.iter().enumerate().map(|(k, &j)| {
-            // Without the joint assignment a pseudo-mode keeps its name: it lies above the
-            // band, where no configured or added mode is.
+            // Without the joint assignment a pseudo-mode keeps its name: it lies above or
+            // below the band, where no configured or added mode is.
             let cand = if by_effect {
                 added[k].0
+            } else if is_pseudo_mode_below(m.mode[j].name.as_deref()) {
+                Cand::ResidualModeBelow
             } else if is_pseudo_mode(m.mode[j].name.as_deref()) {
                 Cand::ResidualMode
             } else {

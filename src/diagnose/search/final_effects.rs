@@ -198,7 +198,7 @@ pub fn final_effects(
                 }
             }
         }
-        if *c == Cand::ResidualMode {
+        if matches!(c, Cand::ResidualMode | Cand::ResidualModeBelow) {
             // A residual term: its damping is where the refit left it above the band, not a
             // measured damping; it is not reported.
             params.remove("zeta");
