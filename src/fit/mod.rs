@@ -38,6 +38,7 @@ pub(crate) mod polyfit;
 mod polylevel;
 mod polyrows;
 pub(crate) mod problem;
+mod working_set;
 pub(crate) mod provenance;
 pub(crate) mod realization;
 pub(crate) mod run;

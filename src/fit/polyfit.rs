@@ -14,7 +14,7 @@
 //! interior-point solution of a zero objective lies near the analytic centre, away from
 //! the bounds; a slack variable would not do: the disk form of a rising `|r|` is tiny far
 //! above the band, so any uniform slack there is ~0 at every level), solved on a working set
-//! ([`super::problem::active_set_solve`]).  The search starts by testing the level just
+//! ([`super::working_set::active_set_solve`]).  The search starts by testing the level just
 //! below the best candidate already found: when that is infeasible the other candidates
 //! are optimal to the bisection tolerance and no more LPs are spent.
 

@@ -10,7 +10,8 @@ use super::polyrows::{
     cut_rows, disk, fixed_rows, level_rows, max_violation, reached_level, relative_cuts,
     relative_level_rows, Rows, B_CUT_GROUP,
 };
-use super::problem::{active_set_solve, initial_points, Retry, SolverEvent, SolverStatus};
+use super::problem::{SolverEvent, SolverStatus};
+use super::working_set::{active_set_solve, initial_points, Retry};
 use super::provenance::EventKind;
 use super::FitSettings;
 
