@@ -15,9 +15,9 @@ use super::basis::{reference_poles, GridPoint, PointKind};
 use super::levelsearch::minimax_level;
 use super::polyfit;
 use super::problem::{area_fixed_poles, basis_rows, SolverEvent, SolverStatus};
-use super::working_set::initial_points;
 use super::provenance::{EventKind, Origin, PoleSet};
 use super::spectral::{stable_roots, RootKind, Zpk};
+use super::working_set::initial_points;
 use super::{FitSettings, Objective};
 use num_complex::Complex64;
 

@@ -38,12 +38,12 @@ pub(crate) mod polyfit;
 mod polylevel;
 mod polyrows;
 pub(crate) mod problem;
-mod working_set;
 pub(crate) mod provenance;
 pub(crate) mod realization;
 pub(crate) mod run;
 mod settings_check;
 pub(crate) mod spectral;
+mod working_set;
 
 pub use a1_proof::A1Proof;
 pub use basis::Scaling;

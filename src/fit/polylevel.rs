@@ -11,8 +11,8 @@ use super::polyrows::{
     relative_level_rows, Rows, B_CUT_GROUP,
 };
 use super::problem::{SolverEvent, SolverStatus};
-use super::working_set::{active_set_solve, initial_points, Retry};
 use super::provenance::EventKind;
+use super::working_set::{active_set_solve, initial_points, Retry};
 use super::FitSettings;
 
 /// Interior-point iterations of the retry with every row after a working-set solve short
