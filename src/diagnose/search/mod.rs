@@ -5,6 +5,7 @@
 //! * `rank`: screening and physical plausibility;
 //! * `node`: an effect set written into the model and jointly refit;
 //! * `beam`: the beam search over effect sets;
+//! * `expand`: a node's screen and the candidates it sends to joint refits;
 //! * `first_level`: the root's candidates ranked;
 //! * `polish`: the consistency polish;
 //! * `ties`: sets the data cannot tell apart;
@@ -21,6 +22,7 @@ pub(crate) mod assign;
 pub(crate) mod backward;
 pub(crate) mod beam;
 pub(crate) mod child;
+pub(crate) mod expand;
 pub(crate) mod final_effects;
 pub(crate) mod final_refit;
 pub(crate) mod first_level;
