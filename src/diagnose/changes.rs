@@ -60,6 +60,11 @@ pub struct Changes {
     pub common_gain: Option<CommonGain>,
     /// The threshold in σ a move had to exceed (3σ corrected for the number of parameters).
     pub threshold_sigmas: f64,
+    /// Said when the refit's output gains (linear slots) are at least as many as the data's
+    /// real values: they alone fit the data, so the refit identified no frequency or
+    /// damping (the retune is "settled" on them, [`crate::diagnose::lsq::retune`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settled: Option<String>,
 }
 
 /// The two-sided tail of 3σ: the false-alarm rate of one parameter.
@@ -243,6 +248,13 @@ fn configured_nl(base: &PhysicalModel, m: &PhysicalModel, s: Nl) -> bool {
 /// possibly with added effects) moved by more than 3σ, σ at `refit` on `data`.
 pub fn changes(base: &PhysicalModel, refit: &PhysicalModel, data: &Channels) -> Changes {
     let (lin, nl) = slots(refit, data);
+    let values = 2 * data.len() * data.n_ch();
+    let settled = (!nl.is_empty() && lin.len() >= values).then(|| {
+        format!(
+            "the model has {} output gains for {values} real data values: the refit solved for the gains alone (least norm) and identified no frequency or damping (ω_n and ζ kept as configured); more lines, or fewer modes, would identify them",
+            lin.len()
+        )
+    });
     let sig = slot_sigmas(refit, &lin, &nl, data);
     // (param after, param before, σ of the physical value, relative σ of the gain).
     let mut rows: Vec<(Param, f64, f64, f64)> = Vec::new();
@@ -329,6 +341,7 @@ pub fn changes(base: &PhysicalModel, refit: &PhysicalModel, data: &Channels) -> 
         changes: out,
         common_gain: common,
         threshold_sigmas: k_sig,
+        settled,
     }
 }
 
@@ -359,7 +372,38 @@ impl Changes {
 
 #[cfg(test)]
 mod tests {
-    use super::threshold_sigmas;
+    use super::{changes, threshold_sigmas};
+    use crate::diagnose::lsq::channels::Channels;
+    use crate::model::physical::{Gains, ModeSpec, PhysicalModel};
+
+    /// Three modes on two lines (4 real values, 3 output gains): not settled; on one line
+    /// (2 real values): settled, and said so (no frequency or damping identified).
+    #[test]
+    fn a_refit_with_more_gains_than_data_values_says_it_identified_no_frequency() {
+        let mode = |w: f64| ModeSpec {
+            name: None,
+            omega_n: w,
+            zeta: 0.02,
+            mass: 1.0,
+            input_gain: Gains::Scalar(1.0),
+            output_gain: Gains::Scalar(1e4),
+        };
+        let m = PhysicalModel {
+            mode: vec![mode(100.0), mode(300.0), mode(900.0)],
+            ..Default::default()
+        };
+        let data =
+            |omega: Vec<f64>| Channels::of_model(&m, omega, vec![(0, 0)], 1.05, (0.01, 1e-6));
+        let two = changes(&m, &m, &data(vec![150.0, 600.0]));
+        assert!(two.settled.is_none(), "{:?}", two.settled);
+        let one = changes(&m, &m, &data(vec![150.0]));
+        let note = one.settled.expect("settled");
+        assert!(
+            note.contains("3 output gains for 2 real data values")
+                && note.contains("identified no frequency or damping"),
+            "{note}"
+        );
+    }
 
     /// Against scipy's `norm.isf(0.0027/n/2)`: 2.99998, 3.54967, 3.81715.
     #[test]
