@@ -15,12 +15,14 @@
 //! The SVD is of the column-scaled `J`; a tall `J` (far more residual rows than slots, as
 //! 29952 × 51 on a 1664-line, nine-channel record) is first reduced to its `R` factor
 //! (`J = QR`, `Q` with orthonormal columns: `R` has `J`'s singular values and right singular
-//! vectors), so the SVD is of a square matrix of the slots' size.
+//! vectors), so the SVD is of a square matrix of the slots' size; a wide `J` (400 × 3000
+//! for 1000 modes on 200 data) through the QR of `Jᵀ`, the SVD of a square matrix of the
+//! rows' size ([`svd_right`]).
 
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::slots::{get_lin, get_nl, set_lin, set_nl, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use rayon::prelude::*;
 
@@ -189,6 +191,29 @@ fn jacobian(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> DMatr
     DMatrix::from_fn(rows, all.len(), |i, j| cols[j][i])
 }
 
+/// The singular values of `j` and its right singular vectors (the rows of `vt`, one
+/// column per slot), from the SVD of a square triangular factor: a tall `j = QR` through
+/// `R` (the same singular values and right singular vectors); a wide `j` (more slots than
+/// rows: 3000 × 400 for 1000 modes on 200 data) through the QR of its transpose,
+/// `jᵀ = QR`, so `j = RᵀQᵀ` and, with `R = UΣWᵀ`, `j = WΣ(QU)ᵀ`: the right singular vectors
+/// are `QU`.  Signs may differ from a direct SVD; no use of them sees signs.
+fn svd_right(j: DMatrix<f64>) -> Option<(DVector<f64>, DMatrix<f64>)> {
+    let (rows, n) = j.shape();
+    if rows > n {
+        let svd = j.qr().r().svd(false, true);
+        Some((svd.singular_values, svd.v_t?))
+    } else if rows < n {
+        let qr = j.transpose().qr();
+        let (q, r) = (qr.q(), qr.r());
+        let svd = r.svd(true, false);
+        let u = svd.u?;
+        Some((svd.singular_values, (q * u).transpose()))
+    } else {
+        let svd = j.svd(false, true);
+        Some((svd.singular_values, svd.v_t?))
+    }
+}
+
 /// Standard deviations of every slot coordinate of `m` (`lin` then `nl`) from
 /// `cov = (2JᵀJ)⁻¹`, by an SVD of the column-scaled Jacobian; a coordinate with a
 /// noticeable share in a direction the data do not determine gets `∞`.
@@ -220,17 +245,13 @@ pub(crate) fn slot_covariance(
             jac.column_mut(j).scale_mut(1.0 / s);
         }
     }
-    // A tall Jacobian through its `R` factor: the same singular values and right singular
-    // vectors (up to sign, which no use below sees), from an `n × n` SVD.
-    let reduced = if rows > n { jac.qr().r() } else { jac };
-    let svd = reduced.svd(false, true);
-    let Some(vt) = svd.v_t else {
+    let Some((singular_values, vt)) = svd_right(jac) else {
         return (vec![f64::INFINITY; n], None);
     };
-    let smax = svd.singular_values.max();
+    let smax = singular_values.max();
     let mut var = vec![0.0; n];
     let mut undetermined = vec![false; n];
-    for (k, sk) in svd.singular_values.iter().enumerate() {
+    for (k, sk) in singular_values.iter().enumerate() {
         if *sk <= 1e-10 * smax {
             for (j, u) in undetermined.iter_mut().enumerate() {
                 *u |= vt[(k, j)].abs() > 1e-3;
@@ -245,7 +266,7 @@ pub(crate) fn slot_covariance(
     // only `rows` right singular vectors, and the other `n − rows` span directions the data
     // do not see at all; a coordinate's share in them is what its unit vector lacks in
     // the ones returned.
-    if svd.singular_values.len() < n {
+    if singular_values.len() < n {
         for (j, u) in undetermined.iter_mut().enumerate() {
             let seen: f64 = vt.column(j).norm_squared();
             *u |= 1.0 - seen > 1e-6;
@@ -262,12 +283,12 @@ pub(crate) fn slot_covariance(
         .collect();
     // Correlations in the scaled coordinates (the scale cancels): V Σ⁻² Vᵀ normalized.
     let full_rank =
-        svd.singular_values.len() == n && svd.singular_values.iter().all(|sk| *sk > 1e-10 * smax);
+        singular_values.len() == n && singular_values.iter().all(|sk| *sk > 1e-10 * smax);
     let corr = full_rank.then(|| {
-        let k = svd.singular_values.len();
+        let k = singular_values.len();
         let mut w = vt.transpose();
         for c in 0..k {
-            let sk = svd.singular_values[c];
+            let sk = singular_values[c];
             w.column_mut(c).scale_mut(1.0 / sk);
         }
         let cov = &w * w.transpose();

@@ -142,3 +142,38 @@ fn a_wide_jacobian_leaves_the_unseen_directions_undetermined() {
     assert!(finite <= rows, "{finite} finite σ with {rows} rows");
     assert!(sigma.iter().any(|s| s.is_infinite()));
 }
+
+/// The factored SVD ([`svd_right`]) of a wide, a square and a tall matrix against nalgebra's
+/// direct SVD: the same singular values (sorted) and the same projector `VᵀV` onto the
+/// right singular vectors (signs and order aside), to 1e-10.
+#[test]
+fn the_factored_svd_matches_the_direct_one() {
+    for (rows, n) in [(7, 19), (9, 9), (40, 6)] {
+        // Full rank (a pseudo-random fill): every singular vector is defined.
+        let mut state = 12345u64 + (rows * n) as u64;
+        let a = DMatrix::<f64>::from_fn(rows, n, |_, _| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        });
+        let (s, vt) = svd_right(a.clone()).expect("svd");
+        let direct = a.clone().svd(false, true);
+        let sorted = |v: &DVector<f64>| {
+            let mut x: Vec<f64> = v.iter().copied().collect();
+            x.sort_by(f64::total_cmp);
+            x
+        };
+        let (s1, s2) = (sorted(&s), sorted(&direct.singular_values));
+        assert_eq!(s1.len(), s2.len());
+        for (x, y) in s1.iter().zip(&s2) {
+            assert!(
+                (x - y).abs() <= 1e-10 * s2[s2.len() - 1],
+                "{rows}×{n}: {x} vs {y}"
+            );
+        }
+        let vt2 = direct.v_t.unwrap();
+        let (p1, p2) = (vt.transpose() * &vt, vt2.transpose() * &vt2);
+        assert!((p1 - p2).amax() <= 1e-10, "{rows}×{n}: projectors differ");
+    }
+}
