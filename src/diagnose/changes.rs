@@ -62,7 +62,7 @@ pub struct Changes {
     pub threshold_sigmas: f64,
     /// Said when the refit's output gains (linear slots) are at least as many as the data's
     /// real values: they alone fit the data, so the refit identified no frequency or
-    /// damping (the retune is "settled" on them, [`crate::diagnose::lsq::retune`]).
+    /// damping (the retune is "settled" on them).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub settled: Option<String>,
 }

@@ -129,8 +129,8 @@ impl Cand {
         with_effect!(self, e => e.modify(nat, rho, base, omega, ch, entry, core, path))
     }
 
-    /// `∂ ln f/∂θ` at `ω` of a one-parameter path effect's factor ([`Effect::path_log_slope`]);
-    /// `None` for the other effects.
+    /// `∂ ln f/∂θ` at `ω` of a one-parameter path effect's factor (the effect's
+    /// `path_log_slope`); `None` for the other effects.
     pub fn path_log_slope(&self, th: f64, omega: f64) -> Option<Complex64> {
         with_effect!(self, e => e.path_log_slope(th, omega))
     }

@@ -6,9 +6,9 @@
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::problem::Problem;
-use crate::diagnose::search::beam::SearchSettings;
 use crate::diagnose::search::node::Node;
 use crate::diagnose::search::rank::{candidate_list, Screened};
+use crate::diagnose::search::settings::SearchSettings;
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 

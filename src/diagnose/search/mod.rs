@@ -6,6 +6,7 @@
 //! * `node`: an effect set written into the model and jointly refit;
 //! * `beam`: the beam search over effect sets;
 //! * `expand`: a node's screen and the candidates it sends to joint refits;
+//! * `settings`: the search's settings;
 //! * `first_level`: the root's candidates ranked;
 //! * `polish`: the consistency polish;
 //! * `ties`: sets the data cannot tell apart;
@@ -33,4 +34,5 @@ pub(crate) mod peak_modes;
 pub(crate) mod peaks;
 pub(crate) mod polish;
 pub(crate) mod rank;
+pub(crate) mod settings;
 pub(crate) mod ties;
