@@ -21,11 +21,9 @@
 //! `gain` (before 1, after `k`) with the parameters it covers in [`CommonGain`].
 
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::slots::{
-    gains_of, get_lin, get_nl, set_lin, set_nl, slots, Lin, Nl, Term,
-};
+pub(crate) use crate::diagnose::lsq::covariance::{slot_covariance, slot_sigmas};
+use crate::diagnose::lsq::slots::{gains_of, get_lin, get_nl, slots, Lin, Nl, Term};
 use crate::model::physical::PhysicalModel;
-use nalgebra::DMatrix;
 use serde::Serialize;
 
 /// A configured parameter the refit moved by more than 3σ (family-wise).
@@ -62,6 +60,11 @@ pub struct Changes {
     pub common_gain: Option<CommonGain>,
     /// The threshold in σ a move had to exceed (3σ corrected for the number of parameters).
     pub threshold_sigmas: f64,
+    /// Said when the refit's output gains (linear slots) are at least as many as the data's
+    /// real values: they alone fit the data, so the refit identified no frequency or
+    /// damping (the retune is "settled" on them).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub settled: Option<String>,
 }
 
 /// The two-sided tail of 3σ: the false-alarm rate of one parameter.
@@ -241,126 +244,17 @@ fn configured_nl(base: &PhysicalModel, m: &PhysicalModel, s: Nl) -> bool {
     }
 }
 
-/// The weighted residual `√2/r · (G_d − G)` (real and imaginary parts) of `m` on `data`.
-fn residual(m: &PhysicalModel, data: &Channels, out: &mut Vec<f64>) {
-    out.clear();
-    for (k, w) in data.omega.iter().enumerate() {
-        let g = m.eval(*w);
-        for (ch, e) in data.entries.iter().enumerate() {
-            let wt = std::f64::consts::SQRT_2 / data.radius[ch][k];
-            let d = (data.g[ch][k] - g[*e]) * wt;
-            out.push(d.re);
-            out.push(d.im);
-        }
-    }
-}
-
-/// Standard deviations of every slot coordinate of `m` (`lin` then `nl`) from
-/// `cov = (2JᵀJ)⁻¹`, by an SVD of the column-scaled Jacobian; a coordinate with a
-/// noticeable share in a direction the data do not determine gets `∞`.
-pub(crate) fn slot_sigmas(m: &PhysicalModel, lin: &[Lin], nl: &[Nl], data: &Channels) -> Vec<f64> {
-    slot_covariance(m, lin, nl, data).0
-}
-
-/// Standard deviations of every slot coordinate (as [`slot_sigmas`]) and, when the Jacobian
-/// has full rank, the correlation matrix of the slots (`lin` then `nl`) from the same
-/// covariance `(2JᵀJ)⁻¹`.
-pub(crate) fn slot_covariance(
-    m: &PhysicalModel,
-    lin: &[Lin],
-    nl: &[Nl],
-    data: &Channels,
-) -> (Vec<f64>, Option<DMatrix<f64>>) {
-    let n = lin.len() + nl.len();
-    let mut r0 = Vec::new();
-    residual(m, data, &mut r0);
-    let rows = r0.len();
-    if n == 0 || rows == 0 {
-        return (vec![f64::INFINITY; n], None);
-    }
-    let w_max = data.omega.last().copied().unwrap_or(1.0);
-    let mut jac = DMatrix::<f64>::zeros(rows, n);
-    let mut rp = Vec::new();
-    for j in 0..n {
-        let mut t = m.clone();
-        let h = if j < lin.len() {
-            let x = get_lin(m, lin[j]);
-            let h = 1e-6 * x.abs().max(1e-300);
-            set_lin(&mut t, lin[j], x + h);
-            h
-        } else {
-            let s = nl[j - lin.len()];
-            let x = get_nl(m, s);
-            let typ = match s {
-                Nl::Delay(_) => 1.0 / w_max,
-                Nl::In(..) => x.abs().max(1e-300),
-                _ => 1.0,
-            };
-            let h = 1e-6 * x.abs().max(typ);
-            set_nl(&mut t, s, x + h);
-            h
-        };
-        residual(&t, data, &mut rp);
-        for k in 0..rows {
-            jac[(k, j)] = (rp[k] - r0[k]) / h;
-        }
-    }
-    let scale: Vec<f64> = (0..n).map(|j| jac.column(j).norm()).collect();
-    if scale.iter().any(|s| !s.is_finite()) {
-        return (vec![f64::INFINITY; n], None);
-    }
-    for (j, s) in scale.iter().enumerate() {
-        if *s > 0.0 {
-            jac.column_mut(j).scale_mut(1.0 / s);
-        }
-    }
-    let svd = jac.svd(false, true);
-    let Some(vt) = svd.v_t else {
-        return (vec![f64::INFINITY; n], None);
-    };
-    let smax = svd.singular_values.max();
-    let mut var = vec![0.0; n];
-    let mut undetermined = vec![false; n];
-    for (k, sk) in svd.singular_values.iter().enumerate() {
-        if *sk <= 1e-10 * smax {
-            for (j, u) in undetermined.iter_mut().enumerate() {
-                *u |= vt[(k, j)].abs() > 1e-3;
-            }
-            continue;
-        }
-        for (j, v) in var.iter_mut().enumerate() {
-            *v += (vt[(k, j)] / sk).powi(2);
-        }
-    }
-    let sigma = (0..n)
-        .map(|j| {
-            if undetermined[j] || scale[j] == 0.0 {
-                f64::INFINITY
-            } else {
-                (var[j] / 2.0).sqrt() / scale[j]
-            }
-        })
-        .collect();
-    // Correlations in the scaled coordinates (the scale cancels): V Σ⁻² Vᵀ normalized.
-    let full_rank = svd.singular_values.iter().all(|sk| *sk > 1e-10 * smax);
-    let corr = full_rank.then(|| {
-        let k = svd.singular_values.len();
-        let mut w = vt.transpose();
-        for c in 0..k {
-            let sk = svd.singular_values[c];
-            w.column_mut(c).scale_mut(1.0 / sk);
-        }
-        let cov = &w * w.transpose();
-        let d: Vec<f64> = (0..n).map(|j| cov[(j, j)].max(1e-300).sqrt()).collect();
-        DMatrix::from_fn(n, n, |a, b| cov[(a, b)] / (d[a] * d[b]))
-    });
-    (sigma, corr)
-}
-
 /// The configured parameters of `base` that the refit model `refit` (configured terms first,
 /// possibly with added effects) moved by more than 3σ, σ at `refit` on `data`.
 pub fn changes(base: &PhysicalModel, refit: &PhysicalModel, data: &Channels) -> Changes {
     let (lin, nl) = slots(refit, data);
+    let values = 2 * data.len() * data.n_ch();
+    let settled = (!nl.is_empty() && lin.len() >= values).then(|| {
+        format!(
+            "the model has {} output gains for {values} real data values: the refit solved for the gains alone (least norm) and identified no frequency or damping (ω_n and ζ kept as configured); more lines, or fewer modes, would identify them",
+            lin.len()
+        )
+    });
     let sig = slot_sigmas(refit, &lin, &nl, data);
     // (param after, param before, σ of the physical value, relative σ of the gain).
     let mut rows: Vec<(Param, f64, f64, f64)> = Vec::new();
@@ -447,6 +341,7 @@ pub fn changes(base: &PhysicalModel, refit: &PhysicalModel, data: &Channels) -> 
         changes: out,
         common_gain: common,
         threshold_sigmas: k_sig,
+        settled,
     }
 }
 
@@ -477,7 +372,38 @@ impl Changes {
 
 #[cfg(test)]
 mod tests {
-    use super::threshold_sigmas;
+    use super::{changes, threshold_sigmas};
+    use crate::diagnose::lsq::channels::Channels;
+    use crate::model::physical::{Gains, ModeSpec, PhysicalModel};
+
+    /// Three modes on two lines (4 real values, 3 output gains): not settled; on one line
+    /// (2 real values): settled, and said so (no frequency or damping identified).
+    #[test]
+    fn a_refit_with_more_gains_than_data_values_says_it_identified_no_frequency() {
+        let mode = |w: f64| ModeSpec {
+            name: None,
+            omega_n: w,
+            zeta: 0.02,
+            mass: 1.0,
+            input_gain: Gains::Scalar(1.0),
+            output_gain: Gains::Scalar(1e4),
+        };
+        let m = PhysicalModel {
+            mode: vec![mode(100.0), mode(300.0), mode(900.0)],
+            ..Default::default()
+        };
+        let data =
+            |omega: Vec<f64>| Channels::of_model(&m, omega, vec![(0, 0)], 1.05, (0.01, 1e-6));
+        let two = changes(&m, &m, &data(vec![150.0, 600.0]));
+        assert!(two.settled.is_none(), "{:?}", two.settled);
+        let one = changes(&m, &m, &data(vec![150.0]));
+        let note = one.settled.expect("settled");
+        assert!(
+            note.contains("3 output gains for 2 real data values")
+                && note.contains("identified no frequency or damping"),
+            "{note}"
+        );
+    }
 
     /// Against scipy's `norm.isf(0.0027/n/2)`: 2.99998, 3.54967, 3.81715.
     #[test]

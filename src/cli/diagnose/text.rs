@@ -23,6 +23,9 @@ pub(super) fn print_text(
         fmt_pct(d.retuned.invalid_fraction)
     );
     print_changes(&d.retuned.moved, "the retune moved");
+    if let Some(note) = &d.retuned.moved.settled {
+        println!("  note: {note}");
+    }
     print_candidates(d);
     print_path(d);
     if !d.chosen.is_empty() {

@@ -129,6 +129,12 @@ impl Cand {
         with_effect!(self, e => e.modify(nat, rho, base, omega, ch, entry, core, path))
     }
 
+    /// `∂ ln f/∂θ` at `ω` of a one-parameter path effect's factor (the effect's
+    /// `path_log_slope`); `None` for the other effects.
+    pub fn path_log_slope(&self, th: f64, omega: f64) -> Option<Complex64> {
+        with_effect!(self, e => e.path_log_slope(th, omega))
+    }
+
     /// The SI parameters `(name, value, factor)` from the internal ones; `factor` turns an
     /// internal standard deviation into an SI one (0 for labels).  Per-channel residues are
     /// named `rho`, `c`, `d` for one channel, else `rho_<out>_<in>` (1-based).

@@ -38,6 +38,11 @@ impl OnPath for Delay {
         *path *= (-Complex64::new(0.0, omega) * tau).exp();
     }
 
+    /// `f = e^{−jωτ}`: `−jω`.
+    fn log_slope(_: f64, omega: f64) -> Complex64 {
+        -Complex64::new(0.0, omega)
+    }
+
     fn set(e: &mut EffectSpec, v: f64) {
         e.tau_s = Some(v);
     }

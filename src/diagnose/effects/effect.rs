@@ -177,6 +177,13 @@ pub trait Effect: Copy {
     /// How far apart two fits `a`, `b` of this effect are for the hold-out's "same set"
     /// (|Δ ln ω_n| of an added mode; 0 when the target alone tells the effect).
     fn apart(&self, a: &[f64], b: &[f64]) -> f64;
+
+    /// `∂ ln f/∂θ` at `ω` of the factor `f(jω; θ)` a one-parameter path effect multiplies
+    /// the path by (its analytic Jacobian: `∂r/∂θ = −G·∂ ln f/∂θ / σ` on the rows it acts
+    /// on); `None` (the default) for every other effect.
+    fn path_log_slope(&self, _th: f64, _omega: f64) -> Option<Complex64> {
+        None
+    }
 }
 
 /// A parameter of a physical model, by the term it belongs to (0-based indices into the

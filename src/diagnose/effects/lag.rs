@@ -34,6 +34,12 @@ impl OnPath for Lag {
         *path /= Complex64::new(1.0, 0.0) + s / omega_c;
     }
 
+    /// `f = 1/(1 + s/ω_c)`: `(s/ω_c²)/(1 + s/ω_c)`.
+    fn log_slope(omega_c: f64, omega: f64) -> Complex64 {
+        let u = Complex64::new(0.0, omega) / omega_c;
+        u / ((Complex64::new(1.0, 0.0) + u) * omega_c)
+    }
+
     fn set(e: &mut EffectSpec, v: f64) {
         e.omega_c = Some(v);
     }

@@ -36,6 +36,12 @@ impl OnPath for NmpZero {
         *path *= (one - s / z) / (one + s / z)
     }
 
+    /// `f = (1 − s/z)/(1 + s/z)`: `(2s/z²)/(1 − (s/z)²)`.
+    fn log_slope(z: f64, omega: f64) -> Complex64 {
+        let u = Complex64::new(0.0, omega) / z;
+        2.0 * u / ((Complex64::new(1.0, 0.0) - u * u) * z)
+    }
+
     fn set(e: &mut EffectSpec, v: f64) {
         e.z = Some(v);
     }

@@ -35,6 +35,9 @@ pub trait OnPath: Copy {
     fn bounds_in(w_min: f64, w_max: f64) -> (f64, f64);
     /// Multiplies `path` at `ω` by its factor with the natural parameter `x`.
     fn apply(x: f64, omega: f64, path: &mut Complex64);
+    /// `∂ ln f/∂x` of that factor `f` at `ω` (closed form, for the analytic Jacobian of a
+    /// fit of the effect alone, [`Effect::path_log_slope`]).
+    fn log_slope(x: f64, omega: f64) -> Complex64;
     /// Sets its parameter `v` (SI) in the written spec.
     fn set(e: &mut EffectSpec, v: f64);
     /// The phase it adds at the band top `w_hi` as written in `e`, and its words in the
@@ -60,6 +63,18 @@ pub(crate) fn natural_of<T: OnPath>(th: f64) -> f64 {
     }
 }
 
+/// `∂x/∂θ` of [`natural_of`]: `x` for a logarithm, the sign of `τ` for a delay (`+1` at 0,
+/// the side a forward difference sees).
+pub(crate) fn dnatural_of<T: OnPath>(th: f64) -> f64 {
+    if T::LOG {
+        th.exp()
+    } else if th >= 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
 /// `on_path!(Type)`: implements [`Effect`] for `Type`, which implements [`OnPath`] (a
 /// macro, not a blanket impl: two blanket impls of [`Effect`] would overlap).
 macro_rules! on_path {
@@ -69,7 +84,7 @@ macro_rules! on_path {
                 at_bound_flag, last, one, sig, Band, Effect, Explain, Param, Resolution, Sel, Si,
                 Site, Stands, Writer,
             };
-            use $crate::diagnose::effects::path::{natural_of, OnPath};
+            use $crate::diagnose::effects::path::{dnatural_of, natural_of, OnPath};
             use $crate::model::physical::PhysicalModel;
             use num_complex::Complex64;
 
@@ -199,6 +214,10 @@ macro_rules! on_path {
 
                 fn apart(&self, _: &[f64], _: &[f64]) -> f64 {
                     0.0
+                }
+
+                fn path_log_slope(&self, th: f64, omega: f64) -> Option<Complex64> {
+                    Some(<T as OnPath>::log_slope(natural_of::<T>(th), omega) * dnatural_of::<T>(th))
                 }
             }
         };

@@ -37,6 +37,18 @@ impl OnPath for Zoh {
         *path *= (-s * t / 2.0).exp() * sinc
     }
 
+    /// `f = e^{−sT/2} sin(u)/u`, `u = ωT/2`: `−s/2 + (u cot u − 1)/T` (`−u²/3` for the
+    /// bracket near 0, where the factor uses `sinc = 1`).
+    fn log_slope(t: f64, omega: f64) -> Complex64 {
+        let u = omega * t / 2.0;
+        let bracket = if u.abs() < 1e-4 {
+            -u * u / 3.0
+        } else {
+            u / u.tan() - 1.0
+        };
+        -Complex64::new(0.0, omega) / 2.0 + bracket / t
+    }
+
     fn set(e: &mut EffectSpec, v: f64) {
         e.t_s = Some(v);
     }

@@ -8,6 +8,7 @@
 //! * `starts`: each candidate's starting points;
 //! * `lm`: Levenberg–Marquardt;
 //! * `slots`: the configured model's parameters `retune` refits;
+//! * `covariance`: the covariance of every slot at a refit (σ, correlations);
 //! * `varpro`: the variable-projection Jacobian;
 //! * `mode_grid`: the cost as one mode moves (the retune's rough placement);
 //! * `retune`: the joint refit of the configured model's own parameters;
@@ -15,6 +16,7 @@
 //! * `profile`: the profile likelihood of a damping at that floor (flat: not identified);
 //! * `whiteness`: is the normalized residual the stated noise (level, Ljung–Box).
 pub(crate) mod channels;
+pub(crate) mod covariance;
 pub(crate) mod lm;
 pub(crate) mod measures;
 pub(crate) mod mode_grid;

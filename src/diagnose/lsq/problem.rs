@@ -380,6 +380,54 @@ impl<'a> Problem<'a> {
         jac.iter().all(|v| v.is_finite())
     }
 
+    /// The Jacobian of [`Problem::residual`] for a lone one-parameter path effect `c`
+    /// (delay, lag, NMP zero, ZOH: the path multiplied by `f(jω; θ)`): on a channel it acts
+    /// on, `e = (G_d − core₀·path₀·f)/σ`, so `∂e/∂θ = −(G_d/σ − e)·∂ ln f/∂θ`
+    /// ([`Cand::path_log_slope`], closed form) with `e` the residual `r` at θ; the folded row
+    /// of the other channels does not depend on θ.  `false` when `jac` is not the residual's
+    /// shape or a value is not finite.
+    fn lone_path_jacobian(
+        &self,
+        c: &Cand,
+        th: &[f64],
+        mask: &[usize],
+        r: &[f64],
+        jac: &mut DMatrix<f64>,
+    ) -> bool {
+        if th.len() != 1 || jac.ncols() != 1 || jac.nrows() != r.len() {
+            return false;
+        }
+        let slopes: Option<Vec<Complex64>> = mask
+            .iter()
+            .map(|k| c.path_log_slope(th[0], self.data.omega[*k]))
+            .collect();
+        let Some(slopes) = slopes else {
+            return false;
+        };
+        let mut row = 0;
+        for ch in 0..self.n_ch() {
+            if !c.acts_on(self.data.entries[ch]) {
+                continue;
+            }
+            if row + 2 * mask.len() > r.len() {
+                return false;
+            }
+            for (q, &k) in mask.iter().enumerate() {
+                let e = Complex64::new(r[row], r[row + 1]);
+                let d = -(self.data.g[ch][k] * self.inv_sigma[ch][k] - e) * slopes[q];
+                jac[(row, 0)] = d.re;
+                jac[(row + 1, 0)] = d.im;
+                row += 2;
+            }
+        }
+        match r.len() - row {
+            0 => {}
+            1 => jac[(row, 0)] = 0.0,
+            _ => return false,
+        }
+        jac.iter().all(|v| v.is_finite())
+    }
+
     /// Joint bounded LM fit of `mods` (all its parameters free) on the data in `mask`.
     pub(crate) fn refit(&self, mods: &Mods, mask: &[usize]) -> (Mods, f64, DMatrix<f64>) {
         if mods.theta.is_empty() {
@@ -395,8 +443,14 @@ impl<'a> Problem<'a> {
         let (lo, hi) = self.bounds(mods);
         let cands = mods.cands.clone();
         // An added mode fitted alone (the screen's most frequent fit, from several starts)
-        // has an analytic Jacobian; every other fit, forward differences.
+        // and a one-parameter path effect fitted alone (the screen's most numerous fits:
+        // four effects on every input) have analytic Jacobians; every other fit, forward
+        // differences.
         let lone_mode = mods.cands == [Cand::Mode];
+        let lone_path = match mods.cands.as_slice() {
+            [c] if c.path_log_slope(mods.theta[0], self.omega_max()).is_some() => Some(*c),
+            _ => None,
+        };
         let res = lm_box_jac(
             |th: &[f64], out: &mut Vec<f64>| {
                 let m = Mods {
@@ -405,8 +459,9 @@ impl<'a> Problem<'a> {
                 };
                 self.residual(&m, mask, out)
             },
-            &|th: &[f64], _: &[f64], jac: &mut DMatrix<f64>| {
-                lone_mode && self.lone_mode_jacobian(th, mask, jac)
+            &|th: &[f64], r: &[f64], jac: &mut DMatrix<f64>| {
+                (lone_mode && self.lone_mode_jacobian(th, mask, jac))
+                    || lone_path.is_some_and(|c| self.lone_path_jacobian(&c, th, mask, r, jac))
             },
             &mods.theta,
             &typ,

@@ -111,3 +111,73 @@ fn the_lone_mode_jacobian_matches_central_differences() {
         }
     }
 }
+
+/// The analytic Jacobian of each lone one-parameter path effect (delay, lag, NMP zero,
+/// ZOH; on every channel and on input 2 of three, where the other two channels fold into
+/// one row) against fourth-order central differences of the residual itself.
+#[test]
+fn the_lone_path_jacobian_matches_central_differences() {
+    use crate::diagnose::effects::candidates::Sel;
+    let base = PhysicalModel {
+        mode: vec![ModeSpec {
+            name: None,
+            omega_n: 900.0,
+            zeta: 0.01,
+            mass: 1.0,
+            input_gain: Gains::Vector(vec![1.0, -0.4, 0.7]),
+            output_gain: Gains::Scalar(3e4),
+        }],
+        ..Default::default()
+    };
+    let omega = crate::system::logspace(100.0, 3000.0, 80);
+    let entries = vec![(0, 0), (0, 1), (0, 2)];
+    let data = Channels::of_model(&base, omega, entries, 1.1, (0.02, 1e-3));
+    let p = Problem::new(&base, &data).expect("problem");
+    let mask: Vec<usize> = (0..data.len()).step_by(2).collect();
+    // θ: τ (s) for a delay (both signs: `|τ|` is used), else the logarithm of the corner,
+    // zero or hold time.
+    for sel in [Sel::All, Sel::Input(1)] {
+        for (c, th) in [
+            (Cand::Delay(sel), 3e-4),
+            (Cand::Delay(sel), -2e-4),
+            (Cand::Lag(sel), 1500f64.ln()),
+            (Cand::NmpZero(sel), 4000f64.ln()),
+            (Cand::Zoh(sel), 5e-4f64.ln()),
+        ] {
+            let resid = |t: f64| {
+                let mut out = Vec::new();
+                let m = Mods {
+                    cands: vec![c],
+                    theta: vec![t],
+                };
+                p.residual(&m, &mask, &mut out);
+                out
+            };
+            let r = resid(th);
+            let rows = r.len();
+            assert_eq!(rows % 2, usize::from(sel != Sel::All), "{c:?}: folded row");
+            let mut jac = DMatrix::zeros(rows, 1);
+            assert!(
+                p.lone_path_jacobian(&c, &[th], &mask, &r, &mut jac),
+                "{c:?}"
+            );
+            let h = 1e-4 * th.abs().max(1e-3);
+            let (p2, p1, m1, m2) = (
+                resid(th + 2.0 * h),
+                resid(th + h),
+                resid(th - h),
+                resid(th - 2.0 * h),
+            );
+            let scale = (0..rows).map(|i| jac[(i, 0)].abs()).fold(0.0, f64::max);
+            assert!(scale > 0.0, "{c:?}: zero column");
+            for i in 0..rows {
+                let fd = (-p2[i] + 8.0 * p1[i] - 8.0 * m1[i] + m2[i]) / (12.0 * h);
+                assert!(
+                    (fd - jac[(i, 0)]).abs() <= 1e-6 * scale,
+                    "{c:?}, row {i}: analytic {} vs {fd}",
+                    jac[(i, 0)]
+                );
+            }
+        }
+    }
+}
