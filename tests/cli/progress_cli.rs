@@ -68,7 +68,7 @@ fn stability_and_synthesize_print_their_stage_lines_on_stderr() {
     );
     assert!(at.windows(2).all(|w| w[0] < w[1]), "{lines:#?}");
     assert!(
-        !stdout(&o).contains("closed-loop poles ("),
+        !stdout(&o).contains("stability: "),
         "{}",
         stdout(&o)
     );
