@@ -67,11 +67,7 @@ fn stability_and_synthesize_print_their_stage_lines_on_stderr() {
         ],
     );
     assert!(at.windows(2).all(|w| w[0] < w[1]), "{lines:#?}");
-    assert!(
-        !stdout(&o).contains("stability: "),
-        "{}",
-        stdout(&o)
-    );
+    assert!(!stdout(&o).contains("stability: "), "{}", stdout(&o));
     assert!(stdout(&o).contains("internally stable"), "{}", stdout(&o));
     // The default threshold: this model is small, no stage line.
     let quiet = rshape(&["stability", cfg, "--controller", k]);
