@@ -2,7 +2,6 @@
 //! (nalgebra's uncapped `schur()` can hang; docs/design/lessons.md, crate notes).
 
 use crate::error::{Error, Result};
-use crate::system::hessenberg::hessenberg_form;
 use crate::system::hqr::hessenberg_eigenvalues;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
@@ -101,17 +100,10 @@ pub fn eigenvalues(a: &DMatrix<f64>, what: &str) -> Result<Vec<Complex64>> {
     // Schur vectors, so about twice as fast as nalgebra's Schur form from a few hundred
     // states on (1600 × 1600: 21 s against 46 s, release, loaded), and it converges on the
     // clustered spectra where nalgebra's iteration stalls (see `hqr`).
-    // From `FRANCIS_FIRST_FROM` on the Hessenberg form is `hessenberg_form`'s (column-wise
-    // reflections: nalgebra's row-wise ones were 60 % of a 1600 × 1600 Hamiltonian's time);
-    // below it nalgebra's, so small models (the robot's H∞ loop) keep their figures.
     let francis = |m: &DMatrix<f64>| {
         let balanced = apply_balancing(m, &balancing(m));
-        let h = if balanced.nrows() >= FRANCIS_FIRST_FROM {
-            hessenberg_form(balanced)
-        } else {
-            nalgebra::linalg::Hessenberg::new(balanced).h()
-        };
-        hessenberg_eigenvalues(h).filter(|w| w.iter().all(|z| z.re.is_finite() && z.im.is_finite()))
+        hessenberg_eigenvalues(nalgebra::linalg::Hessenberg::new(balanced).h())
+            .filter(|w| w.iter().all(|z| z.re.is_finite() && z.im.is_finite()))
     };
     let first = if n >= FRANCIS_FIRST_FROM {
         francis(a).or_else(|| schur_of(a))

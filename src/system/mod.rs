@@ -17,7 +17,6 @@ pub(crate) mod dense_inverse;
 pub(crate) mod eig;
 pub(crate) mod freq_eval;
 pub(crate) mod golden;
-pub(crate) mod hessenberg;
 pub(crate) mod hinf;
 pub(crate) mod hqr;
 pub(crate) mod interconnect;
