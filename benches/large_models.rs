@@ -24,6 +24,10 @@
 //! whole-matrix staircase: > 600 s at 1000); `diagnose_root_retune` 4.6 s / 0.12 s (1000
 //! modes: 20–40 s per mode placed before).
 //!
+//! Fifth session (`cargo bench --bench large_models -- loop_poles_structured --sample-count
+//! 1`, load 8–9): `loop_poles_structured` 100 / 1000 modes 84.5 ms / 65.5 s (the dense
+//! 4000 × 4000 eigenvalues of the 1000-mode loop had not finished in 600 s).
+//!
 //! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
 //! smallest size of the two long benches runs, as a check that the measurement works).
 //!
