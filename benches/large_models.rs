@@ -58,7 +58,8 @@ fn main() {
 const SIZES: &[usize] = &[25, 50, 100];
 
 /// Sizes of the long benches (`stability_run` at 1000 modes has dense eigenproblems of
-/// 4000 × 4000, the loop's poles and each Hamiltonian iteration: not measured).
+/// 2000 × 2000 for the loop's poles and 4000 × 4000 for each Hamiltonian iteration: not
+/// measured).
 const STABILITY_SIZES: &[usize] = &[25, 50, 100, 200];
 const COMPARE_SIZES: &[usize] = &[50, 100, 200, 1000];
 
