@@ -50,9 +50,20 @@ pub fn loop_poles(
     controller_gain: &StateSpace,
     t: &StateSpace,
 ) -> Result<LoopPoles> {
-    if let Some(done) = structured(f, controller_gain, t)? {
+    loop_poles_told(f, controller_gain, t, &|_| ())
+}
+
+/// [`loop_poles`], telling `stage` the eigenproblem it solves once the route is decided.
+pub(crate) fn loop_poles_told(
+    f: &Factorization,
+    controller_gain: &StateSpace,
+    t: &StateSpace,
+    stage: &dyn Fn(&str),
+) -> Result<LoopPoles> {
+    if let Some(done) = structured(f, controller_gain, t, stage)? {
         return Ok(done);
     }
+    stage(&format!("closed-loop poles ({} states)", t.states()));
     Ok(LoopPoles {
         poles: eigenvalues(&t.a, "closed-loop poles")?,
         row_loop: None,
@@ -60,8 +71,8 @@ pub fn loop_poles(
 }
 
 /// `Σ deg qᵢ`, the hidden modes [`loop_poles`] takes from the factors' denominators, when
-/// its structured route applies to the loop `t` (for the progress line, before solving).
-pub(crate) fn hidden_mode_count(f: &Factorization, t: &StateSpace) -> Option<usize> {
+/// its structured route may apply to the loop `t`.
+fn hidden_mode_count(f: &Factorization, t: &StateSpace) -> Option<usize> {
     applies(f, t).then(|| (0..f.states()).map(|i| f.m.entry(i, i).den.degree()).sum())
 }
 
@@ -75,7 +86,12 @@ fn applies(f: &Factorization, t: &StateSpace) -> bool {
         })
 }
 
-fn structured(f: &Factorization, k: &StateSpace, t: &StateSpace) -> Result<Option<LoopPoles>> {
+fn structured(
+    f: &Factorization,
+    k: &StateSpace,
+    t: &StateSpace,
+    stage: &dyn Fn(&str),
+) -> Result<Option<LoopPoles>> {
     let Some(hidden) = hidden_mode_count(f, t) else {
         return Ok(None);
     };
@@ -93,6 +109,11 @@ fn structured(f: &Factorization, k: &StateSpace, t: &StateSpace) -> Result<Optio
         }
         poles.extend(roots.roots);
     }
+    let (n, r) = (t.states(), reduced.states());
+    stage(&format!(
+        "closed-loop poles ({n} states: the eigenvalues of the {r} x {r} loop of the cancelled \
+         rows, and {hidden} hidden modes of the factors, the roots of their denominators)"
+    ));
     let own = eigenvalues(&reduced.a, "closed-loop poles")?;
     poles.extend(own.iter().copied());
     Ok(Some(LoopPoles {

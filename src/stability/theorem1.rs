@@ -6,7 +6,7 @@
 use super::factor_loop::{
     gang_of_four, gang_sigma_max, t_sigma_max, theorem1_norm_system, theorem1_system,
 };
-use super::loop_poles::{hidden_mode_count, loop_poles, LoopPoles};
+use super::loop_poles::{loop_poles, loop_poles_told, LoopPoles};
 use crate::error::{Error, Result};
 use crate::model::controller::Controller;
 use crate::model::Factorization;
@@ -198,17 +198,7 @@ pub fn analyze_gridded(
     let k = controller_fits(f, controller)?;
     stage("the loop's realization");
     let t = theorem1_system(f, &k)?;
-    let n = t.states();
-    stage(&match hidden_mode_count(f, &t) {
-        Some(h) if h < n => format!(
-            "closed-loop poles ({n} states: the eigenvalues of the {} x {} loop of the cancelled rows, \
-             and {h} hidden modes of the factors, the roots of their denominators)",
-            n - h,
-            n - h
-        ),
-        _ => format!("closed-loop poles ({n} states)"),
-    });
-    let LoopPoles { poles, row_loop } = loop_poles(f, &k, &t)?;
+    let LoopPoles { poles, row_loop } = loop_poles_told(f, &k, &t, stage)?;
     let abscissa = spectral_abscissa(&poles);
     let grid = &grid(&poles)[..];
     stage(&format!(
