@@ -14,12 +14,19 @@
 //!   from 50 modal coordinates (fourth session; the whole-matrix staircase had not finished
 //!   the 1000-mode loop in 600 s);
 //! * `diagnose_root_retune` (200, 1000 modes): the retune at `diagnose`'s root from a rough
-//!   start (1000 modes on 200 data: settled, the output gains' least-norm fit only).
+//!   start (1000 modes on 200 data: settled, the output gains' least-norm fit only);
+//! * `loop_poles_structured` (100, 1000 modes): `closed_loop_poles` from the loop's structure
+//!   (`stability::loop_poles`: the loop of the cancelled rows, 2 states per mode, and the
+//!   roots of each mode's factor denominator; fifth session).
 //!
 //! Fourth session (`cargo bench --bench large_models -- loop_realization diagnose_root_retune
 //! --sample-count 1`, load 6–8): `loop_realization` 200 / 1000 modes 63 ms / 2.6 s (the
 //! whole-matrix staircase: > 600 s at 1000); `diagnose_root_retune` 4.6 s / 0.12 s (1000
 //! modes: 20–40 s per mode placed before).
+//!
+//! Fifth session (`cargo bench --bench large_models -- loop_poles_structured --sample-count
+//! 1`, load 8–9): `loop_poles_structured` 100 / 1000 modes 84.5 ms / 65.5 s (the dense
+//! 4000 × 4000 eigenvalues of the 1000-mode loop had not finished in 600 s).
 //!
 //! Run: `cargo bench --bench large_models -- --sample-count 1` (under `cargo test` only the
 //! smallest size of the two long benches runs, as a check that the measurement works).
@@ -51,7 +58,8 @@ fn main() {
 const SIZES: &[usize] = &[25, 50, 100];
 
 /// Sizes of the long benches (`stability_run` at 1000 modes has dense eigenproblems of
-/// 4000 × 4000, the loop's poles and each Hamiltonian iteration: not measured).
+/// 2000 × 2000 for the loop's poles and 4000 × 4000 for each Hamiltonian iteration: not
+/// measured).
 const STABILITY_SIZES: &[usize] = &[25, 50, 100, 200];
 const COMPARE_SIZES: &[usize] = &[50, 100, 200, 1000];
 
@@ -156,4 +164,21 @@ fn diagnose_root_retune(bencher: Bencher, k: usize) {
     let channels = rshape::diagnose::Channels::from_siso(&siso).expect("channels");
     let model = config.physical.clone().expect("[physical]");
     bencher.bench(|| rshape::diagnose::retune(&model, &channels, None, true));
+}
+
+/// Sizes of the closed-loop poles from the loop's structure (fifth session): the loop of the
+/// cancelled rows' eigenvalues and the factors' denominators' roots, from 200 loop states
+/// (50 modes); 1000 modes is a 2000 × 2000 eigenproblem instead of 4000 × 4000.
+const POLE_SIZES: &[usize] = &[100, 1000];
+
+#[divan::bench(args = POLE_SIZES, sample_count = 1)]
+fn loop_poles_structured(bencher: Bencher, k: usize) {
+    if k > POLE_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, controller, _dir) = inputs(k);
+    bencher.bench(|| {
+        rshape::stability::closed_loop_poles(&config.factorization, &controller).expect("poles")
+    });
 }

@@ -28,6 +28,10 @@ pub struct StabilityArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// From this many (approximate) loop states on, stage lines on stderr (a test lowers it
+    /// to see them on a small model).
+    #[arg(long, default_value_t = LARGE_MODEL_STATES, hide = true)]
+    pub progress_from_states: usize,
 }
 
 /// From this many states on, `stability` announces its long stage (issue 34: a 200-mode
@@ -75,7 +79,7 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         .realization
         .as_ref()
         .map_or(2 * f.states(), |n| n.plant.states());
-    let view = (states >= LARGE_MODEL_STATES).then(|| {
+    let view = (states >= a.progress_from_states).then(|| {
         let v = super::progress::FitProgressView::new("stability");
         v.stage(&format!(
             "the loop of a model with about {states} states: closed-loop poles, then the exact H∞ norms (dense, O(n³))"

@@ -38,6 +38,10 @@ pub struct SynthesizeArgs {
     /// Print synthesis.json's content instead of the summary.
     #[arg(long)]
     pub json: bool,
+    /// From this many (approximate) plant states on, stage lines on stderr (a test lowers it
+    /// to see them on a small model).
+    #[arg(long, default_value_t = LARGE_PLANT_STATES, hide = true)]
+    pub progress_from_states: usize,
 }
 
 /// `--method`.
@@ -64,7 +68,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
         .realization
         .as_ref()
         .map_or(2 * f.states(), |n| n.plant.states());
-    let view = (states >= LARGE_PLANT_STATES).then(|| {
+    let view = (states >= a.progress_from_states).then(|| {
         let v = super::progress::FitProgressView::new("synthesize");
         v.stage(&format!(
             "normalized coprime factors of a plant with about {states} states (realization, Riccati equation: dense, O(n³))"

@@ -212,6 +212,13 @@ pub fn theorem1_norm_system(
     if full.states() < ROW_NORMS_FROM || f.realization.is_some() || !f.m.is_diagonal() {
         return Ok(full.clone());
     }
+    row_loop(f, k)
+}
+
+/// The Theorem 1 loop on the rows `M̃ᵢᵢ⁻¹·[Ñᵢ  1]` with `q` cancelled (`modal_rows`,
+/// [`Rows::Cancelled`]), for a diagonal `M̃`: the same `T` as [`theorem1_system`] without the
+/// factors' hidden modes (see [`theorem1_norm_system`] and `loop_poles`).
+pub(crate) fn row_loop(f: &Factorization, k: &StateSpace) -> Result<StateSpace> {
     let ms = modal_rows(f, Rows::Cancelled)?.series(&j_and_identity(f));
     let closed = negative_feedback(&ms, &controller_on_modes(f, k), f.inputs())?;
     Ok(j_and_identity(f).series(&closed))

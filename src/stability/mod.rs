@@ -24,14 +24,18 @@
 //! [`CROSS_CHECK_RTOL`]), [`decide`] (the verdict from the norm's bounds), and the systems
 //! it is computed on: [`theorem1_system`] (`r·T` of condition 2), [`gang_of_four`],
 //! [`plant_system`], [`modal_system`] (for a large diagonal `M̃` row by row; the whole-matrix
-//! [`modal_cascade`] below [`CASCADE_ROWS_FROM`]) and the grid value [`t_sigma_max`].
+//! [`modal_cascade`] below [`CASCADE_ROWS_FROM`]), the grid value [`t_sigma_max`] and the
+//! closed-loop poles [`loop_poles`] (for a large diagonal `M̃` from the structure: the loop of
+//! the cancelled rows and the factors' denominators).
 pub(crate) mod factor_loop;
+pub(crate) mod loop_poles;
 pub(crate) mod theorem1;
 
 pub use factor_loop::{
     gang_of_four, gang_sigma_max, modal_cascade, modal_system, plant_system, t_sigma_max,
     theorem1_system, CASCADE_ROWS_FROM,
 };
+pub use loop_poles::{loop_poles, LoopPoles, POLES_BY_STRUCTURE_FROM};
 pub use theorem1::{
     analyze, analyze_gridded, analyze_with_stages, closed_loop_poles, controller_fits, decide,
     GridCurve, MarginRow, RobustStability, Verdict, CROSS_CHECK_RTOL,

@@ -6,12 +6,13 @@
 use super::factor_loop::{
     gang_of_four, gang_sigma_max, t_sigma_max, theorem1_norm_system, theorem1_system,
 };
+use super::loop_poles::{loop_poles, loop_poles_told, LoopPoles};
 use crate::error::{Error, Result};
 use crate::model::controller::Controller;
 use crate::model::Factorization;
-use crate::system::eig::{eigenvalues, spectral_abscissa};
+use crate::system::eig::spectral_abscissa;
 use crate::system::freq_eval::FreqEvaluator;
-use crate::system::hinf::{hinf_norm, hinf_norm_near, HinfNorm};
+use crate::system::hinf::{hinf_norm, hinf_norm_near, hinf_norm_near_with_poles, HinfNorm};
 use crate::system::{StateSpace, TransferFunction};
 use num_complex::Complex64;
 use serde::Serialize;
@@ -139,7 +140,7 @@ fn complex_list<S: serde::Serializer>(
 /// `A`), without the norms [`analyze`] computes: what a caller needs to choose its grid.
 pub fn closed_loop_poles(f: &Factorization, controller: &Controller) -> Result<Vec<Complex64>> {
     let k = controller_fits(f, controller)?;
-    eigenvalues(&theorem1_system(f, &k)?.a, "closed-loop poles")
+    Ok(loop_poles(f, &k, &theorem1_system(f, &k)?)?.poles)
 }
 
 /// The controller as the negative-feedback gain `K`, checked to be `m×p` (plant inputs ×
@@ -197,9 +198,7 @@ pub fn analyze_gridded(
     let k = controller_fits(f, controller)?;
     stage("the loop's realization");
     let t = theorem1_system(f, &k)?;
-    let n = t.states();
-    stage(&format!("closed-loop poles ({n} states)"));
-    let poles = eigenvalues(&t.a, "closed-loop poles")?;
+    let LoopPoles { poles, row_loop } = loop_poles_told(f, &k, &t, stage)?;
     let abscissa = spectral_abscissa(&poles);
     let grid = &grid(&poles)[..];
     stage(&format!(
@@ -238,7 +237,12 @@ pub fn analyze_gridded(
     }
     // The norms on the same T without the factors' hidden modes (large diagonal-M̃ loops).
     let t_full_states = t.states();
-    let t = theorem1_norm_system(f, &k, &t)?;
+    // The structured poles already realized that system and know its poles (the same
+    // matrix): no second dense eigenproblem of its size in the norm's start.
+    let (t, t_poles) = match row_loop {
+        Some((rl, own)) => (rl, Some(own)),
+        None => (theorem1_norm_system(f, &k, &t)?, None),
+    };
     let nt = t.states();
     // A large loop: its peaks located by the grid values (structured, cheap) at the grid and
     // at every lightly damped closed-loop pole, instead of one dense response per pole in
@@ -274,7 +278,10 @@ pub fn analyze_gridded(
     ));
     let t_norm = if peaks.is_some() {
         let sig = |w: f64| t_sigma_max(f, &kev, w);
-        hinf_norm_near(&t, &near(&|_| 1.0), Some(&sig))?
+        match &t_poles {
+            Some(p) => hinf_norm_near_with_poles(&t, &near(&|_| 1.0), Some(&sig), p)?,
+            None => hinf_norm_near(&t, &near(&|_| 1.0), Some(&sig))?,
+        }
     } else {
         hinf_norm(&t)?
     };
@@ -305,7 +312,12 @@ pub fn analyze_gridded(
                 .collect();
             c.sort_by(|a, b| b.1.total_cmp(&a.1));
             let starts: Vec<f64> = c.iter().take(4).map(|(w, _)| *w).collect();
-            hinf_norm_near(&g4, &starts, Some(&sig))?
+            // The gang's loop is the plant's rows closed by K, the matrix of the norm
+            // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
+            match t_poles.as_ref().filter(|_| same_matrix(&g4.a, &t.a)) {
+                Some(p) => hinf_norm_near_with_poles(&g4, &starts, Some(&sig), p)?,
+                None => hinf_norm_near(&g4, &starts, Some(&sig))?,
+            }
         } else {
             hinf_norm(&g4)?
         }
@@ -372,4 +384,9 @@ pub fn analyze_gridded(
         },
         curve,
     ))
+}
+
+/// Whether two state matrices are the same to rounding (`‖A − B‖_max ≤ 1e-13·‖A‖_max`).
+fn same_matrix(a: &nalgebra::DMatrix<f64>, b: &nalgebra::DMatrix<f64>) -> bool {
+    a.shape() == b.shape() && (a - b).amax() <= 1e-13 * a.amax().max(f64::MIN_POSITIVE)
 }

@@ -274,7 +274,7 @@ fn dense_candidates(poles: &[Complex64], lo: f64, wmin: f64, wmax: f64) -> Vec<f
 /// `‖G‖∞` of a stable system; errors when `A` is not Hurwitz (the norm is infinite) or an
 /// eigenvalue computation fails.
 pub fn hinf_norm(ss: &StateSpace) -> Result<HinfNorm> {
-    peak_gain(ss, 0.0, true, None, None)
+    peak_gain(ss, 0.0, true, None, None, None)
 }
 
 /// [`hinf_norm`] started from the caller's frequencies instead of one per pole and a grid:
@@ -292,7 +292,27 @@ pub fn hinf_norm_near(
     omegas: &[f64],
     sigma: Option<&dyn Fn(f64) -> Option<f64>>,
 ) -> Result<HinfNorm> {
-    peak_gain(ss, 0.0, true, Some(omegas), sigma)
+    peak_gain(ss, 0.0, true, Some(omegas), sigma, None)
+}
+
+/// [`hinf_norm_near`] for a system whose poles the caller has already computed (the
+/// eigenvalues of `ss.a`, e.g. the closed-loop poles of the same loop): on a loop of
+/// thousands of states that dense eigenproblem is minutes, and the iteration needs the
+/// poles only for the stability test and the scale of the pencil's shift.
+pub fn hinf_norm_near_with_poles(
+    ss: &StateSpace,
+    omegas: &[f64],
+    sigma: Option<&dyn Fn(f64) -> Option<f64>>,
+    poles: &[Complex64],
+) -> Result<HinfNorm> {
+    if poles.len() != ss.states() {
+        return Err(Error::Invalid(format!(
+            "H∞ norm: {} poles given for {} states",
+            poles.len(),
+            ss.states()
+        )));
+    }
+    peak_gain(ss, 0.0, true, Some(omegas), sigma, Some(poles))
 }
 
 /// `sup σ_max(G(jω))` over `ω ∈ [omega_lo, ∞]` for any `A` (stable or not): the `L∞` norm of
@@ -307,7 +327,7 @@ pub fn peak_gain_above(ss: &StateSpace, omega_lo: f64) -> Result<HinfNorm> {
             "peak gain: band edge {omega_lo} must be finite and ≥ 0"
         )));
     }
-    peak_gain(ss, omega_lo, false, None, None)
+    peak_gain(ss, omega_lo, false, None, None, None)
 }
 
 fn peak_gain(
@@ -316,6 +336,7 @@ fn peak_gain(
     require_stable: bool,
     start: Option<&[f64]>,
     sigma: Option<&dyn Fn(f64) -> Option<f64>>,
+    known_poles: Option<&[Complex64]>,
 ) -> Result<HinfNorm> {
     ss.validate("H∞ norm")?;
     // An exact similarity that keeps the Hamiltonian's eigenvalues accurate when the
@@ -335,7 +356,11 @@ fn peak_gain(
             iterations: 0,
         });
     }
-    let poles = eigenvalues(&ss.a, "H∞ norm: poles")?;
+    // The balancing below is a similarity: the caller's poles are those of `ss.a`.
+    let poles = match known_poles {
+        Some(p) => p.to_vec(),
+        None => eigenvalues(&ss.a, "H∞ norm: poles")?,
+    };
     let abscissa = spectral_abscissa(&poles);
     if abscissa.is_nan() || (require_stable && abscissa >= 0.0) {
         return Err(Error::Invalid(format!(

@@ -32,7 +32,9 @@ pub(crate) mod transfer_function;
 
 pub use eig::{eigenvalues, spectral_abscissa};
 pub use freq_eval::FreqEvaluator;
-pub use hinf::{hinf_norm, hinf_norm_near, peak_gain_above, HinfNorm, HINF_RTOL};
+pub use hinf::{
+    hinf_norm, hinf_norm_near, hinf_norm_near_with_poles, peak_gain_above, HinfNorm, HINF_RTOL,
+};
 pub use interconnect::negative_feedback;
 pub use linalg::{extreme_singular_values, spectral_norm};
 pub use ncf::NormalizedLcf;

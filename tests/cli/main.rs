@@ -7,6 +7,11 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+/// The large-model structure of the benches.
+#[path = "../../benches/support/modes.rs"]
+#[allow(dead_code)]
+mod modes;
+
 mod a1_proof;
 mod a1_verdict;
 mod bad_input;
@@ -26,6 +31,7 @@ mod hardening_iii_minor;
 mod kill_safety;
 mod output_modes;
 mod output_policy;
+mod progress_cli;
 mod quiet_output;
 mod run_cli;
 mod settings_validate;

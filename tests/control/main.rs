@@ -15,6 +15,7 @@ mod closed_loop_stability_large;
 mod hinf_large_modal;
 mod hinf_near_d;
 mod iss_reduction;
+mod loop_poles_structure;
 mod modal_cascade_rows;
 mod progress_stages;
 mod stability;
