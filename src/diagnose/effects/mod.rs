@@ -28,6 +28,7 @@ pub(crate) mod explain;
 pub(crate) mod factor;
 pub(crate) mod lscf;
 pub(crate) mod path;
+pub(crate) mod pseudo_mode;
 mod tests;
 
 /// The registration list: declares each effect's module, makes [`Cand`] (one variant per

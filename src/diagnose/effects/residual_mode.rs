@@ -11,18 +11,16 @@
 //! do).  Tried only on a model that has the upper residual already.
 
 use crate::diagnose::effects::effect::{
-    fmt_w, log_grid, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site,
-    Stands, Writer,
+    fmt_w, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
 };
-use crate::diagnose::effects::mode::mode_term;
-use crate::model::physical::{ModeSpec, PhysicalModel};
+use crate::diagnose::effects::pseudo_mode;
+use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
 /// A pseudo-mode above the band.
 #[derive(Debug, Clone, Copy)]
 pub struct ResidualMode;
 
-pub use crate::diagnose::effects::effect::PSEUDO_ZETA;
 /// Its `ω_n` lies between these multiples of the band top.
 pub const ABOVE: (f64, f64) = (1.05, 10.0);
 
@@ -68,19 +66,12 @@ impl Effect for ResidualMode {
     }
 
     fn typ(&self, theta: &[f64], _: f64) -> Vec<f64> {
-        let mut v = vec![1.0];
-        v.extend(theta[1..].iter().map(|x| x.abs().max(1e-300)));
-        v
+        pseudo_mode::typ(theta)
     }
 
     /// `ω_n` in `[1.05, 10] ω_max`, residues free.
     fn bounds(&self, n_ch: usize, _: f64, w_max: f64, _: f64) -> Vec<(f64, f64)> {
-        let mut v = vec![((ABOVE.0 * w_max).ln(), (ABOVE.1 * w_max).ln())];
-        v.extend(std::iter::repeat_n(
-            (f64::NEG_INFINITY, f64::INFINITY),
-            n_ch,
-        ));
-        v
+        pseudo_mode::bounds(n_ch, (ABOVE.0 * w_max, ABOVE.1 * w_max))
     }
 
     fn natural(&self, th: &[f64], nat: &mut [f64]) {
@@ -102,25 +93,15 @@ impl Effect for ResidualMode {
         core: &mut Complex64,
         _: &mut Complex64,
     ) {
-        *core += mode_term(omega, nat[0], PSEUDO_ZETA, nat[1 + ch]);
+        *core += pseudo_mode::term(nat, omega, ch);
     }
 
     fn si_params(&self, th: &[f64], entries: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        let mut v = one("omega_n", th[0].exp(), th[0].exp());
-        v.extend(per_channel("rho", th, 1, entries));
-        v
+        pseudo_mode::si_params(th, entries)
     }
 
     fn write(&self, w: &mut Writer) {
-        let (b, c) = w.gains(1);
-        w.m.mode.push(ModeSpec {
-            name: Some(w.note.to_string()),
-            omega_n: w.get("omega_n"),
-            zeta: PSEUDO_ZETA,
-            mass: 1.0,
-            input_gain: b,
-            output_gain: c,
-        });
+        pseudo_mode::write(w)
     }
 
     fn explain(&self, x: &Explain) -> String {
@@ -139,17 +120,7 @@ impl Effect for ResidualMode {
     /// `ω_n` on a log grid above the band, the residues by least squares.
     fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
         let (_, wmax) = site.band();
-        let mut trials: Vec<(f64, Vec<f64>)> = log_grid(ABOVE.0 * wmax, ABOVE.1 * wmax, 16)
-            .into_iter()
-            .map(|lw| {
-                let mut th = site.mode_theta(lw.exp(), PSEUDO_ZETA);
-                // `mode_theta` is an added mode's [ln ω_n, ln ζ, ρ…]: ζ is not a parameter here.
-                th.remove(1);
-                (site.cost(&th), th)
-            })
-            .collect();
-        trials.sort_by(|a, b| a.0.total_cmp(&b.0));
-        trials.into_iter().take(3).map(|t| t.1).collect()
+        pseudo_mode::starts(site, (ABOVE.0 * wmax, ABOVE.1 * wmax))
     }
 
     fn flags(
@@ -160,12 +131,7 @@ impl Effect for ResidualMode {
         _: Band,
         out: &mut Vec<String>,
     ) {
-        if at(0) {
-            out.push(format!(
-                "ω_n at its bound {}: the pseudo-mode is not placed (the upper residual alone, or modes further up)",
-                fmt_w(th[0].exp())
-            ));
-        }
+        pseudo_mode::not_placed(th, at, "the upper residual alone, or modes further up", out)
     }
 
     fn stands(&self) -> Stands {
@@ -203,6 +169,8 @@ impl Effect for ResidualMode {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::effects::effect::PSEUDO_ZETA;
+    use crate::model::physical::ModeSpec;
 
     #[test]
     fn its_term_is_an_undamped_mode_above_the_band() {

@@ -14,11 +14,10 @@
 //! ΔBIC does not pay for its parameters.
 
 use crate::diagnose::effects::effect::{
-    fmt_w, log_grid, one, per_channel, Band, Effect, Explain, Param, Resolution, Sel, Si, Site,
-    Stands, Writer, PSEUDO_ZETA,
+    fmt_w, Band, Effect, Explain, Param, Resolution, Sel, Si, Site, Stands, Writer,
 };
-use crate::diagnose::effects::mode::mode_term;
-use crate::model::physical::{ModeSpec, PhysicalModel};
+use crate::diagnose::effects::pseudo_mode;
+use crate::model::physical::PhysicalModel;
 use num_complex::Complex64;
 
 /// A pseudo-mode below the band.
@@ -62,19 +61,12 @@ impl Effect for ResidualModeBelow {
     }
 
     fn typ(&self, theta: &[f64], _: f64) -> Vec<f64> {
-        let mut v = vec![1.0];
-        v.extend(theta[1..].iter().map(|x| x.abs().max(1e-300)));
-        v
+        pseudo_mode::typ(theta)
     }
 
     /// `ω_n` in `[0.1, 0.95] ω_min`, residues free.
     fn bounds(&self, n_ch: usize, w_min: f64, _: f64, _: f64) -> Vec<(f64, f64)> {
-        let mut v = vec![((BELOW.0 * w_min).ln(), (BELOW.1 * w_min).ln())];
-        v.extend(std::iter::repeat_n(
-            (f64::NEG_INFINITY, f64::INFINITY),
-            n_ch,
-        ));
-        v
+        pseudo_mode::bounds(n_ch, (BELOW.0 * w_min, BELOW.1 * w_min))
     }
 
     fn natural(&self, th: &[f64], nat: &mut [f64]) {
@@ -96,25 +88,15 @@ impl Effect for ResidualModeBelow {
         core: &mut Complex64,
         _: &mut Complex64,
     ) {
-        *core += mode_term(omega, nat[0], PSEUDO_ZETA, nat[1 + ch]);
+        *core += pseudo_mode::term(nat, omega, ch);
     }
 
     fn si_params(&self, th: &[f64], entries: &[(usize, usize)]) -> Vec<(String, f64, f64)> {
-        let mut v = one("omega_n", th[0].exp(), th[0].exp());
-        v.extend(per_channel("rho", th, 1, entries));
-        v
+        pseudo_mode::si_params(th, entries)
     }
 
     fn write(&self, w: &mut Writer) {
-        let (b, c) = w.gains(1);
-        w.m.mode.push(ModeSpec {
-            name: Some(w.note.to_string()),
-            omega_n: w.get("omega_n"),
-            zeta: PSEUDO_ZETA,
-            mass: 1.0,
-            input_gain: b,
-            output_gain: c,
-        });
+        pseudo_mode::write(w)
     }
 
     fn explain(&self, x: &Explain) -> String {
@@ -132,17 +114,7 @@ impl Effect for ResidualModeBelow {
     /// `ω_n` on a log grid below the band, the residues by least squares.
     fn starts(&self, site: &dyn Site) -> Vec<Vec<f64>> {
         let (wmin, _) = site.band();
-        let mut trials: Vec<(f64, Vec<f64>)> = log_grid(BELOW.0 * wmin, BELOW.1 * wmin, 16)
-            .into_iter()
-            .map(|lw| {
-                let mut th = site.mode_theta(lw.exp(), PSEUDO_ZETA);
-                // `mode_theta` is an added mode's [ln ω_n, ln ζ, ρ…]: ζ is not a parameter here.
-                th.remove(1);
-                (site.cost(&th), th)
-            })
-            .collect();
-        trials.sort_by(|a, b| a.0.total_cmp(&b.0));
-        trials.into_iter().take(3).map(|t| t.1).collect()
+        pseudo_mode::starts(site, (BELOW.0 * wmin, BELOW.1 * wmin))
     }
 
     fn flags(
@@ -153,12 +125,12 @@ impl Effect for ResidualModeBelow {
         _: Band,
         out: &mut Vec<String>,
     ) {
-        if at(0) {
-            out.push(format!(
-                "ω_n at its bound {}: the pseudo-mode is not placed (the lower residual alone, or modes further down)",
-                fmt_w(th[0].exp())
-            ));
-        }
+        pseudo_mode::not_placed(
+            th,
+            at,
+            "the lower residual alone, or modes further down",
+            out,
+        )
     }
 
     fn stands(&self) -> Stands {
@@ -196,6 +168,8 @@ impl Effect for ResidualModeBelow {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::effects::effect::PSEUDO_ZETA;
+    use crate::model::physical::ModeSpec;
     use crate::model::physical::PoleAtZeroSpec;
 
     #[test]
