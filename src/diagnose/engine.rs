@@ -26,16 +26,13 @@ use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::measures::Measures;
 use crate::diagnose::lsq::problem::Problem;
 use crate::diagnose::progress::{DiagnoseOptions, DiagnoseProgress::Stage};
-use crate::diagnose::report::{
-    DiagnoseVerdict, Diagnosis, EffectSet, Holdout, Phases, Retuned, SearchStats,
-};
-use crate::diagnose::search::beam::{
-    roots, screen_configured, search, SearchResult, SearchSettings,
-};
+use crate::diagnose::report::{DiagnoseVerdict, Diagnosis, Holdout, Phases, Retuned, SearchStats};
+use crate::diagnose::search::beam::{roots, screen_configured, search, SearchSettings};
 use crate::diagnose::search::final_effects::final_effects;
 use crate::diagnose::search::first_level::{ranked_candidates, Root};
 use crate::diagnose::search::holdout::{holdouts, model_of};
 use crate::diagnose::search::node::Node;
+use crate::diagnose::search::path::{restate_path, runner_ups};
 use crate::diagnose::search::ties::{candidate_ties, set_ties};
 use crate::diagnose::verdict::{
     residual_account, stop_explanation, unreached_modes, verdict_message,
@@ -179,7 +176,12 @@ pub fn diagnose_channels(
         })
     })?;
     // Runner-ups and ties are then relative to the set kept.
+    let rejected = res.chosen;
     res.chosen = replaced_by.unwrap_or(res.chosen);
+    let mut restated = None;
+    if !dropped.is_empty() && replaced_by.is_none() {
+        restated = Some(restate_path(&mut node, &res.nodes, base, data)?);
+    }
     options.tell(Stage("backward elimination"));
     let eliminated = phases.time("backward elimination", || {
         crate::diagnose::search::backward::eliminate(
@@ -190,6 +192,17 @@ pub fn diagnose_channels(
             s.min_delta_bic,
         )
     })?;
+    if !eliminated.is_empty() {
+        restated = Some(restate_path(&mut node, &res.nodes, base, data)?);
+    }
+    // The kept set is a node of the search (its own path, BIC and ties), or no node is: then
+    // no set tie can be stated against it (`set_ties` compares nodes).
+    let set_node = match restated {
+        None => Some(res.chosen),
+        Some(found) => found,
+    };
+    res.chosen = set_node.unwrap_or(res.chosen);
+    let rejected = (!dropped.is_empty()).then(|| res.nodes[rejected].clone());
     options.tell(Stage("final refit"));
     let dampings_not_identified = phases.time("final refit", || {
         crate::diagnose::search::final_refit::final_refit(&mut node, base, data)
@@ -200,11 +213,14 @@ pub fn diagnose_channels(
         &node.model,
         &node.effects,
     );
-    let runner_up = runner_ups(&res);
+    let runner_up = runner_ups(&res, &node, rejected.as_ref());
     let chosen_labels = node.labels();
     options.tell(Stage("ties"));
     let ties = phases.time("ties", || {
-        let mut ties = set_ties(&res, &chosen_labels, &node.model, data);
+        let mut ties = match set_node {
+            Some(_) => set_ties(&res, &chosen_labels, &node.model, data),
+            None => vec![],
+        };
         ties.extend(candidate_ties(&mut candidates, &ties, data));
         ties
     });
@@ -350,28 +366,6 @@ fn drop_failing_holdout(
     });
     node.effects = keep;
     Ok((holdout, dropped))
-}
-
-/// The four best other effect sets of the search, by BIC, with their gap to the chosen one.
-fn runner_ups(res: &SearchResult) -> Vec<EffectSet> {
-    let chosen_bic = res.nodes[res.chosen].bic;
-    let mut runner_up: Vec<EffectSet> = res
-        .nodes
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| *i != res.chosen)
-        .map(|(_, nd)| EffectSet {
-            effects: nd.labels(),
-            bic: nd.bic,
-            bic_gap: nd.bic - chosen_bic,
-            misfit_rms: nd.measures.misfit_rms,
-            invalid_fraction: nd.measures.invalid_fraction,
-            consistent: nd.measures.consistent(),
-        })
-        .collect();
-    runner_up.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-    runner_up.truncate(4);
-    runner_up
 }
 
 /// The revised model of first-level candidate `rank` (1-based): the retuned model with the

@@ -35,7 +35,7 @@ fn columns(path: &Path) -> Vec<Vec<f64>> {
 }
 
 /// The accelerance on `[f_lo, f_hi]` Hz with its noise radius from the coherence.
-fn pyfrf(f_lo: f64, f_hi: f64) -> Channels {
+pub(crate) fn pyfrf(f_lo: f64, f_hi: f64) -> Channels {
     let h = columns(&dir().join("frf_h1.csv"));
     let c = columns(&dir().join("frf_h1_coherence.csv"));
     let (mut omega, mut g, mut radius) = (vec![], vec![], vec![]);

@@ -11,6 +11,7 @@
 //! * `polish`: the consistency polish;
 //! * `ties`: sets the data cannot tell apart;
 //! * `holdout`: the final set checked on held-out data;
+//! * `path`: the chosen path and the runner-ups once the holdout or the elimination dropped effects;
 //! * `backward`: backward elimination;
 //! * `peaks`: every peak of the residual and its fate;
 //! * `peak_modes`: a mode proposed at every peak that would pass the screen;
@@ -30,6 +31,7 @@ pub(crate) mod first_level;
 pub(crate) mod holdout;
 pub(crate) mod multi_mode;
 pub(crate) mod node;
+pub(crate) mod path;
 pub(crate) mod peak_modes;
 pub(crate) mod peaks;
 pub(crate) mod polish;

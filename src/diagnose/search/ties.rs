@@ -13,6 +13,7 @@ use crate::diagnose::effects::candidates::fmt_w;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::report::{CandidateReport, Tie};
 use crate::diagnose::search::beam::SearchResult;
+use crate::diagnose::search::node::Node;
 use crate::diagnose::search::rank::TIE_BIC;
 use crate::model::physical::PhysicalModel;
 
@@ -105,6 +106,9 @@ pub fn set_ties(
                 && (nd.bic - chosen.bic).abs() < TIE_BIC
                 && nd.effects.len() == chosen.effects.len()
                 && !nd.effects.is_empty()
+                // The same effects added in another order refit to the same model: not a
+                // rival (the gap is the refit's rounding).
+                && !same_fit(nd, chosen)
         })
         .map(|(_, nd)| {
             tie(
@@ -116,6 +120,27 @@ pub fn set_ties(
             )
         })
         .collect()
+}
+
+/// Two nodes of the search are the same fit: the same effects (in any order), the same BIC
+/// up to the refits' convergence (relative 1e-6) and their modes at the same frequencies
+/// (relative 1e-3).
+pub fn same_fit(a: &Node, b: &Node) -> bool {
+    let sorted = |n: &Node| {
+        let mut l = n.labels();
+        l.sort();
+        l
+    };
+    let modes = |n: &Node| {
+        let mut w: Vec<f64> = n.model.mode.iter().map(|m| m.omega_n).collect();
+        w.sort_by(f64::total_cmp);
+        w
+    };
+    let (wa, wb) = (modes(a), modes(b));
+    (a.bic - b.bic).abs() <= 1e-6 * a.bic.abs().max(1.0)
+        && sorted(a) == sorted(b)
+        && wa.len() == wb.len()
+        && wa.iter().zip(&wb).all(|(x, y)| (x / y - 1.0).abs() < 1e-3)
 }
 
 /// Marks the first-level candidates tied with the best one (both passing, within
