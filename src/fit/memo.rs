@@ -11,12 +11,14 @@ use super::problem::{Lp, LpOut};
 use std::cell::RefCell;
 use std::hash::{Hash, Hasher};
 
-/// Entries kept (the repeats measured are within the last few solves of a level).
-const ENTRIES: usize = 8;
+/// Entries kept.  Most repeats are within the last few solves of a level; 64 entries (8
+/// before issue 38's seventh step) answer 63 more of the sweep's 17,672 Clarabel solves;
+/// 477 exact repeats remain, on another thread or further back.
+const ENTRIES: usize = 64;
 
-/// Coefficients kept in all entries together, at most (8 MB): an LP with every row at
+/// Coefficients kept in all entries together, at most (16 MB): an LP with every row at
 /// 2000 data and order 8 has about 110,000.
-const MAX_COEFFS: usize = 1_000_000;
+const MAX_COEFFS: usize = 2_000_000;
 
 struct Entry {
     hash: u64,

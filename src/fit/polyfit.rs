@@ -86,7 +86,8 @@ pub(crate) fn minimax(
     let mut pending: std::collections::VecDeque<(f64, f64)> = attempts.iter().copied().collect();
     let mut b_cut_used = None;
     // The band centre runs alone (most orders end there without a doubt); after a doubt the
-    // next two attempts run at once on two cores (`rayon`) from the level known then.  The
+    // next two attempts run at once on two cores (`rayon`; one after the other on a
+    // one-thread pool) from the level known then.  The
     // loop takes their results in order, exactly as if they had run one after the other: an
     // attempt is run again when the one before it lowered the level it started from, and
     // dropped when the one before it was decisive.  So the fit is that of the sequential
@@ -114,7 +115,10 @@ pub(crate) fn minimax(
                 let Some(next) = pending.pop_front() else {
                     break;
                 };
-                if b_cut_used.is_none() {
+                // One thread (`RAYON_NUM_THREADS=1`, or a one-thread pool): the plain
+                // sequential search; a pair there would only run its second attempt for
+                // nothing whenever the first is decisive or lowers the level.
+                if b_cut_used.is_none() || rayon::current_num_threads() < 2 {
                     attempt_at(prep, n, next, t_best, set)
                 } else {
                     let pair: Vec<(f64, f64)> =

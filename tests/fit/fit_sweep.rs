@@ -11,7 +11,7 @@
 //! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing).
 
 #[path = "../../benches/support/random_envelopes.rs"]
-mod random_envelopes;
+pub(crate) mod random_envelopes;
 
 use random_envelopes::{envelope, sweep_specs, to_csv, SWEEP_LEN};
 use rshape::fit::{fit_auto, FitSettings};

@@ -9,6 +9,7 @@ mod common;
 mod certificate_exact;
 mod fit_defects;
 mod fit_paper;
+mod fit_parallel;
 mod fit_random;
 mod fit_reference;
 mod fit_sweep;
