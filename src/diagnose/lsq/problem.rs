@@ -409,17 +409,30 @@ impl<'a> Problem<'a> {
         Cand::Mode.natural(th, &mut nat);
         let (w, z) = (nat[0], nat[1]);
         let z_free = z == th[1].exp();
+        // The denominator and the log-slopes depend on the line only: once per line, not
+        // once per channel (the same values).
+        let per_line: Vec<(Complex64, Complex64, Complex64)> = mask
+            .iter()
+            .map(|&k| {
+                let s = Complex64::new(0.0, self.data.omega[k]);
+                let by_z = if z_free {
+                    mode_log_slope(s, w, z, false)
+                } else {
+                    Complex64::new(0.0, 0.0)
+                };
+                (mode_den(s, w, z), mode_log_slope(s, w, z, true), by_z)
+            })
+            .collect();
         jac.fill(0.0);
         for ch in 0..n_ch {
             let rho = nat[2 + ch];
-            for (q, &k) in mask.iter().enumerate() {
+            for (q, (&k, &(den, slope_w, slope_z))) in mask.iter().zip(&per_line).enumerate() {
                 let row = 2 * (ch * mask.len() + q);
-                let s = Complex64::new(0.0, self.data.omega[k]);
                 let p = self.path0[ch][k] * self.inv_sigma[ch][k];
-                let by_rho = -p / mode_den(s, w, z);
-                let by_w = by_rho * rho * mode_log_slope(s, w, z, true);
+                let by_rho = -p / den;
+                let by_w = by_rho * rho * slope_w;
                 let by_z = if z_free {
-                    by_rho * rho * mode_log_slope(s, w, z, false)
+                    by_rho * rho * slope_z
                 } else {
                     Complex64::new(0.0, 0.0)
                 };
