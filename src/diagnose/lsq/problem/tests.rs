@@ -275,10 +275,10 @@ fn the_channel_batched_residual_is_the_per_datum_one() {
             assert_eq!(p.v(mods, mask), v);
         }
         let g = p.response(mods);
-        for ch in 0..3 {
-            for k in 0..data.len() {
+        for (ch, g_ch) in g.iter().enumerate() {
+            for (k, g_k) in g_ch.iter().enumerate() {
                 let (c, pa) = p.parts(mods, ch, Some(k), data.omega[k]);
-                assert_eq!(g[ch][k], c * pa, "response, channel {ch}, datum {k}");
+                assert_eq!(*g_k, c * pa, "response, channel {ch}, datum {k}");
             }
         }
     }
