@@ -129,6 +129,30 @@ impl Cand {
         with_effect!(self, e => e.modify(nat, rho, base, omega, ch, entry, core, path))
     }
 
+    /// [`Cand::modify_natural`] at the data `ks` of channel `ch` (frequencies `omega[k]`),
+    /// `core[q]` and `path[q]` belonging to datum `ks[q]`: the effect is looked up once,
+    /// not once per datum, and each datum gets the same operations as one call of
+    /// [`Cand::modify_natural`] (the same values, bit for bit).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn modify_natural_many(
+        &self,
+        nat: &[f64],
+        rho: f64,
+        base: &PhysicalModel,
+        omega: &[f64],
+        ks: &[usize],
+        ch: usize,
+        entry: (usize, usize),
+        core: &mut [Complex64],
+        path: &mut [Complex64],
+    ) {
+        with_effect!(self, e => {
+            for ((&k, c), p) in ks.iter().zip(core.iter_mut()).zip(path.iter_mut()) {
+                e.modify(nat, rho, base, omega[k], ch, entry, c, p);
+            }
+        })
+    }
+
     /// `∂ ln f/∂θ` at `ω` of a one-parameter path effect's factor (the effect's
     /// `path_log_slope`); `None` for the other effects.
     pub fn path_log_slope(&self, th: f64, omega: f64) -> Option<Complex64> {

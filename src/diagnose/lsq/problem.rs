@@ -9,7 +9,6 @@ use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::lm::{lm_box_jac, LmSettings};
 use crate::diagnose::lsq::measures::{measures_of, Measures};
 use crate::diagnose::lsq::shapes::path_at;
-use crate::diagnose::lsq::shapes::{mode_den, mode_log_slope};
 use crate::error::{Error, Result};
 use crate::model::physical::PhysicalModel;
 use nalgebra::DMatrix;
@@ -32,6 +31,10 @@ pub struct Problem<'a> {
     /// channel no effect of the model acts on (a path effect on one input leaves the other
     /// channels as they are) keeps these rows, computed once ([`Problem::residual`]).
     e0: Vec<Vec<Complex64>>,
+    /// `Σ_k |e0[ch][k]|²` over every datum in index order, per channel: the folded row's
+    /// share of a channel on the whole band, summed once (the same sum a residual on every
+    /// datum would form).
+    e0_sum: Vec<f64>,
 }
 
 /// A model: the base plus effects with their internal parameters (concatenated).
@@ -97,12 +100,16 @@ impl<'a> Problem<'a> {
             .map(|r| r.iter().map(|x| std::f64::consts::SQRT_2 / x).collect())
             .collect();
         // The same expression as the residual's, so a cached row is the row it replaces.
-        let e0 = (0..data.n_ch())
+        let e0: Vec<Vec<Complex64>> = (0..data.n_ch())
             .map(|ch| {
                 (0..data.len())
                     .map(|k| (data.g[ch][k] - core0[ch][k] * path0[ch][k]) * inv_sigma[ch][k])
                     .collect()
             })
+            .collect();
+        let e0_sum = e0
+            .iter()
+            .map(|e| e.iter().map(|x| x.norm_sqr()).sum::<f64>())
             .collect();
         Ok(Self {
             base,
@@ -114,6 +121,7 @@ impl<'a> Problem<'a> {
             path0,
             zeta_floor: super::resolution::band_floor(data),
             e0,
+            e0_sum,
         })
     }
 
@@ -245,18 +253,47 @@ impl<'a> Problem<'a> {
     /// Model response at the data, `[ch][k]`.
     pub fn response(&self, mods: &Mods) -> Vec<Vec<Complex64>> {
         let nat = self.naturals_of(mods);
+        let all: Vec<usize> = (0..self.f()).collect();
+        let (mut core, mut path) = (Vec::new(), Vec::new());
         (0..self.n_ch())
             .map(|ch| {
-                let terms = self.channel_terms(mods, ch);
-                (0..self.f())
-                    .map(|k| {
-                        let (c, p) =
-                            self.parts_at(mods, &nat, &terms, ch, Some(k), self.data.omega[k]);
-                        c * p
-                    })
-                    .collect()
+                self.channel_parts(mods, &nat, ch, &all, &mut core, &mut path);
+                core.iter().zip(&path).map(|(c, p)| c * p).collect()
             })
             .collect()
+    }
+
+    /// `(core, path)` of channel `ch` with `mods` applied at the data in `mask`, into
+    /// `core` and `path` (one entry per datum of `mask`): [`Problem::parts_at`] effect by
+    /// effect over the channel's data ([`Cand::modify_natural_many`]), the same values.
+    fn channel_parts(
+        &self,
+        mods: &Mods,
+        nat: &[f64],
+        ch: usize,
+        mask: &[usize],
+        core: &mut Vec<Complex64>,
+        path: &mut Vec<Complex64>,
+    ) {
+        let (c0, p0) = (&self.core0[ch], &self.path0[ch]);
+        core.clear();
+        core.extend(mask.iter().map(|k| c0[*k]));
+        path.clear();
+        path.extend(mask.iter().map(|k| p0[*k]));
+        let entry = self.data.entries[ch];
+        for (c, (off, n, rho)) in mods.cands.iter().zip(self.channel_terms(mods, ch)) {
+            c.modify_natural_many(
+                &nat[off..off + n],
+                rho,
+                self.base,
+                &self.data.omega,
+                mask,
+                ch,
+                entry,
+                core,
+                path,
+            );
+        }
     }
 
     /// The weighted residual `(G_d − Ĝ)/σ` (real and imaginary parts, channel by channel) on
@@ -267,30 +304,44 @@ impl<'a> Problem<'a> {
     /// parameters).  A fit of a path effect on one input of nine carries a ninth of the rows.
     pub(crate) fn residual(&self, mods: &Mods, mask: &[usize], out: &mut Vec<f64>) {
         out.clear();
+        self.residual_rows(mods, mask, &mut |x| out.push(x));
+    }
+
+    /// [`Problem::residual`]'s rows, in order, each handed to `row`.
+    fn residual_rows<F: FnMut(f64)>(&self, mods: &Mods, mask: &[usize], row: &mut F) {
         let nat = self.naturals_of(mods);
+        let whole = mask.len() == self.f() && mask.iter().enumerate().all(|(i, k)| i == *k);
         let mut fixed: Option<f64> = None;
+        let (mut core, mut path) = (Vec::new(), Vec::new());
         for ch in 0..self.n_ch() {
             let entry = self.data.entries[ch];
             if !mods.cands.iter().any(|c| c.acts_on(entry)) {
                 let e0 = &self.e0[ch];
-                *fixed.get_or_insert(0.0) += mask.iter().map(|k| e0[*k].norm_sqr()).sum::<f64>();
+                *fixed.get_or_insert(0.0) += if whole {
+                    self.e0_sum[ch]
+                } else {
+                    mask.iter().map(|k| e0[*k].norm_sqr()).sum::<f64>()
+                };
                 continue;
             }
-            let terms = self.channel_terms(mods, ch);
-            for &k in mask {
-                let (c, p) = self.parts_at(mods, &nat, &terms, ch, Some(k), self.data.omega[k]);
-                let e = (self.data.g[ch][k] - c * p) * self.inv_sigma[ch][k];
-                out.push(e.re);
-                out.push(e.im);
+            self.channel_parts(mods, &nat, ch, mask, &mut core, &mut path);
+            let (g, w) = (&self.data.g[ch], &self.inv_sigma[ch]);
+            for ((&k, c), p) in mask.iter().zip(&core).zip(&path) {
+                let e = (g[k] - c * p) * w[k];
+                row(e.re);
+                row(e.im);
             }
         }
-        out.extend(fixed.map(f64::sqrt));
+        if let Some(f) = fixed {
+            row(f.sqrt());
+        }
     }
 
+    /// The cost `Σ r²` of [`Problem::residual`] (summed row by row in its order, so the
+    /// same value, without storing the rows); `∞` when it is not finite.
     pub(crate) fn v(&self, mods: &Mods, mask: &[usize]) -> f64 {
-        let mut r = Vec::with_capacity(2 * mask.len() * self.n_ch());
-        self.residual(mods, mask, &mut r);
-        let v: f64 = r.iter().map(|x| x * x).sum();
+        let mut v = 0.0;
+        self.residual_rows(mods, mask, &mut |x| v += x * x);
         if v.is_finite() {
             v
         } else {
@@ -341,91 +392,6 @@ impl<'a> Problem<'a> {
             }
         }
         (lo, hi)
-    }
-
-    /// The Jacobian of [`Problem::residual`] for a lone added mode, `θ = (ln ω_n, ln ζ,
-    /// ρ_1 … ρ_C)`: with `e = (G_d − (G₀ + ρ_c/d(s))·P)/σ`, `d = s² + 2ζω_n s + ω_n²`,
-    /// `∂e/∂ln ω_n = ρ_c P (2ζω_n s + 2ω_n²)/(d² σ)`, `∂e/∂ln ζ = ρ_c P 2ζω_n s/(d² σ)`
-    /// (zero where ζ is clamped to its bounds) and `∂e/∂ρ_c = −P/(d σ)` on channel `c`'s
-    /// rows.  `false` when `jac` is not the residual's shape.
-    fn lone_mode_jacobian(&self, th: &[f64], mask: &[usize], jac: &mut DMatrix<f64>) -> bool {
-        let n_ch = self.n_ch();
-        if th.len() != 2 + n_ch || jac.nrows() != 2 * mask.len() * n_ch || jac.ncols() != th.len() {
-            return false;
-        }
-        let mut nat = Vec::with_capacity(th.len());
-        Cand::Mode.natural(th, &mut nat);
-        let (w, z) = (nat[0], nat[1]);
-        let z_free = z == th[1].exp();
-        jac.fill(0.0);
-        for ch in 0..n_ch {
-            let rho = nat[2 + ch];
-            for (q, &k) in mask.iter().enumerate() {
-                let row = 2 * (ch * mask.len() + q);
-                let s = Complex64::new(0.0, self.data.omega[k]);
-                let p = self.path0[ch][k] * self.inv_sigma[ch][k];
-                let by_rho = -p / mode_den(s, w, z);
-                let by_w = by_rho * rho * mode_log_slope(s, w, z, true);
-                let by_z = if z_free {
-                    by_rho * rho * mode_log_slope(s, w, z, false)
-                } else {
-                    Complex64::new(0.0, 0.0)
-                };
-                for (col, v) in [(0, by_w), (1, by_z), (2 + ch, by_rho)] {
-                    jac[(row, col)] = v.re;
-                    jac[(row + 1, col)] = v.im;
-                }
-            }
-        }
-        jac.iter().all(|v| v.is_finite())
-    }
-
-    /// The Jacobian of [`Problem::residual`] for a lone one-parameter path effect `c`
-    /// (delay, lag, NMP zero, ZOH: the path multiplied by `f(jω; θ)`): on a channel it acts
-    /// on, `e = (G_d − core₀·path₀·f)/σ`, so `∂e/∂θ = −(G_d/σ − e)·∂ ln f/∂θ`
-    /// ([`Cand::path_log_slope`], closed form) with `e` the residual `r` at θ; the folded row
-    /// of the other channels does not depend on θ.  `false` when `jac` is not the residual's
-    /// shape or a value is not finite.
-    fn lone_path_jacobian(
-        &self,
-        c: &Cand,
-        th: &[f64],
-        mask: &[usize],
-        r: &[f64],
-        jac: &mut DMatrix<f64>,
-    ) -> bool {
-        if th.len() != 1 || jac.ncols() != 1 || jac.nrows() != r.len() {
-            return false;
-        }
-        let slopes: Option<Vec<Complex64>> = mask
-            .iter()
-            .map(|k| c.path_log_slope(th[0], self.data.omega[*k]))
-            .collect();
-        let Some(slopes) = slopes else {
-            return false;
-        };
-        let mut row = 0;
-        for ch in 0..self.n_ch() {
-            if !c.acts_on(self.data.entries[ch]) {
-                continue;
-            }
-            if row + 2 * mask.len() > r.len() {
-                return false;
-            }
-            for (q, &k) in mask.iter().enumerate() {
-                let e = Complex64::new(r[row], r[row + 1]);
-                let d = -(self.data.g[ch][k] * self.inv_sigma[ch][k] - e) * slopes[q];
-                jac[(row, 0)] = d.re;
-                jac[(row + 1, 0)] = d.im;
-                row += 2;
-            }
-        }
-        match r.len() - row {
-            0 => {}
-            1 => jac[(row, 0)] = 0.0,
-            _ => return false,
-        }
-        jac.iter().all(|v| v.is_finite())
     }
 
     /// Joint bounded LM fit of `mods` (all its parameters free) on the data in `mask`.
@@ -480,5 +446,6 @@ impl<'a> Problem<'a> {
     }
 }
 
+mod jacobians;
 #[cfg(test)]
 mod tests;
