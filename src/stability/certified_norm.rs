@@ -30,28 +30,20 @@ use super::enclosure::{ControllerEnclosure, Disk, Interval, Rational};
 use super::factor_loop::t_sigma_max;
 use crate::model::Factorization;
 use crate::system::freq_eval::FreqEvaluator;
-use crate::system::{HinfNorm, StateSpace};
+use crate::system::{HinfNorm, StateSpace, HINF_RTOL};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// Unit roundoff.
 const U: f64 = f64::EPSILON / 2.0;
 
-/// Relative accuracy of the sweep: it ends when every interval is below
-/// `(1 + 2·SWEEP_RTOL)·best`, so `upper = (1 + 2·SWEEP_RTOL)·gamma`.
-pub const SWEEP_RTOL: f64 = 1e-7;
-
-fn sweep_rtol() -> f64 {
-    std::env::var("DBG_RTOL").ok().and_then(|s| s.parse().ok()).unwrap_or(SWEEP_RTOL)
-}
-
 /// Interval tests before the sweep gives up (the caller then takes the Hamiltonian route).
 pub const MAX_INTERVAL_TESTS: usize = 2_000_000;
 
 /// Entries of `Λ` with `|Λᵢ| < SMALL_LAMBDA·(γ²|Dᵢ|² + 1)` are kept in the small block.
-const SMALL_LAMBDA: f64 = 1e-2;
+pub(super) const SMALL_LAMBDA: f64 = 1e-2;
 /// At most this many such entries (else the interval is split).
-const MAX_SMALL: usize = 12;
+pub(super) const MAX_SMALL: usize = 12;
 
 /// The outcome of one interval test at a level.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,18 +65,20 @@ pub(crate) trait Sweep {
 }
 
 /// The factor entries prepared for enclosures, and the controller.
-struct Prepared<'a> {
-    f: &'a Factorization,
-    d: Vec<Rational>,
+pub(super) struct Prepared<'a> {
+    pub(super) f: &'a Factorization,
+    pub(super) d: Vec<Rational>,
     /// `Ñ`, row-major `n × m`.
-    u: Vec<Rational>,
-    j: Vec<Rational>,
+    pub(super) u: Vec<Rational>,
+    pub(super) j: Vec<Rational>,
     /// `C` (`p × n`) and an upper bound of its spectral norm.
-    c: DMatrix<Complex64>,
+    pub(super) c: DMatrix<Complex64>,
     c_abs: DMatrix<f64>,
-    c_norm: f64,
-    k: ControllerEnclosure,
+    pub(super) c_norm: f64,
+    pub(super) k: ControllerEnclosure,
     kev: FreqEvaluator,
+    /// `Ñᵢₗ/M̃ᵢᵢ` as one rational each (row-major), for the gang's second-order test.
+    pub(super) y: Option<Vec<Rational>>,
 }
 
 /// The enclosures on one interval.
@@ -111,9 +105,19 @@ impl<'a> Prepared<'a> {
             .map(|(i, l)| Rational::new(f.n.entry(i, l)))
             .collect::<Option<Vec<_>>>()?;
         let j = f.j.iter().map(Rational::new).collect::<Option<Vec<_>>>()?;
+        let y = (0..n)
+            .flat_map(|i| (0..m).map(move |l| (i, l)))
+            .map(|(i, l)| {
+                let (ui, di) = (f.n.entry(i, l), f.m.entry(i, i));
+                Rational::new(&crate::system::TransferFunction {
+                    num: ui.num.mul(&di.den),
+                    den: ui.den.mul(&di.num),
+                })
+            })
+            .collect::<Option<Vec<_>>>();
         let cct = &f.c * f.c.transpose();
-        let c_norm = cct.symmetric_eigenvalues().max().max(0.0).sqrt() * (1.0 + 1e-10)
-            + 1e-14 * f.c.norm();
+        let c_norm =
+            cct.symmetric_eigenvalues().max().max(0.0).sqrt() * (1.0 + 1e-10) + 1e-14 * f.c.norm();
         Some(Self {
             f,
             d,
@@ -124,6 +128,7 @@ impl<'a> Prepared<'a> {
             c_norm,
             k: ControllerEnclosure::new(k),
             kev: FreqEvaluator::new(k),
+            y,
         })
     }
 
@@ -198,8 +203,7 @@ impl Sweep for TSweep<'_> {
         }
         let gamma0 = level * (1.0 - d_v) / (1.0 + level * d_m) * (1.0 - 8.0 * U);
         let rho_v = (at.ek / k0n.max(f64::MIN_POSITIVE)).min(1.0)
-            + at
-                .j
+            + at.j
                 .iter()
                 .map(|x| x.e / x.c.norm().max(f64::MIN_POSITIVE))
                 .fold(0.0, f64::max)
@@ -211,12 +215,17 @@ impl Sweep for TSweep<'_> {
             v0: &v0,
             rho_v,
         };
-        match positive_definite(&ctx, gamma0) {
-            Some(true) => Test::Below,
-            _ => match positive_definite(&ctx, level) {
-                Some(false) => Test::Above,
-                _ => Test::Unknown,
-            },
+        if positive_definite(&ctx, gamma0) == Some(true) {
+            return Test::Below;
+        }
+        if let Interval::Finite(a, b) = *iv {
+            if super::second_order::t_below(p, a, b, level) {
+                return Test::Below;
+            }
+        }
+        match positive_definite(&ctx, level) {
+            Some(false) => Test::Above,
+            _ => Test::Unknown,
         }
     }
 }
@@ -429,8 +438,14 @@ impl Sweep for GangSweep<'_> {
         let d_m = d_g * (k0n + at.rk) + g0n * at.rk;
         let den = 1.0 - at.rk - sigma_up * d_m;
         if den > 0.5 && sigma_up * (1.0 + d_g) / den < level {
-            Test::Below
-        } else if sigma_lo > level {
+            return Test::Below;
+        }
+        if let Interval::Finite(a, b) = *iv {
+            if super::second_order::gang_below(&self.0, a, b, level) {
+                return Test::Below;
+            }
+        }
+        if sigma_lo > level {
             Test::Above
         } else {
             Test::Unknown
@@ -490,16 +505,12 @@ pub(crate) fn certify(
             lo = w;
         }
     }
-    let mut level = (1.0 + 2.0 * sweep_rtol()) * best;
+    let mut level = (1.0 + 2.0 * HINF_RTOL) * best;
     let mut tests = 0usize;
     while let Some(iv) = stack.pop() {
         tests += 1;
         if tests > cap || !(level > 0.0) {
-            eprintln!("DBG cap: tests {tests} level {level} best {best} at {omega} iv {iv:?}");
             return None;
-        }
-        if std::env::var("DBG_SWEEP").is_ok() && tests % 20000 == 0 {
-            eprintln!("DBG tests {tests} level {level} best {best} at {omega} iv {iv:?} stack {}", stack.len());
         }
         match sw.test(&iv, level) {
             Test::Below => continue,
@@ -509,16 +520,12 @@ pub(crate) fn certify(
                 consider(w0, &mut best, &mut omega);
                 if best > before {
                     polish(w0, &mut best, &mut omega);
-                    level = (1.0 + 2.0 * sweep_rtol()) * best;
+                    level = (1.0 + 2.0 * HINF_RTOL) * best;
                 }
             }
             Test::Unknown => {}
         }
-        let Some(halves) = iv.split() else {
-            eprintln!("DBG nosplit: tests {tests} level {level} best {best} at {omega} iv {iv:?}");
-            return None;
-        };
-        stack.extend(halves);
+        stack.extend(iv.split()?);
     }
     Some(HinfNorm {
         gamma: best,

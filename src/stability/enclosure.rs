@@ -90,6 +90,32 @@ pub(crate) struct Rational {
     den_w: Vec<Complex64>,
     num_t: Vec<Complex64>,
     den_t: Vec<Complex64>,
+    /// `dh/dω = (N′D − ND′)/D²` in `ω`.
+    dnum_w: Vec<Complex64>,
+    dden_w: Vec<Complex64>,
+}
+
+/// Product of two polynomials (ascending complex coefficients).
+fn poly_mul(a: &[Complex64], b: &[Complex64]) -> Vec<Complex64> {
+    let mut c = vec![Complex64::new(0.0, 0.0); a.len() + b.len() - 1];
+    for (i, x) in a.iter().enumerate() {
+        for (j, y) in b.iter().enumerate() {
+            c[i + j] += x * y;
+        }
+    }
+    c
+}
+
+/// Derivative (ascending coefficients).
+fn poly_der(a: &[Complex64]) -> Vec<Complex64> {
+    if a.len() < 2 {
+        return vec![Complex64::new(0.0, 0.0)];
+    }
+    a.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, x)| x * k as f64)
+        .collect()
 }
 
 /// `jᵏ`.
@@ -112,10 +138,7 @@ impl Rational {
         let asc = |c: &[f64]| -> Vec<f64> { c.iter().rev().copied().collect() };
         let (an, ad) = (asc(h.num.coeffs()), asc(h.den.coeffs()));
         let in_w = |a: &[f64]| -> Vec<Complex64> {
-            a.iter()
-                .enumerate()
-                .map(|(k, x)| j_pow(k) * *x)
-                .collect()
+            a.iter().enumerate().map(|(k, x)| j_pow(k) * *x).collect()
         };
         let dd = ad.len() - 1;
         // N(ω) = ω^dn·Σ aₖjᵏ t^(dn−k); h = t^(dd−dn)·Ñ(t)/D̃(t): coefficient of t^i in the
@@ -125,11 +148,21 @@ impl Rational {
             num_t[dd - k] = j_pow(k) * *x;
         }
         let den_t = (0..=dd).map(|i| j_pow(dd - i) * ad[dd - i]).collect();
+        let (num_w, den_w) = (in_w(&an), in_w(&ad));
+        let a = poly_mul(&poly_der(&num_w), &den_w);
+        let b = poly_mul(&num_w, &poly_der(&den_w));
+        let len = a.len().max(b.len());
+        let dnum_w = (0..len)
+            .map(|k| a.get(k).copied().unwrap_or_default() - b.get(k).copied().unwrap_or_default())
+            .collect();
+        let dden_w = poly_mul(&den_w, &den_w);
         Some(Self {
-            num_w: in_w(&an),
-            den_w: in_w(&ad),
+            num_w,
+            den_w,
             num_t,
             den_t,
+            dnum_w,
+            dden_w,
         })
     }
 
@@ -141,24 +174,30 @@ impl Rational {
         } else {
             (&self.num_w, &self.den_w)
         };
-        let (nv, nb, nd) = poly_enclose(n, x0, eta);
-        let (dv, db, dd) = poly_enclose(d, x0, eta);
-        let h0 = nv / dv;
-        let (hn, dn) = (h0.norm(), dv.norm());
-        let deg = (n.len() + d.len()) as f64;
-        // Horner's running bound for the centre, then a relative margin on the sums.
-        let round = 8.0 * (deg + 2.0) * U * (nb + hn * db) / dn;
-        let r = if dn > dd {
-            (nd + hn * dd) / (dn - dd) * (1.0 + 16.0 * deg * U) + round
-        } else {
-            f64::INFINITY
-        };
-        Disk {
-            c: h0,
-            r,
-            e: round,
-        }
+        ratio_enclose(n, d, x0, eta)
     }
+
+    /// The disk enclosing `dh(jω)/dω` on a finite interval `[a, b]`.
+    pub(crate) fn enclose_derivative(&self, a: f64, b: f64) -> Disk {
+        ratio_enclose(&self.dnum_w, &self.dden_w, 0.5 * (a + b), 0.5 * (b - a))
+    }
+}
+
+/// The disk of `N(x)/D(x)` for `|x − x₀| ≤ η` (module docs).
+fn ratio_enclose(n: &[Complex64], d: &[Complex64], x0: f64, eta: f64) -> Disk {
+    let (nv, nb, nd) = poly_enclose(n, x0, eta);
+    let (dv, db, dd) = poly_enclose(d, x0, eta);
+    let h0 = nv / dv;
+    let (hn, dn) = (h0.norm(), dv.norm());
+    let deg = (n.len() + d.len()) as f64;
+    // Horner's running bound for the centre, then a relative margin on the sums.
+    let round = 8.0 * (deg + 2.0) * U * (nb + hn * db) / dn;
+    let r = if dn > dd {
+        (nd + hn * dd) / (dn - dd) * (1.0 + 16.0 * deg * U) + round
+    } else {
+        f64::INFINITY
+    };
+    Disk { c: h0, r, e: round }
 }
 
 /// `(P(x₀), Σ|cₖ||x₀|ᵏ, Σ|cₖ|((|x₀| + η)ᵏ − |x₀|ᵏ))` for ascending coefficients `c`.
@@ -219,8 +258,7 @@ impl ControllerEnclosure {
             return Some((self.d.clone(), 0.0, 0.0));
         }
         let w0 = iv.omega0();
-        let shifted =
-            DMatrix::<Complex64>::identity(n, n) * Complex64::new(0.0, w0) - &self.a;
+        let shifted = DMatrix::<Complex64>::identity(n, n) * Complex64::new(0.0, w0) - &self.a;
         let r0 = shifted.lu().solve(&DMatrix::identity(n, n))?;
         let r0n = r0.norm();
         let r0b = &r0 * &self.b;
@@ -243,8 +281,68 @@ impl ControllerEnclosure {
             }
         };
         // Rounding of the centre (a small dense solve; generous).
-        let round = 64.0 * (n as f64 + 4.0) * U * (self.d.norm() + self.c_norm * r0n * self.b_norm)
+        let round = 64.0
+            * (n as f64 + 4.0)
+            * U
+            * (self.d.norm() + self.c_norm * r0n * self.b_norm)
             * (1.0 + r0n * self.a_norm);
         Some((k0, radius + round, round))
+    }
+}
+
+/// A first-order Taylor model on `|ω − ω₀| ≤ η`: `x(ω) = x₀ + (ω − ω₀)·x₁ + R`, `‖R‖ ≤ r`,
+/// and `‖x(ω) − x₀‖ ≤ delta` (rounding of the centre included in both).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Taylor {
+    pub(crate) x0: Complex64,
+    pub(crate) x1: Complex64,
+    pub(crate) r: f64,
+    pub(crate) delta: f64,
+}
+
+impl Rational {
+    /// The Taylor model of `h(jω)` on the finite interval `[a, b]`: the value and derivative
+    /// disks give `|h(ω) − h₀ − (ω − ω₀)h₁| ≤ e₀ + η·sup|h′ − h₁|` (mean value theorem).
+    pub(crate) fn taylor(&self, a: f64, b: f64) -> Taylor {
+        let iv = Interval::Finite(a, b);
+        let v = self.enclose(&iv);
+        let d = self.enclose_derivative(a, b);
+        let eta = 0.5 * (b - a);
+        Taylor {
+            x0: v.c,
+            x1: d.c,
+            r: v.e + eta * d.r,
+            delta: v.r.min(v.e + eta * (d.c.norm() + d.r)),
+        }
+    }
+}
+
+impl ControllerEnclosure {
+    /// `(K₀, K₁ = dK/dω at ω₀, r, Δ)` on `[a, b]`: `K(jω) − K₀ − tK₁ = C·R₀(jtR₀)²(I + jtR₀)⁻¹·B`
+    /// (`R₀ = (jω₀ − A)⁻¹`), so `r ≤ ‖C‖‖B‖‖R₀‖³η²/(1 − η‖R₀‖)`.
+    pub(crate) fn taylor(
+        &self,
+        a: f64,
+        b: f64,
+    ) -> Option<(DMatrix<Complex64>, DMatrix<Complex64>, f64, f64)> {
+        let iv = Interval::Finite(a, b);
+        let (k0, delta, round) = self.enclose(&iv)?;
+        let n = self.a.nrows();
+        if n == 0 {
+            let z = DMatrix::zeros(k0.nrows(), k0.ncols());
+            return Some((k0, z, 0.0, 0.0));
+        }
+        let w0 = iv.omega0();
+        let eta = 0.5 * (b - a);
+        let shifted = DMatrix::<Complex64>::identity(n, n) * Complex64::new(0.0, w0) - &self.a;
+        let r0 = shifted.lu().solve(&DMatrix::identity(n, n))?;
+        let r0n = r0.norm();
+        if eta * r0n >= 0.5 {
+            return None;
+        }
+        let k1 = -(&self.c * &r0 * &r0 * &self.b) * Complex64::new(0.0, 1.0);
+        let r = self.c_norm * self.b_norm * r0n.powi(3) * eta * eta / (1.0 - eta * r0n)
+            + round * (1.0 + 2.0 * eta * r0n);
+        Some((k0, k1, r, delta))
     }
 }

@@ -31,6 +31,7 @@ pub(crate) mod certified_norm;
 pub(crate) mod enclosure;
 pub(crate) mod factor_loop;
 pub(crate) mod loop_poles;
+pub(crate) mod second_order;
 pub(crate) mod theorem1;
 
 pub use certified_norm::{certified_gang_norm, certified_t_norm, MAX_INTERVAL_TESTS};

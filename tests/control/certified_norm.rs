@@ -33,8 +33,17 @@ fn agree(what: &str, cert: &HinfNorm, dense: &HinfNorm) {
         cert.gamma,
         dense.gamma
     );
-    assert!(cert.upper >= dense.gamma, "{what}: upper {} below {}", cert.upper, dense.gamma);
-    assert!(dense.upper >= cert.gamma, "{what}: {} above the Hamiltonian's bound", cert.gamma);
+    assert!(
+        cert.upper >= dense.gamma,
+        "{what}: upper {} below {}",
+        cert.upper,
+        dense.gamma
+    );
+    assert!(
+        dense.upper >= cert.gamma,
+        "{what}: {} above the Hamiltonian's bound",
+        cert.gamma
+    );
     assert!(cert.upper <= cert.gamma * (1.0 + 3e-9), "{what}: {cert:?}");
 }
 
@@ -77,7 +86,10 @@ fn lightly_damped_modes() {
         ms[13].zeta = 3.0 * zeta;
         let w = check(&format!("zeta {zeta}"), &ms, "1e-3");
         // The peak is the least damped mode's.
-        assert!((w - ms[7].omega).abs() <= 10.0 * zeta * ms[7].omega, "peak at {w}");
+        assert!(
+            (w - ms[7].omega).abs() <= 10.0 * zeta * ms[7].omega,
+            "peak at {w}"
+        );
     }
 }
 
