@@ -27,7 +27,7 @@ const U: f64 = f64::EPSILON / 2.0;
 pub(super) fn t_below(p: &Prepared, a: f64, b: f64, gamma: f64) -> bool {
     let (n, m) = (p.f.states(), p.f.inputs());
     let eta = 0.5 * (b - a);
-    if !(eta > 0.0) {
+    if eta.is_nan() || eta <= 0.0 {
         return false;
     }
     let d: Vec<Taylor> = p.d.iter().map(|h| h.taylor(a, b)).collect();
@@ -248,7 +248,7 @@ pub(super) fn gang_below(p: &Prepared, a: f64, b: f64, gamma: f64) -> bool {
     let (n, m) = (p.f.states(), p.f.inputs());
     let pp = p.c.nrows();
     let eta = 0.5 * (b - a);
-    if !(eta > 0.0) {
+    if eta.is_nan() || eta <= 0.0 {
         return false;
     }
     let y: Vec<Taylor> = yr.iter().map(|h| h.taylor(a, b)).collect();
