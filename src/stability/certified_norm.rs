@@ -41,6 +41,10 @@ const U: f64 = f64::EPSILON / 2.0;
 /// the 1000-mode bench model needs about 19 000 per norm (about 1 ms each there).
 pub const MAX_INTERVAL_TESTS: usize = 100_000;
 
+/// The controller's resolvent is a dense solve per interval: a larger controller (a
+/// synthesized one, hundreds of states) keeps the Hamiltonian route.
+pub const MAX_CONTROLLER_STATES: usize = 16;
+
 /// Entries of `Λ` with `|Λᵢ| < SMALL_LAMBDA·(γ²|Dᵢ|² + 1)` are kept in the small block.
 pub(super) const SMALL_LAMBDA: f64 = 1e-2;
 /// At most this many such entries (else the interval is split).
@@ -94,7 +98,7 @@ struct At {
 
 impl<'a> Prepared<'a> {
     fn new(f: &'a Factorization, k: &StateSpace) -> Option<Self> {
-        if f.realization.is_some() || !f.m.is_diagonal() {
+        if f.realization.is_some() || !f.m.is_diagonal() || k.states() > MAX_CONTROLLER_STATES {
             return None;
         }
         let (n, m) = (f.states(), f.inputs());
@@ -144,6 +148,12 @@ impl<'a> Prepared<'a> {
             ek,
         })
     }
+}
+
+/// Whether the sweep applies to `k` on `f` (a diagonal `M̃` typed as transfer functions,
+/// proper entries, a controller of at most [`MAX_CONTROLLER_STATES`] states).
+pub fn sweep_applies(f: &Factorization, k: &StateSpace) -> bool {
+    Prepared::new(f, k).is_some()
 }
 
 /// `‖T‖∞` of the Theorem 1 system of `k` on `f` by the certified sweep; `breaks` split the

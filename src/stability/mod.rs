@@ -34,7 +34,9 @@ pub(crate) mod loop_poles;
 pub(crate) mod second_order;
 pub(crate) mod theorem1;
 
-pub use certified_norm::{certified_gang_norm, certified_t_norm, MAX_INTERVAL_TESTS};
+pub use certified_norm::{
+    certified_gang_norm, certified_t_norm, sweep_applies, MAX_CONTROLLER_STATES, MAX_INTERVAL_TESTS,
+};
 pub use factor_loop::{
     gang_of_four, gang_sigma_max, modal_cascade, modal_system, plant_system, t_sigma_max,
     theorem1_system, CASCADE_ROWS_FROM,

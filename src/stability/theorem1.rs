@@ -3,7 +3,7 @@
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
-use super::certified_norm::{certified_gang_norm, certified_t_norm};
+use super::certified_norm::{certified_gang_norm, certified_t_norm, sweep_applies};
 use super::factor_loop::{
     gang_of_four, gang_sigma_max, t_sigma_max, theorem1_norm_system, theorem1_system,
 };
@@ -274,7 +274,10 @@ pub fn analyze_gridded(
     };
     // A large loop: the certified sweep over the factor values first (no Hamiltonian of
     // twice the loop's states); the Hamiltonian iteration if it cannot close.
-    let breaks = peaks.as_ref().map(|_| sweep_breaks(grid, &poles));
+    let breaks = peaks
+        .as_ref()
+        .filter(|_| sweep_applies(f, &k))
+        .map(|_| sweep_breaks(grid, &poles));
     type Run<'r> = &'r dyn Fn(&[f64], &[f64]) -> Option<HinfNorm>;
     let swept = |what: &str, run: Run, starts: &[f64]| {
         let breaks = breaks.as_deref()?;
