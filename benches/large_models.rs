@@ -21,6 +21,10 @@
 //! * `certified_norms` (100, 1000 modes): `‖T‖∞` and `1/b(G,K)` by the certified frequency
 //!   sweep on the factor values (sixth session; `stability::certified_t_norm`).
 //!
+//! Sixth session (`cargo bench --bench large_models -- certified_norms --sample-count 1`,
+//! load 2.3–4.5): `certified_norms` 100 / 1000 modes 1.16 s / 24.2 s (both norms; the
+//! Hamiltonian route at 1000 modes: 4000 × 4000 eigenproblems, more than 20 min of CPU).
+//!
 //! Fourth session (`cargo bench --bench large_models -- loop_realization diagnose_root_retune
 //! --sample-count 1`, load 6–8): `loop_realization` 200 / 1000 modes 63 ms / 2.6 s (the
 //! whole-matrix staircase: > 600 s at 1000); `diagnose_root_retune` 4.6 s / 0.12 s (1000
