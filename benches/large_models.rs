@@ -18,6 +18,12 @@
 //! * `loop_poles_structured` (100, 1000 modes): `closed_loop_poles` from the loop's structure
 //!   (`stability::loop_poles`: the loop of the cancelled rows, 2 states per mode, and the
 //!   roots of each mode's factor denominator; fifth session).
+//! * `certified_norms` (100, 1000 modes): `‖T‖∞` and `1/b(G,K)` by the certified frequency
+//!   sweep on the factor values (sixth session; `stability::certified_t_norm`).
+//!
+//! Sixth session (`cargo bench --bench large_models -- certified_norms --sample-count 1`,
+//! load 2.3–4.5): `certified_norms` 100 / 1000 modes 1.16 s / 24.2 s (both norms; the
+//! Hamiltonian route at 1000 modes: 4000 × 4000 eigenproblems, more than 20 min of CPU).
 //!
 //! Fourth session (`cargo bench --bench large_models -- loop_realization diagnose_root_retune
 //! --sample-count 1`, load 6–8): `loop_realization` 200 / 1000 modes 63 ms / 2.6 s (the
@@ -180,5 +186,28 @@ fn loop_poles_structured(bencher: Bencher, k: usize) {
     let (config, controller, _dir) = inputs(k);
     bencher.bench(|| {
         rshape::stability::closed_loop_poles(&config.factorization, &controller).expect("poles")
+    });
+}
+
+/// Sizes of the certified norms (sixth session): `‖T‖∞` and `1/b(G,K)` by the certified
+/// frequency sweep on the factor values (`stability::certified_t_norm`,
+/// `certified_gang_norm`), started from a 1000-point grid, instead of Hamiltonians of
+/// twice the loop's states (1000 modes: 4000 × 4000, tens of minutes of CPU).
+const SWEEP_SIZES: &[usize] = &[100, 1000];
+
+#[divan::bench(args = SWEEP_SIZES, sample_count = 1)]
+fn certified_norms(bencher: Bencher, k: usize) {
+    if k > SWEEP_SIZES[0] && !benching() {
+        bencher.bench(|| ());
+        return;
+    }
+    let (config, controller, _dir) = inputs(k);
+    let f = &config.factorization;
+    let kk = controller.negative_feedback_gain();
+    let grid = rshape::system::logspace(1.0, 1e5, 1000);
+    bencher.bench(|| {
+        let t = rshape::stability::certified_t_norm(f, &kk, &grid, &grid).expect("||T||");
+        let g = rshape::stability::certified_gang_norm(f, &kk, &grid, &grid).expect("gang");
+        (t, g)
     });
 }

@@ -72,8 +72,9 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         fit_text = text;
         rs.push(("fitted".into(), r));
     }
-    // A large model's loop is a dense eigenvalue problem of O(n³) (and the H∞ iteration a
-    // few of twice its size), silent while it runs: say what is going on.
+    // A large model's loop is an eigenvalue problem of O(n³) (and the exact norms a
+    // certified sweep or Hamiltonians of twice its size), silent while it runs: say what is
+    // going on.
     let f = &config.factorization;
     let states = f
         .realization
@@ -82,7 +83,7 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     let view = (states >= a.progress_from_states).then(|| {
         let v = super::progress::FitProgressView::new("stability");
         v.stage(&format!(
-            "the loop of a model with about {states} states: closed-loop poles, then the exact H∞ norms (dense, O(n³))"
+            "the loop of a model with about {states} states: closed-loop poles, the grid, then the exact H∞ norms"
         ));
         v
     });

@@ -27,10 +27,16 @@
 //! [`modal_cascade`] below [`CASCADE_ROWS_FROM`]), the grid value [`t_sigma_max`] and the
 //! closed-loop poles [`loop_poles`] (for a large diagonal `M̃` from the structure: the loop of
 //! the cancelled rows and the factors' denominators).
+pub(crate) mod certified_norm;
+pub(crate) mod enclosure;
 pub(crate) mod factor_loop;
 pub(crate) mod loop_poles;
+pub(crate) mod second_order;
 pub(crate) mod theorem1;
 
+pub use certified_norm::{
+    certified_gang_norm, certified_t_norm, sweep_applies, MAX_CONTROLLER_STATES, MAX_INTERVAL_TESTS,
+};
 pub use factor_loop::{
     gang_of_four, gang_sigma_max, modal_cascade, modal_system, plant_system, t_sigma_max,
     theorem1_system, CASCADE_ROWS_FROM,

@@ -3,6 +3,7 @@
 //! Theorem numbers are those of Boulet & Francis 1998 (BF98 in docs/references.md);
 //! Theorem 1 there is the robust stability theorem (Vidyasagar).
 
+use super::certified_norm::{certified_gang_norm, certified_t_norm, sweep_applies};
 use super::factor_loop::{
     gang_of_four, gang_sigma_max, t_sigma_max, theorem1_norm_system, theorem1_system,
 };
@@ -271,55 +272,104 @@ pub fn analyze_gridded(
         c.sort_by(|a, b| b.1.total_cmp(&a.1));
         c.iter().take(4).map(|(w, _)| *w).collect()
     };
-    stage(&format!(
-        "||T||_inf, exact (Hamiltonian iteration, {} x {} eigenproblems)",
-        2 * nt,
-        2 * nt
-    ));
-    let t_norm = if peaks.is_some() {
-        let sig = |w: f64| t_sigma_max(f, &kev, w);
-        match &t_poles {
-            Some(p) => hinf_norm_near_with_poles(&t, &near(&|_| 1.0), Some(&sig), p)?,
-            None => hinf_norm_near(&t, &near(&|_| 1.0), Some(&sig))?,
+    // A large loop: the certified sweep over the factor values first (no Hamiltonian of
+    // twice the loop's states); the Hamiltonian iteration if it cannot close.
+    let breaks = peaks
+        .as_ref()
+        .filter(|_| sweep_applies(f, &k))
+        .map(|_| sweep_breaks(grid, &poles));
+    type Run<'r> = &'r dyn Fn(&[f64], &[f64]) -> Option<HinfNorm>;
+    let swept = |what: &str, run: Run, starts: &[f64]| {
+        let breaks = breaks.as_deref()?;
+        stage(&format!(
+            "{what}, exact (certified frequency sweep on the factors, {} modal coordinates)",
+            f.states()
+        ));
+        let done = run(breaks, starts);
+        if done.is_none() {
+            stage(&format!(
+                "{what}: the sweep did not close; Hamiltonian iteration instead"
+            ));
         }
-    } else {
-        hinf_norm(&t)?
+        done
     };
-    let g4 = gang_of_four(f, &k)?;
-    let n4 = g4.states();
-    stage(&format!(
-        "b(G,K), exact (Hamiltonian iteration, {} x {} eigenproblems)",
-        2 * n4,
-        2 * n4
-    ));
+    let t_swept = swept(
+        "||T||_inf",
+        &|b, s| certified_t_norm(f, &k, b, s),
+        &near(&|_| 1.0),
+    );
+    let t_norm = match t_swept {
+        Some(h) => h,
+        None => {
+            stage(&format!(
+                "||T||_inf, exact (Hamiltonian iteration, {} x {} eigenproblems)",
+                2 * nt,
+                2 * nt
+            ));
+            if peaks.is_some() {
+                let sig = |w: f64| t_sigma_max(f, &kev, w);
+                match &t_poles {
+                    Some(p) => hinf_norm_near_with_poles(&t, &near(&|_| 1.0), Some(&sig), p)?,
+                    None => hinf_norm_near(&t, &near(&|_| 1.0), Some(&sig))?,
+                }
+            } else {
+                hinf_norm(&t)?
+            }
+        }
+    };
     // A large loop: the iteration started from the peaks of the gang's own value on the
     // grid and at the lightly damped poles (cheap from the factor values) instead of one
     // dense response per pole of the plant-and-controller loop (a synthesized controller
     // doubles it); the Hamiltonian proves the bound either way.
+    let gang_starts = || -> Vec<f64> {
+        let sig = |w: f64| gang_sigma_max(f, &kev, w);
+        let mut c: Vec<(f64, f64)> = grid
+            .iter()
+            .copied()
+            .chain(
+                poles
+                    .iter()
+                    .filter(|z| z.im > 0.0 && z.re.abs() < 0.5 * z.norm())
+                    .map(|z| z.im),
+            )
+            .filter_map(|w| sig(w).map(|s| (w, s)))
+            .collect();
+        c.sort_by(|a, b| b.1.total_cmp(&a.1));
+        c.iter().take(4).map(|(w, _)| *w).collect()
+    };
+    let g_swept = if peaks.is_some() {
+        swept(
+            "b(G,K)",
+            &|b, s| certified_gang_norm(f, &k, b, s),
+            &gang_starts(),
+        )
+    } else {
+        None
+    };
     let b_gk = 1.0
-        / if peaks.is_some() {
-            let sig = |w: f64| gang_sigma_max(f, &kev, w);
-            let mut c: Vec<(f64, f64)> = grid
-                .iter()
-                .copied()
-                .chain(
-                    poles
-                        .iter()
-                        .filter(|z| z.im > 0.0 && z.re.abs() < 0.5 * z.norm())
-                        .map(|z| z.im),
-                )
-                .filter_map(|w| sig(w).map(|s| (w, s)))
-                .collect();
-            c.sort_by(|a, b| b.1.total_cmp(&a.1));
-            let starts: Vec<f64> = c.iter().take(4).map(|(w, _)| *w).collect();
-            // The gang's loop is the plant's rows closed by K, the matrix of the norm
-            // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
-            match t_poles.as_ref().filter(|_| same_matrix(&g4.a, &t.a)) {
-                Some(p) => hinf_norm_near_with_poles(&g4, &starts, Some(&sig), p)?,
-                None => hinf_norm_near(&g4, &starts, Some(&sig))?,
+        / match g_swept {
+            Some(h) => h,
+            None => {
+                let g4 = gang_of_four(f, &k)?;
+                let n4 = g4.states();
+                stage(&format!(
+                    "b(G,K), exact (Hamiltonian iteration, {} x {} eigenproblems)",
+                    2 * n4,
+                    2 * n4
+                ));
+                if peaks.is_some() {
+                    let sig = |w: f64| gang_sigma_max(f, &kev, w);
+                    let starts = gang_starts();
+                    // The gang's loop is the plant's rows closed by K, the matrix of the norm
+                    // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
+                    match t_poles.as_ref().filter(|_| same_matrix(&g4.a, &t.a)) {
+                        Some(p) => hinf_norm_near_with_poles(&g4, &starts, Some(&sig), p)?,
+                        None => hinf_norm_near(&g4, &starts, Some(&sig))?,
+                    }
+                } else {
+                    hinf_norm(&g4)?
+                }
             }
-        } else {
-            hinf_norm(&g4)?
         }
         .gamma;
     let mut margins = Vec::new();
@@ -384,6 +434,20 @@ pub fn analyze_gridded(
         },
         curve,
     ))
+}
+
+/// The cuts that start the certified sweep: the grid and, for every lightly damped
+/// closed-loop pole `λ`, `Im λ` and `Im λ ± 2|Re λ|` (the resonance's half-power band).
+fn sweep_breaks(grid: &[f64], poles: &[Complex64]) -> Vec<f64> {
+    let mut b = grid.to_vec();
+    for z in poles
+        .iter()
+        .filter(|z| z.im > 0.0 && z.re.abs() < 0.5 * z.norm())
+    {
+        b.extend([z.im - 2.0 * z.re.abs(), z.im, z.im + 2.0 * z.re.abs()]);
+    }
+    b.retain(|w| w.is_finite() && *w > 0.0);
+    b
 }
 
 /// Whether two state matrices are the same to rounding (`‖A − B‖_max ≤ 1e-13·‖A‖_max`).

@@ -114,3 +114,42 @@ fn stability_and_synthesize_print_their_stage_lines_on_stderr() {
         stderr(&quiet)
     );
 }
+
+/// A 60-mode loop (240 loop states, above the 200 of the structured routes): `stability`'s
+/// stage lines name the structured closed-loop poles and the certified frequency sweep of
+/// both exact norms (issue 34 item 9, sixth session), in order, and the verdict is printed.
+#[test]
+fn stability_names_the_structured_poles_and_the_certified_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = modes::write(dir.path(), 60, 30);
+    let cfg = cfg.to_str().unwrap();
+    let kp = dir.path().join("k.toml");
+    std::fs::write(&kp, "[controller]\ntf = [[1e-3]]\n").unwrap();
+    let k = kp.to_str().unwrap();
+    let o = rshape(&[
+        "stability",
+        cfg,
+        "--controller",
+        k,
+        "--progress-from-states",
+        "0",
+    ]);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{}", stderr(&o));
+    let lines = stage_lines(&stderr(&o), "stability");
+    let at = positions(
+        &lines,
+        &[
+            "stability: the loop of a model with about 120 states",
+            "stability: closed-loop poles (240 states: the eigenvalues of the 120 x 120 loop of the cancelled rows, and 120 hidden modes",
+            "stability: the grid curve sigma_max(T(jw))",
+            "stability: ||T||_inf, exact (certified frequency sweep on the factors, 60 modal coordinates)",
+            "stability: b(G,K), exact (certified frequency sweep on the factors, 60 modal coordinates)",
+        ],
+    );
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "{lines:#?}");
+    assert!(
+        !lines.iter().any(|l| l.contains("Hamiltonian")),
+        "{lines:#?}"
+    );
+    assert!(stdout(&o).contains("internally stable"), "{}", stdout(&o));
+}

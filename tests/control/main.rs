@@ -11,6 +11,7 @@ mod common;
 #[allow(dead_code)]
 mod modes;
 
+mod certified_norm;
 mod closed_loop_stability_large;
 mod hinf_large_modal;
 mod hinf_near_d;
