@@ -28,6 +28,7 @@
 
 use super::enclosure::{ControllerEnclosure, Disk, Interval, Rational};
 use super::factor_loop::t_sigma_max;
+use super::gang_sweep::GangSweep;
 use crate::model::Factorization;
 use crate::system::freq_eval::FreqEvaluator;
 use crate::system::{HinfNorm, StateSpace, HINF_RTOL};
@@ -35,7 +36,7 @@ use nalgebra::DMatrix;
 use num_complex::Complex64;
 
 /// Unit roundoff.
-const U: f64 = f64::EPSILON / 2.0;
+pub(super) const U: f64 = f64::EPSILON / 2.0;
 
 /// Interval tests before the sweep gives up (the caller then takes the Hamiltonian route):
 /// the 1000-mode bench model needs about 19 000 per norm (about 1 ms each there).
@@ -78,7 +79,7 @@ pub(super) struct Prepared<'a> {
     pub(super) j: Vec<Rational>,
     /// `C` (`p × n`) and an upper bound of its spectral norm.
     pub(super) c: DMatrix<Complex64>,
-    c_abs: DMatrix<f64>,
+    pub(super) c_abs: DMatrix<f64>,
     pub(super) c_norm: f64,
     pub(super) k: ControllerEnclosure,
     kev: FreqEvaluator,
@@ -87,13 +88,13 @@ pub(super) struct Prepared<'a> {
 }
 
 /// The enclosures on one interval.
-struct At {
-    d: Vec<Disk>,
-    u: Vec<Disk>,
-    j: Vec<Disk>,
-    k0: DMatrix<Complex64>,
-    rk: f64,
-    ek: f64,
+pub(super) struct At {
+    pub(super) d: Vec<Disk>,
+    pub(super) u: Vec<Disk>,
+    pub(super) j: Vec<Disk>,
+    pub(super) k0: DMatrix<Complex64>,
+    pub(super) rk: f64,
+    pub(super) ek: f64,
 }
 
 impl<'a> Prepared<'a> {
@@ -137,7 +138,7 @@ impl<'a> Prepared<'a> {
         })
     }
 
-    fn at(&self, iv: &Interval) -> Option<At> {
+    pub(super) fn at(&self, iv: &Interval) -> Option<At> {
         let (k0, rk, ek) = self.k.enclose(iv)?;
         Some(At {
             d: self.d.iter().map(|h| h.enclose(iv)).collect(),
@@ -363,105 +364,6 @@ fn positive_definite(ctx: &PdContext, gamma: f64) -> Option<bool> {
         return Some(false);
     }
     (neg + pos == size && neg_r + neg == m).then_some(true)
-}
-
-struct GangSweep<'a>(Prepared<'a>);
-
-impl GangSweep<'_> {
-    /// `(Γ(jω₀)` from the centre values, `G₀`, their bounds`)`.
-    fn centre(&self, at: &At) -> Option<(DMatrix<Complex64>, f64, f64, f64)> {
-        let p = &self.0;
-        let (n, m) = (p.f.states(), p.f.inputs());
-        let pp = p.c.nrows();
-        // Y = D⁻¹U (disks), G = C·Y·J.
-        let mut y = DMatrix::<Complex64>::zeros(n, m);
-        let mut ry = DMatrix::<f64>::zeros(n, m);
-        for i in 0..n {
-            let di = at.d[i];
-            let dn = di.c.norm();
-            for l in 0..m {
-                let ui = at.u[i * m + l];
-                let c = ui.c / di.c;
-                let r = if dn > di.r {
-                    (ui.r + c.norm() * di.r) / (dn - di.r) + 4.0 * U * c.norm()
-                } else {
-                    f64::INFINITY
-                };
-                y[(i, l)] = c;
-                ry[(i, l)] = r;
-            }
-        }
-        let mut g0 = &p.c * &y;
-        let cy_abs = &p.c_abs * y.map(|z| z.norm());
-        let c_ry = &p.c_abs * &ry;
-        let mut rg2 = 0.0;
-        for l in 0..m {
-            let jl = at.j[l];
-            for k in 0..pp {
-                let r = (jl.c.norm() + jl.r) * c_ry[(k, l)]
-                    + jl.r * g0[(k, l)].norm()
-                    + (n as f64 + 4.0) * U * cy_abs[(k, l)] * (jl.c.norm() + jl.r);
-                rg2 += r * r;
-                g0[(k, l)] *= jl.c;
-            }
-        }
-        let d_g = rg2.sqrt();
-        let s_lhs = DMatrix::<Complex64>::identity(pp, pp) + &g0 * &at.k0;
-        let s = s_lhs.clone().lu().solve(&DMatrix::identity(pp, pp))?;
-        let mut left = DMatrix::<Complex64>::zeros(m + pp, pp);
-        left.view_mut((0, 0), (m, pp)).copy_from(&(-(&at.k0 * &s)));
-        left.view_mut((m, 0), (pp, pp)).copy_from(&s);
-        let mut right = DMatrix::<Complex64>::zeros(pp, pp + m);
-        right
-            .view_mut((0, 0), (pp, pp))
-            .copy_from(&DMatrix::identity(pp, pp));
-        right.view_mut((0, pp), (pp, m)).copy_from(&g0);
-        let gamma = left * right;
-        let kappa = s_lhs.norm() * s.norm();
-        Some((gamma, d_g, g0.norm(), kappa))
-    }
-}
-
-impl Sweep for GangSweep<'_> {
-    fn value(&self, omega: f64) -> Option<f64> {
-        let iv = Interval::Finite(omega, omega);
-        let at = self.0.at(&iv)?;
-        let (g, ..) = self.centre(&at)?;
-        let v = crate::system::spectral_norm(&g);
-        v.is_finite().then_some(v)
-    }
-
-    fn test(&self, iv: &Interval, level: f64) -> Test {
-        let Some(at) = self.0.at(iv) else {
-            return Test::Unknown;
-        };
-        let Some((g, d_g, g0n, kappa)) = self.centre(&at) else {
-            return Test::Unknown;
-        };
-        let sigma = crate::system::spectral_norm(&g);
-        if !sigma.is_finite() {
-            return Test::Unknown;
-        }
-        let dims = (g.nrows() + g.ncols()) as f64;
-        let sigma_up = sigma * (1.0 + 64.0 * dims * U * (1.0 + kappa)) + 64.0 * U * at.ek;
-        let sigma_lo = sigma * (1.0 - 64.0 * dims * U * (1.0 + kappa));
-        let k0n = at.k0.norm();
-        let d_m = d_g * (k0n + at.rk) + g0n * at.rk;
-        let den = 1.0 - at.rk - sigma_up * d_m;
-        if den > 0.5 && sigma_up * (1.0 + d_g) / den < level {
-            return Test::Below;
-        }
-        if let Interval::Finite(a, b) = *iv {
-            if super::second_order::gang_below(&self.0, a, b, level) {
-                return Test::Below;
-            }
-        }
-        if sigma_lo > level {
-            Test::Above
-        } else {
-            Test::Unknown
-        }
-    }
 }
 
 /// The branch and bound of the module docs.

@@ -30,6 +30,7 @@
 pub(crate) mod certified_norm;
 pub(crate) mod enclosure;
 pub(crate) mod factor_loop;
+pub(crate) mod gang_sweep;
 pub(crate) mod loop_poles;
 pub(crate) mod second_order;
 pub(crate) mod theorem1;
