@@ -14,7 +14,10 @@
 //!   `[Λ  W; Wᴴ  −Z⁻¹]` (eliminating the well-conditioned part `Λ_R` of `Λ` and keeping the
 //!   few entries near zero, `Λ_S`, in the small block), `n₋(P) = n₋(Λ_R) + n₋(Q) − m` with
 //!   `Q = [Λ_S  W_S; W_Sᴴ  −Z⁻¹ − W_RᴴΛ_R⁻¹W_R]` of size `|S| + 2m`; each eigenvalue of `Q` is
-//!   counted only when it clears a rounding bound, else the interval is split.
+//!   counted only when it clears a norm-wise rounding bound, or else when the entry-wise
+//!   bound of the same rounding, weighted by `Q`'s eigenvectors, decides the inertia
+//!   ([`weighted_inertia`](super::weighted_inertia): next to a resonance damped 1e-4 the
+//!   deciding eigenvalue is 1e-15, the norm-wise bound 1e-11); else the interval is split.
 //! * The gang of four `Γ = [−K; I]·S·[I  G]`, `S = (I + GK)⁻¹`, `G = C·D⁻¹·U·J` (`p × m`): its
 //!   value at `ω₀` is a small dense matrix, and with the same splitting
 //!   `sup_I ‖Γ‖ ≤ σ₀(1 + ΔG)/(1 − ΔK − σ₀·ΔM)`, `ΔM` the bound of `‖(G − G₀)K + G₀(K − K₀)‖`.
@@ -210,8 +213,14 @@ impl Sweep for TSweep<'_> {
         let v0n = v0.norm();
         let u0n = at.u.iter().map(|x| x.c.norm_sqr()).sum::<f64>().sqrt();
         let d_m = d_d + d_u * (v0n + d_v) + u0n * d_v;
+        let second = || match *iv {
+            Interval::Finite(a, b) => super::second_order::t_below(p, a, b, level),
+            Interval::Ray(_) => false,
+        };
         if !(d_v < 0.5 && level * d_m < 0.5) {
-            return Test::Unknown;
+            // Too wide for the first order (next to a light resonance): the second order
+            // may still prove the interval below.
+            return if second() { Test::Below } else { Test::Unknown };
         }
         let gamma0 = level * (1.0 - d_v) / (1.0 + level * d_m) * (1.0 - 8.0 * U);
         let rho_v = (at.ek / k0n.max(f64::MIN_POSITIVE)).min(1.0)
@@ -230,10 +239,8 @@ impl Sweep for TSweep<'_> {
         if positive_definite(&ctx, gamma0) == Some(true) {
             return Test::Below;
         }
-        if let Interval::Finite(a, b) = *iv {
-            if super::second_order::t_below(p, a, b, level) {
-                return Test::Below;
-            }
+        if second() {
+            return Test::Below;
         }
         match positive_definite(&ctx, level) {
             Some(false) => Test::Above,
@@ -264,6 +271,12 @@ fn positive_definite(ctx: &PdContext, gamma: f64) -> Option<bool> {
     let mut err = 0.0;
     let mut row = vec![Complex64::new(0.0, 0.0); w_cols];
     let mut rows_s: Vec<(f64, Vec<Complex64>)> = Vec::new();
+    // The entry-wise error bounds of the same terms, for `weighted_inertia`: of the small
+    // rows (diagonal, row) and of the `2m` block.
+    let mut f_s: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut f_w = DMatrix::<f64>::zeros(w_cols, w_cols);
+    let mut eps = vec![0.0; w_cols];
+    let mut wa = vec![0.0; w_cols];
     for i in 0..n {
         let di = at.d[i];
         for (k, x) in row.iter_mut().take(m).enumerate() {
@@ -284,12 +297,21 @@ fn positive_definite(ctx: &PdContext, gamma: f64) -> Option<bool> {
         let lam = g * dn2 - 1.0;
         let ew = ctx.rho_v * v2.sqrt() + u2.sqrt() * di.e + di.c.norm() * eu2.sqrt() + 4.0 * U * wn;
         let el = 2.0 * g * di.c.norm() * di.e + 4.0 * U * (g * dn2 + 1.0);
+        // The row's error split by blocks: `Vᴴ`'s part and `DᴴU`'s (each entry at most its
+        // block's norm; the two together are `ew`).
+        let e_vb = ctx.rho_v * v2.sqrt() + 4.0 * U * wn;
+        let e_ub = u2.sqrt() * di.e + di.c.norm() * eu2.sqrt() + 4.0 * U * wn;
+        for (a, (e, w)) in eps.iter_mut().zip(wa.iter_mut()).enumerate() {
+            *e = if a < m { e_vb } else { e_ub };
+            *w = row[a].norm();
+        }
         if lam.abs() < SMALL_LAMBDA * (g * dn2 + 1.0) {
             if small.len() == MAX_SMALL {
                 return None;
             }
             small.push(i);
             rows_s.push((lam, row.clone()));
+            f_s.push((el, eps.clone()));
             err += el + 2.0 * std::f64::consts::SQRT_2 * ew;
             continue;
         }
@@ -306,6 +328,17 @@ fn positive_definite(ctx: &PdContext, gamma: f64) -> Option<bool> {
             }
         }
         let al = lam.abs();
+        // Entry (a, b) of (w + e)ᴴ(w + e)/(λ + δ) − wᴴw/λ, |δ| ≤ el, and of the summation.
+        let (c1, c2) = (
+            1.0 / (al - el),
+            el / (al * (al - el)) + (n as f64 + w_cols as f64 + 4.0) * U / al,
+        );
+        for a_ in 0..w_cols {
+            for b in 0..w_cols {
+                f_w[(a_, b)] += (wa[a_] * eps[b] + eps[a_] * wa[b] + eps[a_] * eps[b]) * c1
+                    + wa[a_] * wa[b] * c2;
+            }
+        }
         err += (2.0 * wn * ew + ew * ew) / al
             + w2 * el / (al * (al - el))
             + (n as f64 + w_cols as f64 + 4.0) * U * w2 / al;
@@ -363,7 +396,39 @@ fn positive_definite(ctx: &PdContext, gamma: f64) -> Option<bool> {
     if neg_r + neg > m {
         return Some(false);
     }
-    (neg + pos == size && neg_r + neg == m).then_some(true)
+    if neg + pos == size {
+        return (neg_r + neg == m).then_some(true);
+    }
+    // Undecided by the norm-wise bound: the entry-wise one, weighted by the eigenvectors.
+    let mut f = DMatrix::<f64>::zeros(size, size);
+    for (r, (el, e)) in f_s.iter().enumerate() {
+        f[(r, r)] = *el;
+        for (b, eb) in e.iter().enumerate() {
+            f[(r, s + b)] = *eb;
+            f[(s + b, r)] = *eb;
+        }
+    }
+    for k in 0..m {
+        for l in 0..m {
+            // −Z⁻¹'s entries: A/γ⁴ (A's error e_a, rounding) and −I/γ².
+            f_w[(m + k, m + l)] += e_a / (g * g) + 4.0 * U * a[(k, l)].norm() / (g * g);
+        }
+        f_w[(k, m + k)] += 4.0 * U / g;
+        f_w[(m + k, k)] += 4.0 * U / g;
+    }
+    for a_ in 0..w_cols {
+        for b in 0..w_cols {
+            // The assembly −Z⁻¹ − Σ: one more rounding of each term.
+            let z = (q[(s + a_, s + b)] + sum_r[(a_, b)]).norm();
+            f[(s + a_, s + b)] = f_w[(a_, b)] + 4.0 * U * (z + sum_r[(a_, b)].norm());
+        }
+    }
+    let (neg, _) = super::weighted_inertia::weighted_inertia(&q, &f)?;
+    match (neg_r + neg).cmp(&m) {
+        std::cmp::Ordering::Greater => Some(false),
+        std::cmp::Ordering::Equal => Some(true),
+        std::cmp::Ordering::Less => None,
+    }
 }
 
 /// The branch and bound of the module docs.

@@ -34,6 +34,7 @@ pub(crate) mod gang_sweep;
 pub(crate) mod loop_poles;
 pub(crate) mod second_order;
 pub(crate) mod theorem1;
+pub(crate) mod weighted_inertia;
 
 pub use certified_norm::{
     certified_gang_norm, certified_t_norm, sweep_applies, MAX_CONTROLLER_STATES, MAX_INTERVAL_TESTS,

@@ -5,10 +5,15 @@
 //!
 //! With every entry as a first-order Taylor model on `[ω₀ − η, ω₀ + η]`
 //! (`x = x₀ + t·x₁ + R`, [`Taylor`]), `P(ω) = γ²MᴴM − I − VᴴV` (`M = D + UV`) is
-//! `P₀ + t·P₁ + E` with `‖E‖ ≤ ρ` (the product rule of Taylor models, the diagonal `DᴴD`
-//! entry by entry). `t ↦ P₀ + tP₁ − ρI` is affine, and the positive definite matrices are a
-//! convex cone: it is positive definite on `[−η, η]` iff it is at both ends. So two exact
-//! tests at `t = ±η` prove `σ_max(T(jω)) < γ` on the interval.
+//! `P₀ + t·P₁ + E_D + E` with `‖E‖ ≤ ρ` (the product rule of Taylor models) and `E_D` the
+//! error of the diagonal `γ²DᴴD`, real and bounded entry by entry, `|E_D,ᵢᵢ| ≤ ρᵢ`: so
+//! `P(ω) ⪰ P₀ + tP₁ − diag(ρᵢ) − ρI`. (One bound `maxᵢ ρᵢ` for all would let the rounding of
+//! a well damped mode's `|Dᵢ|² ≈ 1`, times `γ²`, swamp the row of a light resonance where
+//! `|Dᵢ| ≈ 1/γ`.) `t ↦ P₀ + tP₁ − diag(ρᵢ) − ρI` is affine, and the positive definite
+//! matrices are a convex cone: it is positive definite on `[−η, η]` iff it is at both ends.
+//! So two exact tests at `t = ±η` prove `σ_max(T(jω)) < γ` on the interval; the inertia of
+//! their small block is decided norm-wise, else entry-wise weighted by its eigenvectors
+//! ([`weighted_inertia`](super::weighted_inertia)).
 //!
 //! `P₀ + tP₁ = Λ_t + L·Z·Lᴴ` with `Λ_t = γ²(|D₀|² + 2t·Re(D̄₀D₁)) − 1` diagonal,
 //! `L = [V₀ᴴ  t·V₁ᴴ  D₀ᴴU₀  t(D₀ᴴU₁ + D₁ᴴU₀)]` and the `4m × 4m` Hermitian
@@ -66,18 +71,19 @@ pub(super) fn t_below(p: &Prepared, a: f64, b: f64, gamma: f64) -> bool {
     let uv0 = u0n * v0n;
     let r_uv = r_u * v0n + u0n * r_v + d_u * d_v;
     let d_uv = d_u * v0n + u0n * d_v + d_u * d_v;
-    let rho1 = d
+    // The error of `DᴴD`'s Taylor model is diagonal: kept entry by entry (`E_D`, module docs).
+    let rho_d: Vec<f64> = d
         .iter()
-        .map(|t| 2.0 * t.r * t.x0.norm() + t.delta * t.delta)
-        .fold(0.0, f64::max);
+        .map(|t| g * (2.0 * t.r * t.x0.norm() + t.delta * t.delta) * (1.0 + 64.0 * U))
+        .collect();
     let (d0max, r_d, d_d) = d.iter().fold((0.0f64, 0.0f64, 0.0f64), |acc, t| {
         (acc.0.max(t.x0.norm()), acc.1.max(t.r), acc.2.max(t.delta))
     });
     let rho2 = r_d * uv0 + d0max * r_uv + d_d * d_uv;
     let rho3 = 2.0 * r_uv * uv0 + d_uv * d_uv;
     let rho4 = 2.0 * r_v * v0n + d_v * d_v;
-    let rho = (g * (rho1 + 2.0 * rho2 + rho3) + rho4) * (1.0 + 64.0 * U);
-    if !rho.is_finite() {
+    let rho = (g * (2.0 * rho2 + rho3) + rho4) * (1.0 + 64.0 * U);
+    if !(rho.is_finite() && rho_d.iter().all(|x| x.is_finite())) {
         return false;
     }
     // G₀₀ = U₀ᴴU₀, G₁₀ = U₁ᴴU₀.
@@ -98,6 +104,7 @@ pub(super) fn t_below(p: &Prepared, a: f64, b: f64, gamma: f64) -> bool {
             g,
             t: *t,
             rho,
+            rho_d: &rho_d,
             d: &d,
             u: &u,
             v0: &v0,
@@ -114,6 +121,7 @@ struct EndData<'a> {
     g: f64,
     t: f64,
     rho: f64,
+    rho_d: &'a [f64],
     d: &'a [Taylor],
     u: &'a [Taylor],
     v0: &'a DMatrix<Complex64>,
@@ -154,6 +162,10 @@ fn ends_positive(e: &EndData) -> bool {
     let mut sum_r = DMatrix::<Complex64>::zeros(r, r);
     let mut neg_r = 0usize;
     let mut err = 0.0;
+    // The same rounding bounds entry by entry, for `weighted_inertia`.
+    let mut f_s: Vec<(f64, f64)> = Vec::new();
+    let mut f_w = DMatrix::<f64>::zeros(r, r);
+    let mut wa = vec![0.0; r];
     for i in 0..n {
         let di = e.d[i];
         for k in 0..m {
@@ -165,10 +177,11 @@ fn ends_positive(e: &EndData) -> bool {
             row[2 * m + l] = di.x0.conj() * ui.x0;
             row[3 * m + l] = (di.x0.conj() * ui.x1 + di.x1.conj() * ui.x0) * t;
         }
+        let rho_i = e.rho + e.rho_d[i];
         let quad = di.x0.norm_sqr() + 2.0 * t * (di.x0.conj() * di.x1).re;
         let scale =
-            g * (di.x0.norm_sqr() + 2.0 * (t * di.x0.norm() * di.x1.norm()).abs()) + 1.0 + e.rho;
-        let lam = g * quad - 1.0 - e.rho;
+            g * (di.x0.norm_sqr() + 2.0 * (t * di.x0.norm() * di.x1.norm()).abs()) + 1.0 + rho_i;
+        let lam = g * quad - 1.0 - rho_i;
         let w2: f64 = row.iter().map(|x| x.norm_sqr()).sum();
         if lam.abs() < SMALL_LAMBDA * scale {
             if small.len() == MAX_SMALL {
@@ -176,6 +189,7 @@ fn ends_positive(e: &EndData) -> bool {
             }
             small.push((lam, row.clone()));
             err += 8.0 * U * (scale + 2.0 * w2.sqrt());
+            f_s.push((8.0 * U * scale, 16.0 * U * w2.sqrt()));
             continue;
         }
         if lam < 0.0 {
@@ -187,7 +201,16 @@ fn ends_positive(e: &EndData) -> bool {
                 sum_r[(x, y)] += cx * row[y];
             }
         }
-        err += (n as f64 + r as f64 + 8.0) * 8.0 * U * w2 / lam.abs() * (1.0 + scale / lam.abs());
+        let c = (n as f64 + r as f64 + 8.0) * 8.0 * U / lam.abs() * (1.0 + scale / lam.abs());
+        err += c * w2;
+        for (w, x) in wa.iter_mut().zip(row.iter()) {
+            *w = x.norm();
+        }
+        for x in 0..r {
+            for y in 0..r {
+                f_w[(x, y)] += c * wa[x] * wa[y];
+            }
+        }
     }
     if neg_r > npos {
         return false;
@@ -207,12 +230,33 @@ fn ends_positive(e: &EndData) -> bool {
             q[(s + x, s + y)] = -zinv[(x, y)] - sum_r[(x, y)];
         }
     }
-    err += 64.0 * r as f64 * U * kappa * zinv.norm() + 8.0 * size as f64 * U * q.norm();
+    let e_z = 64.0 * r as f64 * U * kappa * zinv.norm();
+    err += e_z + 8.0 * size as f64 * U * q.norm();
     let bound = 2.0 * err;
     let eig = q.symmetric_eigenvalues();
     let neg = eig.iter().filter(|x| **x < -bound).count();
     let pos = eig.iter().filter(|x| **x > bound).count();
-    neg + pos == size && neg_r + neg == npos
+    if neg + pos == size {
+        return neg_r + neg == npos;
+    }
+    // Undecided by the norm-wise bound (next to a light resonance): the entry-wise one,
+    // weighted by the eigenvectors. Each entry's bound is at most the norm-wise bound of
+    // its term (a row's error at most the row's; `Z⁻¹`'s entries at most `e_z`).
+    let mut f = DMatrix::<f64>::zeros(size, size);
+    for (k, (fd, fr)) in f_s.iter().enumerate() {
+        f[(k, k)] = *fd + 8.0 * U * q[(k, k)].norm();
+        for y in 0..r {
+            f[(k, s + y)] = *fr + 8.0 * U * q[(k, s + y)].norm();
+            f[(s + y, k)] = f[(k, s + y)];
+        }
+    }
+    for x in 0..r {
+        for y in 0..r {
+            f[(s + x, s + y)] =
+                f_w[(x, y)] + e_z + 8.0 * U * (zinv[(x, y)].norm() + sum_r[(x, y)].norm());
+        }
+    }
+    super::weighted_inertia::weighted_inertia(&q, &f).is_some_and(|(neg, _)| neg_r + neg == npos)
 }
 
 /// A matrix Taylor model: `X(ω) = X₀ + tX₁ + R`, `‖R‖ ≤ r`, `‖X(ω) − X₀‖ ≤ delta`
