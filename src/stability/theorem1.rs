@@ -321,7 +321,8 @@ pub fn analyze_gridded(
     // grid and at the lightly damped poles (cheap from the factor values) instead of one
     // dense response per pole of the plant-and-controller loop (a synthesized controller
     // doubles it); the Hamiltonian proves the bound either way.
-    let gang_starts = || -> Vec<f64> {
+    // Evaluated once: the sweep and, if it cannot close, the Hamiltonian start from them.
+    let gang_starts: Vec<f64> = if peaks.is_some() {
         let sig = |w: f64| gang_sigma_max(f, &kev, w);
         let mut c: Vec<(f64, f64)> = grid
             .iter()
@@ -336,12 +337,14 @@ pub fn analyze_gridded(
             .collect();
         c.sort_by(|a, b| b.1.total_cmp(&a.1));
         c.iter().take(4).map(|(w, _)| *w).collect()
+    } else {
+        Vec::new()
     };
     let g_swept = if peaks.is_some() {
         swept(
             "b(G,K)",
             &|b, s| certified_gang_norm(f, &k, b, s),
-            &gang_starts(),
+            &gang_starts,
         )
     } else {
         None
@@ -359,12 +362,11 @@ pub fn analyze_gridded(
                 ));
                 if peaks.is_some() {
                     let sig = |w: f64| gang_sigma_max(f, &kev, w);
-                    let starts = gang_starts();
                     // The gang's loop is the plant's rows closed by K, the matrix of the norm
                     // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
                     match t_poles.as_ref().filter(|_| same_matrix(&g4.a, &t.a)) {
-                        Some(p) => hinf_norm_near_with_poles(&g4, &starts, Some(&sig), p)?,
-                        None => hinf_norm_near(&g4, &starts, Some(&sig))?,
+                        Some(p) => hinf_norm_near_with_poles(&g4, &gang_starts, Some(&sig), p)?,
+                        None => hinf_norm_near(&g4, &gang_starts, Some(&sig))?,
                     }
                 } else {
                     hinf_norm(&g4)?
