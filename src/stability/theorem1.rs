@@ -306,15 +306,15 @@ pub fn analyze_gridded(
                 2 * nt,
                 2 * nt
             ));
-            if peaks.is_some() {
-                let sig = |w: f64| t_sigma_max(f, &kev, w);
-                match &t_poles {
-                    Some(p) => hinf_norm_near_with_poles(&t, &near(&|_| 1.0), Some(&sig), p)?,
-                    None => hinf_norm_near(&t, &near(&|_| 1.0), Some(&sig))?,
-                }
-            } else {
-                hinf_norm(&t)?
-            }
+            let sig = |w: f64| t_sigma_max(f, &kev, w);
+            let starts = near(&|_| 1.0);
+            hamiltonian_norm(
+                &t,
+                peaks
+                    .is_some()
+                    .then_some((&starts[..], &sig as &dyn Fn(f64) -> _)),
+                t_poles.as_deref(),
+            )?
         }
     };
     // A large loop: the iteration started from the peaks of the gang's own value on the
@@ -360,17 +360,16 @@ pub fn analyze_gridded(
                     2 * n4,
                     2 * n4
                 ));
-                if peaks.is_some() {
-                    let sig = |w: f64| gang_sigma_max(f, &kev, w);
-                    // The gang's loop is the plant's rows closed by K, the matrix of the norm
-                    // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
-                    match t_poles.as_ref().filter(|_| same_matrix(&g4.a, &t.a)) {
-                        Some(p) => hinf_norm_near_with_poles(&g4, &gang_starts, Some(&sig), p)?,
-                        None => hinf_norm_near(&g4, &gang_starts, Some(&sig))?,
-                    }
-                } else {
-                    hinf_norm(&g4)?
-                }
+                let sig = |w: f64| gang_sigma_max(f, &kev, w);
+                // The gang's loop is the plant's rows closed by K, the matrix of the norm
+                // system up to rounding (K·(C·X) against (K·C)·X): its poles are known then.
+                hamiltonian_norm(
+                    &g4,
+                    peaks
+                        .is_some()
+                        .then_some((&gang_starts[..], &sig as &dyn Fn(f64) -> _)),
+                    t_poles.as_deref().filter(|_| same_matrix(&g4.a, &t.a)),
+                )?
             }
         }
         .gamma;
@@ -393,12 +392,15 @@ pub fn analyze_gridded(
         } else {
             stage(&format!("||r T||_inf of the {label} r, exact"));
             let rt = t.times_scalar(&StateSpace::from_tf(r));
-            if peaks.is_some() {
-                let sig = |w: f64| t_sigma_max(f, &kev, w).map(|s| s * r.freq(w).norm());
-                hinf_norm_near(&rt, &near(&|w| r.freq(w).norm()), Some(&sig))
-            } else {
-                hinf_norm(&rt)
-            }
+            let sig = |w: f64| t_sigma_max(f, &kev, w).map(|s| s * r.freq(w).norm());
+            let starts = near(&|w| r.freq(w).norm());
+            hamiltonian_norm(
+                &rt,
+                peaks
+                    .is_some()
+                    .then_some((&starts[..], &sig as &dyn Fn(f64) -> _)),
+                None,
+            )
             .map_err(|e| Error::Invalid(format!("the {label} r: {e}")))?
         };
         let alpha = 1.0 / h.gamma;
@@ -436,6 +438,24 @@ pub fn analyze_gridded(
         },
         curve,
     ))
+}
+
+/// A large loop's start of the Hamiltonian iteration: frequencies and the structured `σ_max`.
+type Starts<'a> = (&'a [f64], &'a dyn Fn(f64) -> Option<f64>);
+
+/// `‖G‖∞` by the Hamiltonian iteration (exact, the bound proven whatever the start): on a large
+/// loop started from the caller's frequencies with the structured `σ_max` evaluation, and from
+/// the loop's poles where they are already known; otherwise from the system's own poles and grid.
+fn hamiltonian_norm(
+    ss: &StateSpace,
+    large: Option<Starts>,
+    poles: Option<&[Complex64]>,
+) -> Result<HinfNorm> {
+    match (large, poles) {
+        (Some((starts, sig)), Some(p)) => hinf_norm_near_with_poles(ss, starts, Some(sig), p),
+        (Some((starts, sig)), None) => hinf_norm_near(ss, starts, Some(sig)),
+        (None, _) => hinf_norm(ss),
+    }
 }
 
 /// The cuts that start the certified sweep: the grid and, for every lightly damped
