@@ -27,6 +27,7 @@
 //! [`modal_cascade`] below [`CASCADE_ROWS_FROM`]), the grid value [`t_sigma_max`] and the
 //! closed-loop poles [`loop_poles`] (for a large diagonal `M̃` from the structure: the loop of
 //! the cancelled rows and the factors' denominators).
+pub(crate) mod centre_inertia;
 pub(crate) mod certified_norm;
 pub(crate) mod enclosure;
 pub(crate) mod factor_loop;
