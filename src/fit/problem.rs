@@ -112,6 +112,38 @@ impl Lp {
         super::memo::solve(self, max_iter, refine)
     }
 
+    /// The analytic centre of the feasible set by [`super::dense_ipm`] (the objective is
+    /// ignored: for the zero-objective level LPs): `Solved` with the centre, `AlmostSolved`
+    /// with a strictly feasible point short of it, `PrimalInfeasible` with a checked
+    /// certificate, `InsufficientProgress` (no point) when neither is proven.
+    pub fn solve_dense(&self, start: Option<&[f64]>) -> LpOut {
+        use super::dense_ipm::{analytic_centre, Outcome};
+        let t0 = std::time::Instant::now();
+        let (out, st) = analytic_centre(self, start);
+        if std::env::var("RSHAPE_DENSE_TRACE").is_ok() {
+            let k = match &out { Outcome::Centre { converged, .. } => if *converged { "C" } else { "c" }, Outcome::Infeasible(_) => "I", Outcome::Undecided(w) => w };
+            eprintln!("DENSE {} {} {} {} {:.3} {} {}", self.ge.len(), self.n, st.phase1_steps, st.centre_steps, t0.elapsed().as_secs_f64() * 1e3, start.is_some(), k);
+        }
+        match out {
+            Outcome::Centre { v, converged } => LpOut {
+                status: if converged {
+                    SolverStatus::Solved
+                } else {
+                    SolverStatus::AlmostSolved
+                },
+                x: v,
+            },
+            Outcome::Infeasible(_) => LpOut {
+                status: SolverStatus::PrimalInfeasible,
+                x: Vec::new(),
+            },
+            Outcome::Undecided(_) => LpOut {
+                status: SolverStatus::InsufficientProgress,
+                x: Vec::new(),
+            },
+        }
+    }
+
     /// Solves with Clarabel.  Never panics: a setup failure is `SetupError`.
     pub fn solve(&self, max_iter: u32, refine: bool) -> LpOut {
         let m = self.eq.len() + self.ge.len();
@@ -271,6 +303,7 @@ pub(crate) fn max_slack(
         max_iter,
         refine,
         Retry::Decides,
+        false,
     );
     if !out.status.has_solution() {
         return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
@@ -337,6 +370,7 @@ pub(crate) fn area_fixed_poles(
         max_iter,
         refine,
         Retry::Fails,
+        false,
     );
     if !out.status.has_solution() {
         return (out.status, vec![], f64::INFINITY, rounds);

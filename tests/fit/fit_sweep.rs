@@ -8,7 +8,9 @@
 //! --nocapture`.  It prints LPs and seconds per envelope.  `RSHAPE_SWEEP_WRITE=1` rewrites
 //! the reference table instead of checking it (only on the code the table is meant to record);
 //! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`;
-//! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing).
+//! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing);
+//! `RSHAPE_FIT_DENSE=1` solves the polynomial candidate's level LPs with the dense analytic-
+//! centre solver (`FitSettings::dense_level_lp`, issue 38's eighth step).
 
 #[path = "../../benches/support/random_envelopes.rs"]
 pub(crate) mod random_envelopes;
@@ -21,6 +23,15 @@ const REFERENCE: &str = "tests/data/fit_sweep_reference.csv";
 const MAX_ORDER: usize = 8;
 /// How far (decades) an order's max may rise over the stored table.
 const RISE: f64 = 0.002;
+
+/// The settings of the sweep and the bench cases: the defaults, with
+/// `FitSettings::dense_level_lp` when `RSHAPE_FIT_DENSE` is set.
+fn settings() -> FitSettings {
+    FitSettings {
+        dense_level_lp: std::env::var("RSHAPE_FIT_DENSE").is_ok(),
+        ..FitSettings::default()
+    }
+}
 
 /// `(envelope, order) → max log10` from the stored table.
 fn reference() -> Vec<Vec<f64>> {
@@ -106,7 +117,7 @@ fn sweep_no_order_rises() {
         let (_, rows) = fit_auto(
             &env,
             None,
-            &FitSettings::default(),
+            &settings(),
             MAX_ORDER,
             &Default::default(),
         )
@@ -162,7 +173,7 @@ fn bench_case_figures() {
             let (res, rows) = fit_auto(
                 env,
                 a1,
-                &FitSettings::default(),
+                &settings(),
                 MAX_ORDER,
                 &Default::default(),
             )
