@@ -117,13 +117,8 @@ impl Lp {
     /// with a strictly feasible point short of it, `PrimalInfeasible` with a checked
     /// certificate, `InsufficientProgress` (no point) when neither is proven.
     pub fn solve_dense(&self, start: Option<&[f64]>) -> LpOut {
-        use super::dense_ipm::{analytic_centre, Outcome};
-        let t0 = std::time::Instant::now();
-        let (out, st) = analytic_centre(self, start);
-        if std::env::var("RSHAPE_DENSE_TRACE").is_ok() {
-            let k = match &out { Outcome::Centre { converged, .. } => if *converged { "C" } else { "c" }, Outcome::Infeasible(_) => "I", Outcome::Undecided(w) => w };
-            eprintln!("DENSE {} {} {} {} {:.3} {} {}", self.ge.len(), self.n, st.phase1_steps, st.centre_steps, t0.elapsed().as_secs_f64() * 1e3, start.is_some(), k);
-        }
+        use super::dense_ipm::{analytic_centre, farkas_holds, Outcome, RADIUS};
+        let (out, _) = analytic_centre(self, start);
         match out {
             Outcome::Centre { v, converged } => LpOut {
                 status: if converged {
@@ -133,8 +128,14 @@ impl Lp {
                 },
                 x: v,
             },
-            Outcome::Infeasible(_) => LpOut {
+            // The certificate was checked inside; checked once more here, so that nothing
+            // but a proof reaches the fit as `PrimalInfeasible`.
+            Outcome::Infeasible(cert) if farkas_holds(self, &cert, RADIUS) => LpOut {
                 status: SolverStatus::PrimalInfeasible,
+                x: Vec::new(),
+            },
+            Outcome::Infeasible(_) => LpOut {
+                status: SolverStatus::InsufficientProgress,
                 x: Vec::new(),
             },
             Outcome::Undecided(_) => LpOut {

@@ -114,14 +114,8 @@ fn sweep_no_order_rises() {
             std::fs::write(format!("{dir}/env{k:02}.csv"), to_csv(&env)).unwrap();
         }
         let t = Instant::now();
-        let (_, rows) = fit_auto(
-            &env,
-            None,
-            &settings(),
-            MAX_ORDER,
-            &Default::default(),
-        )
-        .expect("fit");
+        let (_, rows) =
+            fit_auto(&env, None, &settings(), MAX_ORDER, &Default::default()).expect("fit");
         let dt = t.elapsed().as_secs_f64();
         let n_lp: usize = rows.iter().map(|r| r.lp_solves).sum();
         lps += n_lp;
@@ -170,14 +164,8 @@ fn bench_case_figures() {
     let run =
         |name: &str, env: &rshape::consistency::Envelope, a1: Option<rshape::fit::A1Fn<'_>>| {
             let t = Instant::now();
-            let (res, rows) = fit_auto(
-                env,
-                a1,
-                &settings(),
-                MAX_ORDER,
-                &Default::default(),
-            )
-            .expect("fit");
+            let (res, rows) =
+                fit_auto(env, a1, &settings(), MAX_ORDER, &Default::default()).expect("fit");
             let dt = t.elapsed().as_secs_f64();
             let per: Vec<String> = rows.iter().map(|r| r.lp_solves.to_string()).collect();
             println!(

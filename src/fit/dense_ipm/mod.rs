@@ -50,8 +50,8 @@ pub(crate) enum Outcome {
     Centre { v: Vec<f64>, converged: bool },
     /// No feasible point with `‖v‖∞ ≤ R`, with its checked certificate.
     Infeasible(Farkas),
-    /// Neither proven; why.
-    Undecided(&'static str),
+    /// Neither proven; why (for the tests and a debugger: the fit needs only the status).
+    Undecided(#[allow(dead_code)] &'static str),
 }
 
 /// Work done by one solve.
@@ -217,13 +217,7 @@ pub(crate) fn farkas_holds(lp: &Lp, cert: &Farkas, radius: f64) -> bool {
     if cert.y.len() != lp.ge.len() || cert.mu.len() != lp.eq.len() {
         return false;
     }
-    if cert
-        .y
-        .iter()
-        .chain(&cert.mu)
-        .any(|v| !v.is_finite())
-        || cert.y.iter().any(|v| *v < 0.0)
-    {
+    if cert.y.iter().chain(&cert.mu).any(|v| !v.is_finite()) || cert.y.iter().any(|v| *v < 0.0) {
         return false;
     }
     let mut r = vec![0.0; lp.n];
@@ -246,9 +240,16 @@ pub(crate) fn farkas_holds(lp: &Lp, cert: &Farkas, radius: f64) -> bool {
 /// when given (any point: only the work depends on it).
 pub(crate) fn analytic_centre(lp: &Lp, start: Option<&[f64]>) -> (Outcome, Stats) {
     let mut stats = Stats::default();
-    let bad = |v: &(Vec<f64>, f64)| v.0.len() != lp.n || !v.1.is_finite() || v.0.iter().any(|x| !x.is_finite());
+    let bad = |v: &(Vec<f64>, f64)| {
+        v.0.len() != lp.n || !v.1.is_finite() || v.0.iter().any(|x| !x.is_finite())
+    };
     if lp.n == 0 || lp.ge.iter().chain(&lp.eq).any(bad) {
-        return (Outcome::Undecided("malformed LP (no columns, a wrong length or a non-finite coefficient)"), stats);
+        return (
+            Outcome::Undecided(
+                "malformed LP (no columns, a wrong length or a non-finite coefficient)",
+            ),
+            stats,
+        );
     }
     let el = match eliminate(lp.n, &lp.eq) {
         Ok(el) => el,
@@ -260,7 +261,10 @@ pub(crate) fn analytic_centre(lp: &Lp, start: Option<&[f64]>) -> (Outcome, Stats
             return if farkas_holds(lp, &cert, RADIUS) {
                 (Outcome::Infeasible(cert), stats)
             } else {
-                (Outcome::Undecided("inconsistent equalities without a checked certificate"), stats)
+                (
+                    Outcome::Undecided("inconsistent equalities without a checked certificate"),
+                    stats,
+                )
             };
         }
     };
@@ -274,10 +278,18 @@ pub(crate) fn analytic_centre(lp: &Lp, start: Option<&[f64]>) -> (Outcome, Stats
             return if farkas_holds(lp, &cert, RADIUS) {
                 (Outcome::Infeasible(cert), stats)
             } else {
-                (Outcome::Undecided("a row constant on the equalities is violated, unproven"), stats)
+                (
+                    Outcome::Undecided("a row constant on the equalities is violated, unproven"),
+                    stats,
+                )
             };
         }
-        Reduction::Tight => return (Outcome::Undecided("a row is an implied equality: no interior"), stats),
+        Reduction::Tight => {
+            return (
+                Outcome::Undecided("a row is an implied equality: no interior"),
+                stats,
+            )
+        }
     };
     let d = el.d;
     // The start in w: the projection of `start − v0` on the null space.

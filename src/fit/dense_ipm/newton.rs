@@ -1,6 +1,6 @@
 //! Damped Newton on the log barrier `φ_t(x) = t·cᵀx − Σ_i ln(a_iᵀx − b_i)` over dense rows
 //! (row-major, few columns): each step solves `H Δx = −∇φ` with `H = Aᵀ diag(1/s²) A`, an
-//! `n × n` matrix factored by Cholesky after a symmetric Jacobi scaling (Boyd &
+//! `n × n` system solved by a QR factorization of `S⁻¹A` (Boyd &
 //! Vandenberghe, *Convex Optimization*, §9.5–9.6 and §11.3: the barrier is
 //! self-concordant, so the damped step converges from any strictly feasible point).
 
@@ -49,8 +49,6 @@ pub(crate) enum Centring {
 pub(crate) struct Centred {
     pub x: Vec<f64>,
     pub s: Vec<f64>,
-    /// The last Newton decrement `λ² = ∇φᵀ H⁻¹ ∇φ`.
-    pub lambda2: f64,
     pub iters: usize,
     pub end: Centring,
 }
@@ -61,60 +59,41 @@ fn barrier(t: f64, c: Option<&[f64]>, x: &[f64], s: &[f64]) -> f64 {
     t * lin - s.iter().map(|v| v.ln()).sum::<f64>()
 }
 
-/// The Newton step `Δx` and `λ²` at slacks `s`, or `None` when `H` cannot be factored.
+/// The Newton step `Δx` and `λ²` at slacks `s`, or `None` when `J = S⁻¹A` is rank
+/// deficient.  `H = JᵀJ` is never formed: with `J = QR` (Householder), `Δx = R⁻¹Qᵀ1 −
+/// t·R⁻¹R⁻ᵀc`, whose error grows with `cond(J) = √cond(H)` — the slacks span 20 decades
+/// near the end of phase 1, where the normal equations' Cholesky lost the step (phase 1
+/// stalled with `τ` and its bound 5·10⁻⁷ apart on envelope 0 of the sweep).
 fn newton_step(rows: &Rows, t: f64, c: Option<&[f64]>, s: &[f64]) -> Option<(Vec<f64>, f64)> {
-    let n = rows.n;
-    let mut h = vec![0.0; n * n];
+    let (n, m) = (rows.n, rows.m());
+    let mut j = DMatrix::<f64>::zeros(m, n);
+    for (i, (r, si)) in rows.a.chunks_exact(n).zip(s).enumerate() {
+        let inv = 1.0 / si;
+        for k in 0..n {
+            j[(i, k)] = r[k] * inv;
+        }
+    }
+    // g = t·c − Jᵀ1.
     let mut g = vec![0.0; n];
     if let Some(c) = c {
         g.iter_mut().zip(c).for_each(|(gi, ci)| *gi = t * ci);
     }
-    for (r, si) in rows.a.chunks_exact(n).zip(s) {
-        let inv = 1.0 / si;
-        let w = inv * inv;
-        for j in 0..n {
-            g[j] -= inv * r[j];
-            let wj = w * r[j];
-            if wj == 0.0 {
-                continue;
-            }
-            let hj = &mut h[j * n..(j + 1) * n];
-            for k in j..n {
-                hj[k] += wj * r[k];
-            }
-        }
+    for (k, gk) in g.iter_mut().enumerate() {
+        *gk -= j.column(k).sum();
     }
-    // Symmetric Jacobi scaling D H D (D = diag(1/√H_jj)): the columns' scales differ by
-    // decades when the rows do, and the scaled matrix has a unit diagonal.
-    let d: Vec<f64> = (0..n)
-        .map(|j| {
-            let v = h[j * n + j];
-            if v > 0.0 && v.is_finite() {
-                1.0 / v.sqrt()
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let mut hs = DMatrix::<f64>::zeros(n, n);
-    for j in 0..n {
-        for k in j..n {
-            let v = h[j * n + k] * d[j] * d[k];
-            hs[(j, k)] = v;
-            hs[(k, j)] = v;
-        }
+    let qr = j.qr();
+    let r = qr.r();
+    let mut ones = DVector::from_element(m, 1.0);
+    qr.q_tr_mul(&mut ones);
+    let qt1 = DVector::from_iterator(n, ones.iter().take(n).copied());
+    let mut dx = r.solve_upper_triangular(&qt1)?;
+    if let Some(c) = c {
+        let cv = DVector::from_column_slice(c);
+        let y = r.tr_solve_upper_triangular(&cv)?;
+        let z = r.solve_upper_triangular(&y)?;
+        dx -= z * t;
     }
-    let rhs = DVector::from_iterator(n, (0..n).map(|j| -g[j] * d[j]));
-    let chol = hs.clone().cholesky().or_else(|| {
-        // A tiny ridge where H is singular to round-off (a direction no row bounds).
-        let mut r = hs;
-        for j in 0..n {
-            r[(j, j)] += 1e-13;
-        }
-        r.cholesky()
-    })?;
-    let y = chol.solve(&rhs);
-    let dx: Vec<f64> = (0..n).map(|j| y[j] * d[j]).collect();
+    let dx: Vec<f64> = dx.iter().copied().collect();
     let lambda2 = -g.iter().zip(&dx).map(|(u, v)| u * v).sum::<f64>();
     if !lambda2.is_finite() || dx.iter().any(|v| !v.is_finite()) {
         return None;
@@ -151,13 +130,7 @@ pub(crate) fn centre(
 ) -> Centred {
     let mut x = x0;
     let mut s = rows.slacks(&x);
-    let out = |x: Vec<f64>, s: Vec<f64>, lambda2, iters, end| Centred {
-        x,
-        s,
-        lambda2,
-        iters,
-        end,
-    };
+    let out = |x: Vec<f64>, s: Vec<f64>, _lambda2: f64, iters, end| Centred { x, s, iters, end };
     let mut lambda2 = f64::INFINITY;
     for it in 0..cap {
         let Some((dx, l2)) = newton_step(rows, t, c, &s) else {

@@ -92,9 +92,7 @@ pub(super) fn find_interior<C>(
             Centring::Stalled => {
                 return (Phase1::Undecided("phase 1 stalled (Newton system)"), steps)
             }
-            Centring::Capped => {
-                return (Phase1::Undecided("Newton step cap in phase 1"), steps)
-            }
+            Centring::Capped => return (Phase1::Undecided("Newton step cap in phase 1"), steps),
             Centring::Converged => {}
         }
         // Dual estimate (Aᵀy = c): its objective bᵀy bounds τ* from below.
@@ -102,12 +100,6 @@ pub(super) fn find_interior<C>(
             return (Phase1::Undecided("phase 1 stalled (Newton system)"), steps);
         };
         let lower: f64 = y.iter().zip(&ext.b).map(|(u, v)| u * v).sum();
-        if std::env::var("RSHAPE_P1_TRACE").is_ok() {
-            let lg: f64 = y[..mg].iter().zip(&ext.b).map(|(u, v)| u * v).sum();
-            let smin = res.s.iter().fold(f64::INFINITY, |a, v| a.min(*v));
-            let xmax = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            eprintln!("P1 m {} t {t:.2e} tau {:.3e} lower {lower:.3e} lowerG {lg:.3e} it {} l2 {:.1e} smin {smin:.1e} xmax {xmax:.2e} steps {steps}", ext.m(), x[d], res.iters, res.lambda2);
-        }
         if lower > 0.0 {
             if let Some(cert) = certify(&y[..mg]) {
                 return (Phase1::Infeasible(cert), steps);

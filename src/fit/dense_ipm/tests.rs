@@ -284,21 +284,30 @@ fn bad_input_and_inconsistent_equalities() {
         ge: vec![(vec![f64::NAN, 1.0], 0.0)],
         eq: vec![],
     };
-    assert!(matches!(analytic_centre(&nan, None).0, Outcome::Undecided(_)));
+    assert!(matches!(
+        analytic_centre(&nan, None).0,
+        Outcome::Undecided(_)
+    ));
     let none = Lp {
         n: 0,
         c: vec![],
         ge: vec![],
         eq: vec![],
     };
-    assert!(matches!(analytic_centre(&none, None).0, Outcome::Undecided(_)));
+    assert!(matches!(
+        analytic_centre(&none, None).0,
+        Outcome::Undecided(_)
+    ));
     let short = Lp {
         n: 2,
         c: vec![0.0; 2],
         ge: vec![(vec![1.0], 0.0)],
         eq: vec![],
     };
-    assert!(matches!(analytic_centre(&short, None).0, Outcome::Undecided(_)));
+    assert!(matches!(
+        analytic_centre(&short, None).0,
+        Outcome::Undecided(_)
+    ));
     // x + y = 1 and 2x + 2y = 3.
     let clash = Lp {
         n: 2,
@@ -339,4 +348,3 @@ fn bad_input_and_inconsistent_equalities() {
         RADIUS
     ));
 }
-
