@@ -34,7 +34,7 @@ fn settings() -> FitSettings {
 }
 
 /// `(envelope, order) → max log10` from the stored table.
-fn reference() -> Vec<Vec<f64>> {
+pub(crate) fn reference() -> Vec<Vec<f64>> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
     let text = std::fs::read_to_string(&path).expect("reference table");
     let mut table = vec![vec![f64::NAN; MAX_ORDER + 1]; SWEEP_LEN];
