@@ -25,7 +25,6 @@ struct Entry {
     lp: Lp,
     max_iter: u32,
     refine: bool,
-    dense: bool,
     out: LpOut,
 }
 
@@ -37,9 +36,9 @@ fn size(lp: &Lp) -> usize {
     lp.c.len() + (lp.ge.len() + lp.eq.len()) * (lp.n + 1)
 }
 
-fn hash(lp: &Lp, max_iter: u32, refine: bool, dense: bool) -> u64 {
+fn hash(lp: &Lp, max_iter: u32, refine: bool) -> u64 {
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (lp.n, max_iter, refine, dense, lp.ge.len(), lp.eq.len()).hash(&mut h);
+    (lp.n, max_iter, refine, lp.ge.len(), lp.eq.len()).hash(&mut h);
     let bits = |v: &[f64], h: &mut std::collections::hash_map::DefaultHasher| {
         v.iter().for_each(|x| x.to_bits().hash(h));
     };
@@ -54,44 +53,17 @@ fn hash(lp: &Lp, max_iter: u32, refine: bool, dense: bool) -> u64 {
 /// The answer of `lp` with these settings, from the memo or from Clarabel; `true` when
 /// Clarabel ran.
 pub(super) fn solve(lp: &Lp, max_iter: u32, refine: bool) -> (LpOut, bool) {
-    solve_with(lp, max_iter, refine, None)
-}
-
-/// [`solve`], or with `dense = Some(start)` the analytic centre of
-/// [`super::dense_ipm`] from that start (the start changes the work, not the answer, so it
-/// is not part of the key; nor are `max_iter` and `refine`).
-pub(super) fn solve_with(
-    lp: &Lp,
-    max_iter: u32,
-    refine: bool,
-    dense: Option<Option<&[f64]>>,
-) -> (LpOut, bool) {
-    let is_dense = dense.is_some();
-    let (max_iter, refine) = if is_dense {
-        (0, false)
-    } else {
-        (max_iter, refine)
-    };
-    let key = hash(lp, max_iter, refine, is_dense);
+    let key = hash(lp, max_iter, refine);
     let hit = MEMO.with(|m| {
         m.borrow()
             .iter()
-            .find(|e| {
-                e.hash == key
-                    && e.max_iter == max_iter
-                    && e.refine == refine
-                    && e.dense == is_dense
-                    && e.lp == *lp
-            })
+            .find(|e| e.hash == key && e.max_iter == max_iter && e.refine == refine && e.lp == *lp)
             .map(|e| e.out.clone())
     });
     if let Some(out) = hit {
         return (out, false);
     }
-    let out = match dense {
-        Some(start) => lp.solve_dense(start),
-        None => lp.solve(max_iter, refine),
-    };
+    let out = lp.solve(max_iter, refine);
     MEMO.with(|m| {
         let mut m = m.borrow_mut();
         let new = size(lp);
@@ -107,7 +79,6 @@ pub(super) fn solve_with(
                 lp: lp.clone(),
                 max_iter,
                 refine,
-                dense: is_dense,
                 out: out.clone(),
             });
         }

@@ -30,7 +30,6 @@ pub(crate) mod between;
 pub(crate) mod certificate;
 pub(crate) mod chebseries;
 mod context;
-pub(crate) mod dense_ipm;
 pub(crate) mod engine;
 mod levelsearch;
 mod memo;
@@ -126,12 +125,6 @@ pub struct FitSettings {
     /// from the best level known). On the shipped examples 0.7–1.6× the LPs, each dearer.
     /// Default false.
     pub thorough: bool,
-    /// Solve the global polynomial candidate's level LPs with the dense interior-point
-    /// solver of `fit::dense_ipm` (their point: the analytic centre of the level set, a function
-    /// of the LP alone) instead of Clarabel's zero-objective interior point (issue 38,
-    /// eighth step; measured, not the default).  Default false.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub dense_level_lp: bool,
     /// Frequencies (rad/s) where `σ_min(M̃(jω))` may dip sharply: the lightly damped zeros
     /// of `M̃` ([`crate::model::Factorization::a1_dips`]). The certificate evaluates A1
     /// there and refines around each, so that a notch narrower than its grid (a mode with
@@ -165,7 +158,6 @@ impl Default for FitSettings {
             chain: false,
             auto_tolerance: 0.01,
             thorough: false,
-            dense_level_lp: false,
             a1_dips: Vec::new(),
             a1_proof: A1Proof::Sampled,
         }

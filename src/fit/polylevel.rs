@@ -137,10 +137,6 @@ impl<'a> LevelLp<'a> {
         if self.set.thorough {
             return self.level_with(t, events, true);
         }
-        if self.set.dense_level_lp {
-            // The dense solver has no refinement to turn on: the second pass would repeat it.
-            return self.level_with(t, events, false);
-        }
         let before = events.len();
         match self.level_with(t, events, false) {
             Level::Doubt => {
@@ -189,7 +185,6 @@ impl<'a> LevelLp<'a> {
                 set.max_solver_iter.min(RETRY_ITER),
                 refine,
                 Retry::Decides,
-                set.dense_level_lp,
             );
             self.lp_solves += rounds;
             // Only a full-accuracy certificate of infeasibility decides the level; a

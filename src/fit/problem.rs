@@ -112,39 +112,6 @@ impl Lp {
         super::memo::solve(self, max_iter, refine)
     }
 
-    /// The analytic centre of the feasible set by [`super::dense_ipm`] (the objective is
-    /// ignored: for the zero-objective level LPs): `Solved` with the centre, `AlmostSolved`
-    /// with a strictly feasible point short of it, `PrimalInfeasible` with a checked
-    /// certificate, `InsufficientProgress` (no point) when neither is proven.
-    pub fn solve_dense(&self, start: Option<&[f64]>) -> LpOut {
-        use super::dense_ipm::{analytic_centre, farkas_holds, Outcome, RADIUS};
-        let (out, _) = analytic_centre(self, start);
-        match out {
-            Outcome::Centre { v, converged } => LpOut {
-                status: if converged {
-                    SolverStatus::Solved
-                } else {
-                    SolverStatus::AlmostSolved
-                },
-                x: v,
-            },
-            // The certificate was checked inside; checked once more here, so that nothing
-            // but a proof reaches the fit as `PrimalInfeasible`.
-            Outcome::Infeasible(cert) if farkas_holds(self, &cert, RADIUS) => LpOut {
-                status: SolverStatus::PrimalInfeasible,
-                x: Vec::new(),
-            },
-            Outcome::Infeasible(_) => LpOut {
-                status: SolverStatus::InsufficientProgress,
-                x: Vec::new(),
-            },
-            Outcome::Undecided(_) => LpOut {
-                status: SolverStatus::InsufficientProgress,
-                x: Vec::new(),
-            },
-        }
-    }
-
     /// Solves with Clarabel.  Never panics: a setup failure is `SetupError`.
     pub fn solve(&self, max_iter: u32, refine: bool) -> LpOut {
         let m = self.eq.len() + self.ge.len();
@@ -304,7 +271,6 @@ pub(crate) fn max_slack(
         max_iter,
         refine,
         Retry::Decides,
-        false,
     );
     if !out.status.has_solution() {
         return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
@@ -371,7 +337,6 @@ pub(crate) fn area_fixed_poles(
         max_iter,
         refine,
         Retry::Fails,
-        false,
     );
     if !out.status.has_solution() {
         return (out.status, vec![], f64::INFINITY, rounds);

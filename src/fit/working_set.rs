@@ -36,9 +36,7 @@ const MAX_RETRY_ROWS: usize = 60_000;
 /// ended short of `Solved` or a proof of infeasibility).  `Retry::Decides` (the level
 /// searches, where the status says whether a level is feasible) retries an `AlmostSolved`
 /// solve too; `Retry::Fails` (the area polish, where an `AlmostSolved` point is a usable
-/// candidate, certified like any other) only a solve without a solution.  `dense` solves
-/// with [`super::dense_ipm`] instead of Clarabel (zero-objective LPs only: the point is the
-/// analytic centre of the working set's feasible set).
+/// candidate, certified like any other) only a solve without a solution.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Retry {
     /// The status decides a level: retry every solve short of `Solved` or infeasible.
@@ -61,7 +59,6 @@ pub(crate) fn active_set_solve(
     retry_iter: u32,
     refine: bool,
     retry: Retry,
-    dense: bool,
 ) -> (LpOut, usize) {
     // Whether the retry with every row is solved with refinement straight away: once a
     // working-set solve stayed short of `Solved` with refinement (`Retry::Decides`), its
@@ -84,8 +81,6 @@ pub(crate) fn active_set_solve(
     let mut solves = 0;
     let mut all = false;
     let on = |mask: &[bool], i: usize| mask[i];
-    // The dense solver's start: the last round's point (it changes the work, not the point).
-    let mut last: Option<Vec<f64>> = None;
     loop {
         rounds += 1;
         let ge: Vec<(Vec<f64>, f64)> = (0..rows.len())
@@ -100,11 +95,7 @@ pub(crate) fn active_set_solve(
         };
         let iter = if all { retry_iter } else { max_iter };
         let refine = refine || (all && refine_all);
-        let (mut out, ran) = if dense {
-            super::memo::solve_with(&lp, iter, refine, Some(last.as_deref()))
-        } else {
-            lp.solve_memo(iter, refine)
-        };
+        let (mut out, ran) = lp.solve_memo(iter, refine);
         solves += usize::from(ran);
         let settled = match retry {
             Retry::Decides => matches!(
@@ -116,8 +107,7 @@ pub(crate) fn active_set_solve(
                 SolverStatus::Solved | SolverStatus::AlmostSolved | SolverStatus::PrimalInfeasible
             ),
         };
-        // (The dense solver's answer does not depend on a refinement: no second try.)
-        if !refine && !settled && !dense {
+        if !refine && !settled {
             // Solved again with iterative refinement before the status counts: without it a
             // level of the partial-fraction search at order 8 of the ISS example ended short
             // of `Solved` and was taken as not feasible, and the order lost 0.14 decade
@@ -136,13 +126,6 @@ pub(crate) fn active_set_solve(
             {
                 refine_all = true;
             }
-        }
-        if dense && out.status == SolverStatus::InsufficientProgress {
-            // The dense solver left the working set's level undecided (within 1e-9 of
-            // empty): every row only shrinks the set, so the retry with every row would be
-            // as undecided or infeasible, at the price of the largest solve of the level
-            // (2000 points: 40 such retries, 42 of the 48 s in the solver).
-            return (out, solves);
         }
         if !out.status.has_solution() || rounds > MAX_ROUNDS {
             // A working set can leave the objective unbounded or the LP ill-posed: retry
@@ -163,9 +146,6 @@ pub(crate) fn active_set_solve(
         }
         if all {
             return (out, solves);
-        }
-        if dense {
-            last = Some(out.x.clone());
         }
         let scale = 1.0 + out.x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let viol: Vec<f64> = rows

@@ -8,9 +8,7 @@
 //! --nocapture`.  It prints LPs and seconds per envelope.  `RSHAPE_SWEEP_WRITE=1` rewrites
 //! the reference table instead of checking it (only on the code the table is meant to record);
 //! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`;
-//! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing);
-//! `RSHAPE_FIT_DENSE=1` solves the polynomial candidate's level LPs with the dense analytic-
-//! centre solver (`FitSettings::dense_level_lp`, issue 38's eighth step).
+//! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing).
 
 #[path = "../../benches/support/random_envelopes.rs"]
 pub(crate) mod random_envelopes;
@@ -24,17 +22,8 @@ const MAX_ORDER: usize = 8;
 /// How far (decades) an order's max may rise over the stored table.
 const RISE: f64 = 0.002;
 
-/// The settings of the sweep and the bench cases: the defaults, with
-/// `FitSettings::dense_level_lp` when `RSHAPE_FIT_DENSE` is set.
-fn settings() -> FitSettings {
-    FitSettings {
-        dense_level_lp: std::env::var("RSHAPE_FIT_DENSE").is_ok(),
-        ..FitSettings::default()
-    }
-}
-
 /// `(envelope, order) → max log10` from the stored table.
-pub(crate) fn reference() -> Vec<Vec<f64>> {
+fn reference() -> Vec<Vec<f64>> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
     let text = std::fs::read_to_string(&path).expect("reference table");
     let mut table = vec![vec![f64::NAN; MAX_ORDER + 1]; SWEEP_LEN];
@@ -114,8 +103,14 @@ fn sweep_no_order_rises() {
             std::fs::write(format!("{dir}/env{k:02}.csv"), to_csv(&env)).unwrap();
         }
         let t = Instant::now();
-        let (_, rows) =
-            fit_auto(&env, None, &settings(), MAX_ORDER, &Default::default()).expect("fit");
+        let (_, rows) = fit_auto(
+            &env,
+            None,
+            &FitSettings::default(),
+            MAX_ORDER,
+            &Default::default(),
+        )
+        .expect("fit");
         let dt = t.elapsed().as_secs_f64();
         let n_lp: usize = rows.iter().map(|r| r.lp_solves).sum();
         lps += n_lp;
@@ -164,8 +159,14 @@ fn bench_case_figures() {
     let run =
         |name: &str, env: &rshape::consistency::Envelope, a1: Option<rshape::fit::A1Fn<'_>>| {
             let t = Instant::now();
-            let (res, rows) =
-                fit_auto(env, a1, &settings(), MAX_ORDER, &Default::default()).expect("fit");
+            let (res, rows) = fit_auto(
+                env,
+                a1,
+                &FitSettings::default(),
+                MAX_ORDER,
+                &Default::default(),
+            )
+            .expect("fit");
             let dt = t.elapsed().as_secs_f64();
             let per: Vec<String> = rows.iter().map(|r| r.lp_solves.to_string()).collect();
             println!(

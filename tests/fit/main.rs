@@ -8,7 +8,6 @@ mod common;
 
 mod certificate_exact;
 mod fit_defects;
-mod fit_dense;
 mod fit_paper;
 mod fit_parallel;
 mod fit_random;
