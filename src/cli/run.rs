@@ -145,7 +145,12 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             rep.fit_error.clone().unwrap_or_default()
         ),
     }
-    for w in &rep.warnings {
+    // The fit's failure is on the `fit` line already.
+    for w in rep
+        .warnings
+        .iter()
+        .filter(|w| !w.starts_with("fit failed: "))
+    {
         outln!("  warning   {w}");
     }
     outln!(

@@ -1,6 +1,7 @@
 //! The `rshape run` pipeline: envelope → check of the configured `r` → fit → certificate →
 //! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
 //! writes; neither prints.
+pub mod a1_conflict;
 pub mod closed_loop;
 pub mod envelope;
 pub mod integration;

@@ -34,4 +34,5 @@ mod output_policy;
 mod progress_cli;
 mod quiet_output;
 mod run_cli;
+mod sample_time;
 mod settings_validate;

@@ -107,6 +107,11 @@ pub struct RawConfig {
     /// Data file, relative to the config file.
     #[serde(default)]
     pub data: Option<PathBuf>,
+    /// Sampling time `Ts` in seconds when the data files' frequency column is normalized
+    /// (cycles/sample as `freq_hz`, rad/sample as `omega_rad_s`): frequencies are divided by
+    /// `Ts` ([`crate::data::denormalize_frf`]).  Applies to the FRF, std and coherence files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_time: Option<f64>,
     /// The nominal factorization (or give `[physical]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelSection>,
@@ -200,6 +205,12 @@ fn tf_rows(
 }
 
 impl Config {
+    /// The sampling time of a normalized frequency axis (`sample_time`), if the config has
+    /// one: the data files' frequencies are per sample and are divided by it.
+    pub fn sample_time(&self) -> Option<f64> {
+        self.raw.sample_time
+    }
+
     /// Every file this config makes a run read besides itself: the data, the noise
     /// `std_file` or `coherence`, a `[plant] file` (resolved against the config's folder).
     /// The output checks compare every output path with these, so that no figure or
@@ -303,6 +314,9 @@ impl Config {
             None => None,
         };
         raw.noise.validate().map_err(err)?;
+        if let Some(ts) = raw.sample_time {
+            crate::data::check_sample_time(ts).map_err(err)?;
+        }
         let base = path.parent().unwrap_or(Path::new("."));
         let data = raw.data.as_ref().map(|d| base.join(d));
         let noise_std = match (&raw.noise.std_file, raw.noise.std_factor) {
