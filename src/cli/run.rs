@@ -146,10 +146,15 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         ),
     }
     // The fit's failure is on the `fit` line already.
+    let fit_warning = out
+        .fit
+        .as_ref()
+        .err()
+        .map(crate::pipeline::fit_failure_warning);
     for w in rep
         .warnings
         .iter()
-        .filter(|w| !w.starts_with("fit failed: "))
+        .filter(|w| Some(*w) != fit_warning.as_ref())
     {
         outln!("  warning   {w}");
     }

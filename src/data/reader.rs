@@ -93,7 +93,7 @@ impl FrfRows<'static> {
 
 impl FrfRows<'_> {
     /// Reads the frequency column as normalized (cycles or radians per sample) and divides
-    /// it by `ts` seconds (the config's `sample_time`, [`super::sample_time`]); `None` keeps
+    /// it by `ts` seconds (the config's `sample_time`, [`crate::data::denormalize_frf`]); `None` keeps
     /// the column's unit.
     pub fn with_sample_time(mut self, ts: Option<f64>) -> Self {
         self.sample_time = ts;
