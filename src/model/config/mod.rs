@@ -138,6 +138,26 @@ pub struct RawConfig {
     pub v: Option<RSection>,
 }
 
+impl RawConfig {
+    /// The files a config at `path` makes a run read, itself first (see
+    /// [`Config::files_read`]); from the text alone, without building the model (a large
+    /// `[plant] file` takes minutes to factor).
+    pub fn files_read(&self, path: &Path) -> Vec<PathBuf> {
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut files = vec![path.to_path_buf()];
+        files.extend(self.data.as_ref().map(|d| base.join(d)));
+        files.extend(self.noise.std_file.as_ref().map(|f| base.join(f)));
+        files.extend(self.noise.coherence.as_ref().map(|c| base.join(c)));
+        files.extend(
+            self.plant
+                .as_ref()
+                .and_then(|p| p.file.as_ref())
+                .map(|f| base.join(f)),
+        );
+        files
+    }
+}
+
 /// A loaded, validated config.
 ///
 /// ```toml
@@ -216,21 +236,8 @@ impl Config {
     /// The output checks compare every output path with these, so that no figure or
     /// revised config is written over an input.
     pub fn files_read(&self) -> Vec<PathBuf> {
-        let base = self.path.parent().unwrap_or(Path::new("."));
-        let mut files = vec![self.path.clone()];
-        files.extend(self.data.clone());
-        files.extend(self.noise_std.as_ref().map(|(p, _)| p.clone()));
-        files.extend(self.raw.noise.coherence.as_ref().map(|c| base.join(c)));
-        files.extend(
-            self.raw
-                .plant
-                .as_ref()
-                .and_then(|p| p.file.as_ref())
-                .map(|f| base.join(f)),
-        );
-        files
+        self.raw.files_read(&self.path)
     }
-
     /// Reads and validates a config file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::util::read_text_file(path)?;
