@@ -92,8 +92,9 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             run_fit(&env, Some(&a1), &settings, a.order, Some(progress)).map_err(|e| {
                 // Why no order can pass, when the envelope shows it.
                 let gaps = crate::pipeline::a1_conflict::a1_conflicts(&env, f);
-                match crate::pipeline::a1_conflict::hint(&gaps) {
-                    Some(h) => anyhow!("{e}; {h}"),
+                // Where first and what to do last: a long message keeps both ends.
+                match crate::pipeline::a1_conflict::hint_parts(&gaps) {
+                    Some((at, todo)) => anyhow!("{at}; {e}; {todo}"),
                     None => e.into(),
                 }
             })

@@ -50,16 +50,17 @@ impl A1Conflict {
     }
 }
 
-/// One sentence for a fit failure from the gaps of [`a1_conflicts`] (worst first, at most
-/// three named): where, why and what to do; `None` without gaps.
-pub fn hint(gaps: &[A1Conflict]) -> Option<String> {
+/// What a fit failure says about the gaps of [`a1_conflicts`] (worst first, at most two
+/// named): `(where, what to do)`, `None` without gaps.  The second part stays under 150
+/// characters, so that it survives the CLI's cut of long messages.
+pub fn hint_parts(gaps: &[A1Conflict]) -> Option<(String, String)> {
     let first = gaps.first()?;
     let named: Vec<String> = gaps
         .iter()
-        .take(3)
+        .take(2)
         .map(|c| {
             format!(
-                "σ_min(M̃) = {} at ω = {} rad/s between the data at {} and {} rad/s, {} times the level {} that r must keep there",
+                "σ_min(M̃) = {} at ω = {} rad/s (data at {} and {} rad/s), {} × the level {} that r must keep",
                 fmt_g(c.sigma_min),
                 fmt_g(c.omega),
                 fmt_g(c.between.0),
@@ -70,23 +71,33 @@ pub fn hint(gaps: &[A1Conflict]) -> Option<String> {
         })
         .collect();
     let more = match gaps.len() {
-        n if n > 3 => format!(" (and {} more)", n - 3),
+        n if n > 2 => format!(" (and {} more)", n - 2),
         _ => String::new(),
     };
-    let why = "lightly damped poles of the nominal model there make M̃(jω) nearly singular";
-    let todo = "move those modes of the model onto the data's resonances or give them more damping";
+    let todo = "M̃ is nearly singular there (a lightly damped model pole, or a large gain: σ_min(M̃) ≈ 1/‖G‖): damp or move that mode, or rescale the plant's units";
     Some(if first.impossible() {
-        format!(
-            "no r of any order can pass: the A1 limit falls below the envelope between two data: {}{more} ({why}); {todo}, or measure at ω = {} rad/s",
-            named.join("; "),
-            fmt_g(first.omega),
+        (
+            format!(
+                "no r of any order can pass: A1 falls below the envelope between data: {}{more} (a measurement at ω = {} rad/s would split the gap)",
+                named.join("; "),
+                fmt_g(first.omega)
+            ),
+            todo.to_string(),
         )
     } else {
-        format!(
-            "the A1 limit leaves r little room between data: {}{more} ({why}): r must squeeze through; {todo}",
-            named.join("; "),
+        (
+            format!(
+                "A1 leaves r little room between data: {}{more}; r must squeeze through",
+                named.join("; ")
+            ),
+            todo.to_string(),
         )
     })
+}
+
+/// [`hint_parts`] as one sentence.
+pub fn hint(gaps: &[A1Conflict]) -> Option<String> {
+    hint_parts(gaps).map(|(w, todo)| format!("{w}: {todo}"))
 }
 
 /// Per interval between neighbouring data with finite positive `r_min`, its sample of
@@ -162,7 +173,11 @@ mod tests {
         // The sample is its own proof: σ_min there, recomputed, is below the level.
         assert!(f.a1_limit(c.omega) < 0.05 && c.level == 0.05);
         assert!(c.omega > 0.99 && c.omega < 1.01 && c.between == (0.99, 1.01));
-        assert!(hint(&gaps).unwrap().contains("damping"));
+        let (_, todo) = hint_parts(&gaps).unwrap();
+        assert!(
+            todo.contains("damp or move") && todo.chars().count() < 150,
+            "{todo}"
+        );
         // A well-damped model has no conflict; a shallow notch (depth ζ = 0.07) above the
         // level 0.05 is a tight gap, not an impossibility.
         assert_eq!(a1_conflicts(&e, &notch(0.5)), vec![]);
