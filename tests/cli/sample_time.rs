@@ -117,6 +117,24 @@ fn run_reports_frequencies_in_rad_per_second() {
         let want = 2.0 * std::f64::consts::PI * f / 0.5;
         assert!((w - want).abs() < 1e-12 * want, "{w} vs {want}");
     }
+    // Said once, on the terminal and in report.json: the frequencies are the data's ÷ Ts.
+    let text = String::from_utf8_lossy(&o.stdout);
+    let said: Vec<&str> = text.lines().filter(|l| l.contains("sample_time")).collect();
+    assert_eq!(said.len(), 1, "{text}");
+    assert!(
+        said[0].contains("divided by sample_time = 0.5 s: rad/s"),
+        "{}",
+        said[0]
+    );
+    assert_eq!(rep["sample_time"].as_f64(), Some(0.5));
+    // The figures' frequency axes say rad/s or Hz, never per sample.
+    for f in rep["files"].as_array().unwrap() {
+        let f = f.as_str().unwrap();
+        if f.ends_with(".svg") {
+            let svg = std::fs::read_to_string(out.join(f)).unwrap();
+            assert!(!svg.contains("/sample"), "{f}");
+        }
+    }
 }
 
 #[test]
