@@ -102,6 +102,21 @@ impl InputArgs {
 /// Seconds of loading after which, and between which, [`load_config`] says it is still busy.
 const LOAD_NOTICE: std::time::Duration = std::time::Duration::from_secs(5);
 
+/// The environment variable that shortens [`LOAD_NOTICE`] to a number of milliseconds, for
+/// the tests only (tests/cli/load_notice.rs: a load of a few hundred ms shows the notice);
+/// not a user option, so neither a flag nor in `--help`.  Unset, not a whole number or 0:
+/// the 5 s.
+const LOAD_NOTICE_ENV: &str = "RSHAPE_TEST_LOAD_NOTICE_MS";
+
+/// [`LOAD_NOTICE`], or the test's shorter interval from [`LOAD_NOTICE_ENV`].
+fn load_notice() -> std::time::Duration {
+    std::env::var(LOAD_NOTICE_ENV)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .filter(|&ms| ms > 0)
+        .map_or(LOAD_NOTICE, std::time::Duration::from_millis)
+}
+
 /// [`Config::load`], with a line on stderr every 5 s while it lasts longer than that: a
 /// `[plant] file` of a large state space (the 1412-state SLICOT ISS 12A model, its balanced
 /// truncation and its normalized coprime factors) takes minutes with no other sign of life.
@@ -109,11 +124,12 @@ const LOAD_NOTICE: std::time::Duration = std::time::Duration::from_secs(5);
 pub fn load_config(path: &std::path::Path) -> Result<Config> {
     use std::sync::mpsc;
     let (done, wait) = mpsc::channel::<()>();
+    let every = load_notice();
     std::thread::scope(|s| {
         s.spawn(move || {
             let start = std::time::Instant::now();
             // Ends when the sender is dropped (the load finished, or failed).
-            while let Err(mpsc::RecvTimeoutError::Timeout) = wait.recv_timeout(LOAD_NOTICE) {
+            while let Err(mpsc::RecvTimeoutError::Timeout) = wait.recv_timeout(every) {
                 eprintln!(
                     "loading {}: reading and factoring the model ({:.0} s)",
                     path.display(),

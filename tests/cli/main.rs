@@ -31,6 +31,7 @@ mod hardening_iii;
 mod hardening_iii_gaps;
 mod hardening_iii_minor;
 mod kill_safety;
+mod load_notice;
 mod output_modes;
 mod output_policy;
 mod progress_cli;
