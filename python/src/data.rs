@@ -125,11 +125,18 @@ pub struct Frf {
     pub inner: Arc<FrfData>,
 }
 
-/// Reads an FRF CSV file (the format of `rshape run`'s data files).
+/// Reads an FRF CSV file (the format of `rshape run`'s data files).  `sample_time = Ts`
+/// reads its frequency column as normalized (per sample) and divides it by `Ts`, as a
+/// config's `sample_time` does for the config's own data.
 #[pyfunction]
-pub fn read_frf(py: Python<'_>, path: PathBuf) -> PyResult<Frf> {
+#[pyo3(signature = (path, sample_time=None))]
+pub fn read_frf(py: Python<'_>, path: PathBuf, sample_time: Option<f64>) -> PyResult<Frf> {
     guarded(py, || {
-        let d = rshape::read_frf_csv(&path).py()?;
+        let mut d = rshape::read_frf_csv(&path).py()?;
+        if let Some(ts) = sample_time {
+            rshape::data::check_sample_time(ts).map_err(input)?;
+            d = rshape::data::denormalize_frf(d, ts).py()?;
+        }
         Ok(Frf { inner: Arc::new(d) })
     })
 }

@@ -54,7 +54,16 @@ fn stem(p: &Path) -> String {
         .map_or("dataset".into(), |s| s.to_string_lossy().into_owned())
 }
 
-/// Every `*.csv` file in `dir` (not recursive), sorted by file name.
+/// Whether `stem` is `<other>_std` or `<other>_coherence` with `<other>` among `stems`.
+fn is_noise_sibling(stem: &str, stems: &std::collections::HashSet<String>) -> bool {
+    ["_std", "_coherence"].iter().any(|suffix| {
+        stem.strip_suffix(suffix)
+            .is_some_and(|base| stems.contains(base))
+    })
+}
+
+/// Every `*.csv` file in `dir` (not recursive), sorted by file name, except the noise files
+/// of another (`<stem>_std.csv`, `<stem>_coherence.csv` beside `<stem>.csv`).
 pub fn discover_dir(dir: &Path) -> Result<Vec<Dataset>> {
     let rd = std::fs::read_dir(dir).map_err(|source| Error::Io {
         path: dir.to_path_buf(),
@@ -67,6 +76,10 @@ pub fn discover_dir(dir: &Path) -> Result<Vec<Dataset>> {
         .filter(|p| !p.is_dir() && p.extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")))
         .collect();
     paths.sort();
+    // The noise files of a dataset (`<stem>_std.csv`, `<stem>_coherence.csv` beside
+    // `<stem>.csv`, which a config's [noise] finds for each dataset) are not datasets.
+    let csvs: std::collections::HashSet<String> = paths.iter().map(|p| stem(p)).collect();
+    paths.retain(|p| !is_noise_sibling(&stem(p), &csvs));
     if paths.is_empty() {
         return Err(Error::Input {
             path: dir.to_path_buf(),

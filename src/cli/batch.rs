@@ -7,7 +7,6 @@ use crate::batch::{
     self, combine, discover_dir, discover_manifest, run_all, BatchSettings, FinishInput, Shard,
     SummaryRow,
 };
-use crate::model::Config;
 use anyhow::{anyhow, Result};
 use clap::{ArgGroup, Args};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -64,7 +63,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
             ));
         }
     }
-    let config = Config::load(&a.config)?;
+    let config = super::common::load_config(&a.config)?;
     if let Some(x) = a.noise_radius {
         if !(x.is_finite() && x >= 0.0) {
             return Err(anyhow!("--noise-radius {x}: must be a finite number ≥ 0"));

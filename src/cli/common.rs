@@ -43,7 +43,7 @@ impl InputArgs {
 
     /// Loads the config and the data (from `--data` or the config).
     pub fn load(&self) -> Result<Inputs> {
-        let config = Config::load(&self.config)?;
+        let config = load_config(&self.config)?;
         let path = self.data_path(&config)?;
         let data = crate::pipeline::envelope::load_data(&config, &path)?;
         self.check_noise_radius()?;
@@ -75,7 +75,7 @@ impl InputArgs {
     /// The envelope alone, streamed when the noise-free theorems apply
     /// ([`crate::pipeline::envelope::envelope_of_file`]).
     pub fn envelope_only(&self) -> Result<Envelope> {
-        let config = Config::load(&self.config)?;
+        let config = load_config(&self.config)?;
         self.check_noise_radius()?;
         let path = self.data_path(&config)?;
         Ok(crate::pipeline::envelope::envelope_of_file(
@@ -97,6 +97,50 @@ impl InputArgs {
         let options = crate::pipeline::RunOptions::noise_radius(self.noise_radius);
         Ok(crate::pipeline::envelope::envelope(&inputs.config, &inputs.data, &options)?.envelope)
     }
+}
+
+/// Seconds of loading after which, and between which, [`load_config`] says it is still busy.
+const LOAD_NOTICE: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// The environment variable that shortens [`LOAD_NOTICE`] to a number of milliseconds, for
+/// the tests only (tests/cli/load_notice.rs: a load of a few hundred ms shows the notice);
+/// not a user option, so neither a flag nor in `--help`.  Unset, not a whole number or 0:
+/// the 5 s.
+const LOAD_NOTICE_ENV: &str = "RSHAPE_TEST_LOAD_NOTICE_MS";
+
+/// [`LOAD_NOTICE`], or the test's shorter interval from [`LOAD_NOTICE_ENV`].
+fn load_notice() -> std::time::Duration {
+    std::env::var(LOAD_NOTICE_ENV)
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+        .filter(|&ms| ms > 0)
+        .map_or(LOAD_NOTICE, std::time::Duration::from_millis)
+}
+
+/// [`Config::load`], with a line on stderr every 5 s while it lasts longer than that: a
+/// `[plant] file` of a large state space (the 1412-state SLICOT ISS 12A model, its balanced
+/// truncation and its normalized coprime factors) takes minutes with no other sign of life.
+/// A load within 5 s prints nothing.
+pub fn load_config(path: &std::path::Path) -> Result<Config> {
+    use std::sync::mpsc;
+    let (done, wait) = mpsc::channel::<()>();
+    let every = load_notice();
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            let start = std::time::Instant::now();
+            // Ends when the sender is dropped (the load finished, or failed).
+            while let Err(mpsc::RecvTimeoutError::Timeout) = wait.recv_timeout(every) {
+                eprintln!(
+                    "loading {}: reading and factoring the model ({:.0} s)",
+                    path.display(),
+                    start.elapsed().as_secs_f64()
+                );
+            }
+        });
+        let config = Config::load(path);
+        drop(done);
+        Ok(config?)
+    })
 }
 
 pub use crate::report::fmt::{fmt_g, fmt_omegas};
@@ -183,11 +227,15 @@ pub fn check_out_file(
 
 /// Every file a config makes a run read (itself, its data, noise std or coherence file,
 /// plant file: [`Config::files_read`]), for the output checks; just the path when it does
-/// not load.
+/// not parse.  From the TOML alone: the model is not built again (its load, which may factor
+/// a large state space, happens once, in the subcommand).
 pub fn config_files(config: &std::path::Path) -> Vec<PathBuf> {
-    match crate::model::Config::load(config) {
-        Ok(c) => c.files_read(),
-        Err(_) => vec![config.to_path_buf()],
+    let raw = std::fs::read_to_string(config)
+        .ok()
+        .and_then(|text| toml::from_str::<crate::model::RawConfig>(&text).ok());
+    match raw {
+        Some(r) => r.files_read(config),
+        None => vec![config.to_path_buf()],
     }
 }
 

@@ -149,7 +149,7 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
     let agreement = match &a.against {
         Some(p) => {
             let inputs = a.input.load()?;
-            let other = crate::data::read_frf_csv(p)?;
+            let other = crate::pipeline::envelope::read_data_file(&inputs.config, p)?;
             let sb = prepare(
                 &inputs.config,
                 &other,

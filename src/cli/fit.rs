@@ -74,7 +74,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
             let _manifest = super::common::prepare_out(&a.out, &[path])?;
-            run_fit(&env, None, &settings, a.order, Some(progress))
+            run_fit(&env, None, &settings, a.order, Some(progress)).map_err(anyhow::Error::from)
         }
         (None, Some(config)) => {
             let input = InputArgs {
@@ -89,7 +89,15 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
             let settings = settings.with_a1_model(f);
-            run_fit(&env, Some(&a1), &settings, a.order, Some(progress))
+            run_fit(&env, Some(&a1), &settings, a.order, Some(progress)).map_err(|e| {
+                // Why no order can pass, when the envelope shows it.
+                let gaps = crate::pipeline::a1_conflict::a1_conflicts(&env, f);
+                // Where first and what to do last: a long message keeps both ends.
+                match crate::pipeline::a1_conflict::hint_parts(&gaps) {
+                    Some((at, todo)) => anyhow!("{at}; {e}; {todo}"),
+                    None => e.into(),
+                }
+            })
         }
         (None, None) => return Err(anyhow!("give a CONFIG or --envelope FILE")),
     };

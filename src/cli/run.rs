@@ -93,6 +93,13 @@ pub fn run(a: &RunArgs) -> Result<i32> {
         rep.size[1],
         if rep.noisy { "noisy" } else { "noise-free" }
     );
+    if let Some(ts) = rep.sample_time {
+        // Said once: every frequency below and in the figures is the data's divided by Ts.
+        outln!(
+            "  frequency per sample in the data, divided by sample_time = {} s: rad/s and Hz here and in the figures",
+            fmt_g(ts)
+        );
+    }
     outln!(
         "  envelope  {}, max {wmin} = {}",
         // The name report.json and the docs use (`theorem4_mu`), not the Rust one.
@@ -145,7 +152,17 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             rep.fit_error.clone().unwrap_or_default()
         ),
     }
-    for w in &rep.warnings {
+    // The fit's failure is on the `fit` line already.
+    let fit_warning = out
+        .fit
+        .as_ref()
+        .err()
+        .map(crate::pipeline::fit_failure_warning);
+    for w in rep
+        .warnings
+        .iter()
+        .filter(|w| Some(*w) != fit_warning.as_ref())
+    {
         outln!("  warning   {w}");
     }
     outln!(

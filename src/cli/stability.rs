@@ -3,7 +3,6 @@
 //! Exit 0 robustly stable for every bound given, 1 not (including a controller that does
 //! not stabilize the nominal plant), 2 error.
 
-use crate::model::Config;
 use crate::model::Controller;
 use crate::pipeline::stability;
 use anyhow::{anyhow, Result};
@@ -40,7 +39,7 @@ const LARGE_MODEL_STATES: usize = 200;
 
 /// Runs `rshape stability`.
 pub fn run(a: &StabilityArgs) -> Result<i32> {
-    let config = Config::load(&a.config)?;
+    let config = super::common::load_config(&a.config)?;
     let controller = Controller::load(&a.controller)?;
     if a.bounds.fit && a.out.is_none() {
         return Err(anyhow!(

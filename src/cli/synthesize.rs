@@ -2,7 +2,6 @@
 //! --out DIR [--json]`: the Glover–McFarlane controller of the config's plant, proved by Theorem 1
 //! (issue 22). Exit 0 proven robust for every bound given, 1 not, 2 error.
 
-use crate::model::Config;
 use crate::pipeline::synthesize;
 use anyhow::Result;
 use clap::Args;
@@ -60,7 +59,7 @@ const LARGE_PLANT_STATES: usize = 100;
 /// Runs `rshape synthesize`.
 pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     crate::synthesis::check_gamma_factor(a.gamma_factor)?;
-    let config = Config::load(&a.config)?;
+    let config = super::common::load_config(&a.config)?;
     // A large model's synthesis is dense linear algebra of O(n³) for minutes, silent while it
     // runs: say what is going on (issue 34: 200 modes ran minutes without a line).
     let f = &config.factorization;

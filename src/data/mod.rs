@@ -12,6 +12,8 @@
 //!   `Y`, `R` ([`SPECTRA_COLUMNS`]): [`read_closed_loop_csv`], [`parse_closed_loop_csv`];
 //! * standard-deviation and coherence files, turned into noise radii: [`read_std_csv`],
 //!   [`read_coherence_csv`] ([`StdData`]) and [`h1_random_error`];
+//! * normalized frequency axes (cycles or radians per sample, the config's `sample_time`):
+//!   [`denormalize_frf`], [`denormalize_std`], [`check_sample_time`];
 //! * envelope CSV files (`omega_rad_s,r_min[,a1_limit]`, as `rshape envelope` writes them):
 //!   [`read_envelope_csv`], [`parse_envelope_csv`];
 //! * the CSV layer under all of them, every error naming file and line: [`TableReader`]
@@ -21,6 +23,7 @@ pub(crate) mod closed_loop;
 pub(crate) mod envelope_csv;
 pub(crate) mod frf;
 pub(crate) mod reader;
+pub(crate) mod sample_time;
 pub(crate) mod std_file;
 pub(crate) mod table;
 
@@ -28,6 +31,7 @@ pub use closed_loop::{parse_closed_loop_csv, read_closed_loop_csv, SPECTRA_COLUM
 pub use envelope_csv::{parse_envelope_csv, read_envelope_csv};
 pub use frf::FrfData;
 pub use reader::{parse_frf_csv, read_frf_csv, Datum, FrfRows, MAX_CHANNEL};
+pub use sample_time::{check_sample_time, denormalize_frf, denormalize_std};
 pub use std_file::{h1_random_error, read_coherence_csv, read_std_csv, StdData};
 pub use table::{read_text, TableReader, MAX_RECORD_BYTES, MAX_RECORD_FIELDS};
 

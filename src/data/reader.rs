@@ -38,6 +38,7 @@ pub fn parse_frf_csv(text: &str, path: &Path) -> Result<FrfData> {
     let mut rows = FrfRows {
         table: TableReader::new(text.as_bytes(), path, HEADER)?,
         layout: Layout::default(),
+        sample_time: None,
     };
     rows.layout = Layout::of(&rows.table)?;
     let mut data = Vec::new();
@@ -73,6 +74,8 @@ struct Layout {
 pub struct FrfRows<'r> {
     table: TableReader<'r>,
     layout: Layout,
+    /// `Some(Ts)`: the frequency column is normalized (per sample), divided by `Ts`.
+    sample_time: Option<f64>,
 }
 
 impl FrfRows<'static> {
@@ -80,11 +83,23 @@ impl FrfRows<'static> {
     pub fn open(path: &Path) -> Result<Self> {
         let table = TableReader::open(path, HEADER)?;
         let layout = Layout::of(&table)?;
-        Ok(Self { table, layout })
+        Ok(Self {
+            table,
+            layout,
+            sample_time: None,
+        })
     }
 }
 
 impl FrfRows<'_> {
+    /// Reads the frequency column as normalized (cycles or radians per sample) and divides
+    /// it by `ts` seconds (the config's `sample_time`, [`crate::data::denormalize_frf`]); `None` keeps
+    /// the column's unit.
+    pub fn with_sample_time(mut self, ts: Option<f64>) -> Self {
+        self.sample_time = ts;
+        self
+    }
+
     /// Number of outputs `p` and inputs `m` of the data.
     pub fn size(&self) -> (usize, usize) {
         (self.layout.p, self.layout.m)
@@ -145,6 +160,10 @@ impl FrfRows<'_> {
                 "frequency {f:e} Hz overflows in rad/s (2π·f is beyond the largest number): is the column in Hz?"
             )));
         }
+        let omega = match self.sample_time {
+            Some(ts) => super::sample_time::denormalize(omega, ts, t.path(), line)?,
+            None => omega,
+        };
         let mut phi = DMatrix::zeros(l.p, l.m);
         for i in 0..l.p {
             for j in 0..l.m {

@@ -260,6 +260,18 @@ pub fn resolve_noise_for_channel(
     Ok(Some(resolved))
 }
 
+/// A std or coherence file on the config's frequency axis (its `sample_time`).
+fn on_axis(
+    cfg: &Config,
+    f: crate::data::StdData,
+    path: &std::path::Path,
+) -> Result<crate::data::StdData> {
+    match cfg.sample_time() {
+        Some(ts) => crate::data::denormalize_std(f, ts, path),
+        None => Ok(f),
+    }
+}
+
 /// The radii of a config's `[noise] std_file` for the data: the file belongs to the config's
 /// own data; for other data (`--data`) `<data stem>_std.csv` beside them is used.
 fn std_file_noise(
@@ -271,7 +283,8 @@ fn std_file_noise(
         return Err(Error::Invalid("no [noise] std_file in the config".into()));
     };
     let file = file_for_data(cfg, data, file, "std", "std_file")?;
-    let radii = read_std_csv(&file)?.radius_at(&file, &data.omega, out, inp, *k)?;
+    let std = on_axis(cfg, read_std_csv(&file)?, &file)?;
+    let radii = std.radius_at(&file, &data.omega, out, inp, *k)?;
     Ok(ResolvedNoise {
         description: format!("{k} × std_{out}_{inp} of {}", file.display()),
         radii,
@@ -296,7 +309,13 @@ fn coherence_noise(
     let k = sec.coverage.unwrap_or(3.0);
     let base = cfg.path.parent().unwrap_or(std::path::Path::new("."));
     let file = file_for_data(cfg, data, &base.join(file), "coherence", "coherence")?;
-    let gamma2 = read_coherence_csv(&file)?.values_at(&file, "coh", &data.omega, out, inp)?;
+    let gamma2 = on_axis(cfg, read_coherence_csv(&file)?, &file)?.values_at(
+        &file,
+        "coh",
+        &data.omega,
+        out,
+        inp,
+    )?;
     // SISO data are the channel already; MIMO data hold it at (out, inp).
     let at = if data.outputs() == 1 && data.inputs() == 1 {
         (0, 0)

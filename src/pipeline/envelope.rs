@@ -74,7 +74,7 @@ pub fn envelope_of_file(
     cli_noise: Option<f64>,
 ) -> Result<Envelope> {
     if config.closed_loop.is_none() {
-        let rows = FrfRows::open(data_path)?;
+        let rows = FrfRows::open(data_path)?.with_sample_time(config.sample_time());
         if cli_noise.is_none() {
             config.raw.noise.validate().map_err(|msg| Error::Config {
                 path: config.path.clone(),
@@ -93,7 +93,17 @@ pub fn envelope_of_file(
 /// Reads a config's data file (closed-loop spectra or FRF) and applies its `[channel]` when
 /// the data are larger than the model.
 pub fn load_data(config: &Config, data_path: &Path) -> Result<FrfData> {
-    select_channel(config, closed_loop::read_data(config, data_path)?)
+    select_channel(config, read_data_file(config, data_path)?)
+}
+
+/// Reads a data file of a config (closed-loop spectra or FRF) on the config's frequency
+/// axis: normalized frequencies are divided by its `sample_time`.  No `[channel]` applied.
+pub fn read_data_file(config: &Config, data_path: &Path) -> Result<FrfData> {
+    let data = closed_loop::read_data(config, data_path)?;
+    match config.sample_time() {
+        Some(ts) => crate::data::denormalize_frf(data, ts),
+        None => Ok(data),
+    }
 }
 
 /// Applies a config's `[channel]` to data larger than the model, as [`load_data`] does for

@@ -103,6 +103,15 @@ pub enum FitFailure {
     /// certified `r` (see [`crate::fit::FitError`]).
     #[error("fit: {0}")]
     Fit(#[from] crate::fit::FitError),
+    /// The fit failed and the envelope shows why: A1 leaves `r` no or little room between two
+    /// data ([`super::a1_conflict`]); the hint says where and what to do.
+    #[error("fit: {fit}; {hint}")]
+    A1Conflict {
+        /// The fit's own error.
+        fit: crate::fit::FitError,
+        /// Where A1 and the envelope conflict, and what to change.
+        hint: String,
+    },
     /// The fitted `r` could not be written as `r.json` (rshape's own document: a bug).
     #[error("r.json: {0}")]
     Json(String),
@@ -142,12 +151,15 @@ pub fn fit_r(
     };
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
-            let (r, t) = fit_auto(env, a1, &base, max, &FitOptions { progress })?;
+            let (r, t) = fit_auto(env, a1, &base, max, &FitOptions { progress })
+                .map_err(|e| explain(e, env, a1_model))?;
             (r, Some(t))
         }
         OrderChoice::Fixed(n) => {
             let s = FitSettings { order: n, ..base };
-            (fit_unit(env, a1, &s, &FitOptions { progress })?, None)
+            let r = fit_unit(env, a1, &s, &FitOptions { progress })
+                .map_err(|e| explain(e, env, a1_model))?;
+            (r, None)
         }
     };
     let text = crate::report::export::r_json(&result, table.as_deref());
@@ -163,6 +175,20 @@ pub fn fit_r(
         result,
         table,
     })
+}
+
+/// A fit failure with the reason no order can succeed, when the envelope shows one
+/// ([`super::a1_conflict`]).
+fn explain(
+    fit: crate::fit::FitError,
+    env: &Envelope,
+    a1_model: Option<&crate::model::Factorization>,
+) -> FitFailure {
+    let gaps = a1_model.map(|f| super::a1_conflict::a1_conflicts(env, f));
+    match gaps.and_then(|g| super::a1_conflict::hint(&g)) {
+        Some(hint) => FitFailure::A1Conflict { fit, hint },
+        None => FitFailure::Fit(fit),
+    }
 }
 
 /// Writes the exports of `rshape fit`'s outcome (`r.json`, `r.m`, `r.py`, `r.jl`) into `dir`

@@ -1,6 +1,7 @@
 //! The `rshape run` pipeline: envelope → check of the configured `r` → fit → certificate →
 //! exports → figures → `report.json`.  [`run`] computes, [`outputs::write_outputs`]
 //! writes; neither prints.
+pub mod a1_conflict;
 pub mod closed_loop;
 pub mod envelope;
 pub mod integration;
@@ -79,6 +80,15 @@ impl RunOptions<'_> {
     }
 }
 
+/// The warning [`run`] adds when the fit fails (one line), so that a caller printing the
+/// failure elsewhere can leave this one out.
+pub fn fit_failure_warning(e: &integration::FitFailure) -> String {
+    format!(
+        "fit failed: {}",
+        crate::report::fmt::one_line(&e.to_string())
+    )
+}
+
 /// Runs the computations of the pipeline on loaded inputs.  Only an envelope failure (bad
 /// sizes, a failed assumption at a datum) is an error; the fit and μ failures are kept in
 /// the outcome.  `options` give the global noise radius and the progress callbacks.
@@ -105,10 +115,7 @@ pub fn run(
         )
     });
     if let Err(e) = &fit {
-        warnings.push(format!(
-            "fit failed: {}",
-            crate::report::fmt::one_line(&e.to_string())
-        ));
+        warnings.push(fit_failure_warning(e));
     }
     let mu = match (&radii, &config.r) {
         (Some(rad), Some(r)) => {

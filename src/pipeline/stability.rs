@@ -65,7 +65,7 @@ pub fn bounds(config: &Config, given: Option<TransferFunction>) -> Vec<(String, 
 pub fn grid(config: &Config, data: Option<&Path>, poles: &[num_complex::Complex64]) -> Vec<f64> {
     let data_range = data
         .or(config.data.as_deref())
-        .and_then(|p| crate::data::read_frf_csv(p).ok())
+        .and_then(|p| super::envelope::read_data_file(config, p).ok())
         .filter(|d| !d.omega.is_empty())
         .map(|d| (d.omega[0], d.omega[d.omega.len() - 1]));
     let (lo, hi) = match data_range {

@@ -204,6 +204,17 @@ impl LogAxis {
                 break;
             }
         }
+        // A decade or more: linear steps would leave the lower decades unlabelled (1, 2, 3, 4
+        // on 0.02–4), so thin the 1-2-5 set to 1-3, else keep the decades.
+        if hi / lo >= 10.0 {
+            let t = with(&[1.0, 3.0]);
+            if t.len() >= 3 && t.len() <= n {
+                return t;
+            }
+            if wide.len() >= 2 {
+                return wide;
+            }
+        }
         // Narrow: linear steps of 1-2-2.5-5 × 10ᵏ.
         let top = 10f64.powf((hi - lo).log10().floor());
         for e in [1.0, 0.1, 0.01] {

@@ -54,6 +54,10 @@ pub struct RunReport {
     pub config: PathBuf,
     /// The data file.
     pub data: PathBuf,
+    /// The config's `sample_time` (s), when its data are on a normalized axis (per sample):
+    /// their frequencies were divided by it, so every frequency here is in rad/s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sample_time: Option<f64>,
     /// Number of data.
     pub n_data: usize,
     /// Outputs × inputs of the data.
@@ -147,6 +151,7 @@ impl RunReport {
             name: config.raw.name.clone(),
             config: config.path.clone(),
             data: data.path.clone(),
+            sample_time: config.sample_time(),
             n_data: env.len(),
             size: [data.outputs(), data.inputs()],
             method: env.method,

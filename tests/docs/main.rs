@@ -12,3 +12,4 @@ mod docs_commands;
 mod docs_figures;
 mod docs_snippets;
 mod docs_tables;
+mod shipped_examples;

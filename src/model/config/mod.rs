@@ -107,6 +107,11 @@ pub struct RawConfig {
     /// Data file, relative to the config file.
     #[serde(default)]
     pub data: Option<PathBuf>,
+    /// Sampling time `Ts` in seconds when the data files' frequency column is normalized
+    /// (cycles/sample as `freq_hz`, rad/sample as `omega_rad_s`): frequencies are divided by
+    /// `Ts` ([`crate::data::denormalize_frf`]).  Applies to the FRF, std and coherence files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_time: Option<f64>,
     /// The nominal factorization (or give `[physical]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelSection>,
@@ -131,6 +136,26 @@ pub struct RawConfig {
     /// The weight `V` of the closed-loop model (eq. (2)), the analogue of `[r]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub v: Option<RSection>,
+}
+
+impl RawConfig {
+    /// The files a config at `path` makes a run read, itself first (see
+    /// [`Config::files_read`]); from the text alone, without building the model (a large
+    /// `[plant] file` takes minutes to factor).
+    pub fn files_read(&self, path: &Path) -> Vec<PathBuf> {
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut files = vec![path.to_path_buf()];
+        files.extend(self.data.as_ref().map(|d| base.join(d)));
+        files.extend(self.noise.std_file.as_ref().map(|f| base.join(f)));
+        files.extend(self.noise.coherence.as_ref().map(|c| base.join(c)));
+        files.extend(
+            self.plant
+                .as_ref()
+                .and_then(|p| p.file.as_ref())
+                .map(|f| base.join(f)),
+        );
+        files
+    }
 }
 
 /// A loaded, validated config.
@@ -200,26 +225,19 @@ fn tf_rows(
 }
 
 impl Config {
+    /// The sampling time of a normalized frequency axis (`sample_time`), if the config has
+    /// one: the data files' frequencies are per sample and are divided by it.
+    pub fn sample_time(&self) -> Option<f64> {
+        self.raw.sample_time
+    }
+
     /// Every file this config makes a run read besides itself: the data, the noise
     /// `std_file` or `coherence`, a `[plant] file` (resolved against the config's folder).
     /// The output checks compare every output path with these, so that no figure or
     /// revised config is written over an input.
     pub fn files_read(&self) -> Vec<PathBuf> {
-        let base = self.path.parent().unwrap_or(Path::new("."));
-        let mut files = vec![self.path.clone()];
-        files.extend(self.data.clone());
-        files.extend(self.noise_std.as_ref().map(|(p, _)| p.clone()));
-        files.extend(self.raw.noise.coherence.as_ref().map(|c| base.join(c)));
-        files.extend(
-            self.raw
-                .plant
-                .as_ref()
-                .and_then(|p| p.file.as_ref())
-                .map(|f| base.join(f)),
-        );
-        files
+        self.raw.files_read(&self.path)
     }
-
     /// Reads and validates a config file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = crate::util::read_text_file(path)?;
@@ -303,6 +321,9 @@ impl Config {
             None => None,
         };
         raw.noise.validate().map_err(err)?;
+        if let Some(ts) = raw.sample_time {
+            crate::data::check_sample_time(ts).map_err(err)?;
+        }
         let base = path.parent().unwrap_or(Path::new("."));
         let data = raw.data.as_ref().map(|d| base.join(d));
         let noise_std = match (&raw.noise.std_file, raw.noise.std_factor) {

@@ -41,6 +41,26 @@ fn log_ticks_are_round() {
     assert!(t.len() >= 3, "{t:?}");
 }
 
+/// Two decades in a small panel (six labels; the DaISy CD player arm's Bode panels,
+/// 0.0245–2.5 rad/s): every decade keeps a label, never linear steps 1, 2, 3, 4 that leave
+/// the lower decades bare.
+#[test]
+fn log_ticks_label_every_decade_of_a_two_decade_panel() {
+    for (lo, hi) in [(0.0245, 2.5), (0.0245, 4.0), (0.02, 3.0), (0.15, 40.0)] {
+        let t = LogAxis::new(lo, hi).ticks(6);
+        assert!(t.len() >= 2 && t.len() <= 6, "{lo}–{hi}: {t:?}");
+        let d0 = lo.log10().ceil() as i32;
+        let d1 = hi.log10().floor() as i32;
+        for d in d0..=d1 {
+            let v = 10f64.powi(d);
+            assert!(
+                t.iter().any(|x| (x / v - 1.0).abs() < 1e-9),
+                "{lo}–{hi}: {v} in {t:?}"
+            );
+        }
+    }
+}
+
 #[test]
 fn phase_ticks_are_multiples_of_90() {
     let ax = PhaseAxis::covering([-90.0, -235.0]);
