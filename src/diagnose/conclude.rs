@@ -83,7 +83,7 @@ impl Rules for Fits<'_, '_> {
 }
 
 /// Concludes a diagnosis from the search's result `res` (its first two nodes the configured
-/// model and its retune, as [`crate::diagnose::search::beam::roots`] makes them): the
+/// model and its retune, as `search::beam::roots` makes them): the
 /// first-level candidates, the set kept, its last refit and the report.  `phases` holds the
 /// time spent before the search; `t0` when the diagnosis began.
 pub fn conclude(

@@ -83,21 +83,21 @@ pub struct SearchResult {
     pub expanded: usize,
     /// Joint refits.
     pub joint_refits: usize,
-    /// Joint refits given up ([`GIVE_UP_FACTOR`]).
+    /// Joint refits given up (`GIVE_UP_FACTOR`).
     pub gave_up: usize,
     /// Wall time of the screens and of the joint refits.
     pub phases: Phases,
     /// Frequencies (Hz) of the modes proposed at residual peaks and refit jointly
-    /// ([`super::peak_modes`]), whatever became of them.
+    /// (`search::peak_modes`), whatever became of them.
     pub peak_modes_hz: Vec<f64>,
     /// Frequencies (Hz) of each group of modes proposed together and refit jointly
-    /// ([`super::multi_mode`]), whatever became of them.
+    /// (`search::multi_mode`), whatever became of them.
     pub multi_modes_hz: Vec<Vec<f64>>,
 }
 
 impl SearchResult {
     /// The result of a search done elsewhere (or constructed): its `nodes` (the configured
-    /// model and its retune first, as [`roots`] makes them) and the index of the chosen one;
+    /// model and its retune first, as `search::beam::roots` makes them) and the index of the chosen one;
     /// no first-level screen, refusal or statistics.
     pub fn of_nodes(nodes: Vec<Node>, chosen: usize) -> Self {
         SearchResult {
