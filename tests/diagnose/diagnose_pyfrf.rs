@@ -314,6 +314,7 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 ///   8.7e-4, +0.60; 3668.94 Hz, 2.02e-4, +1.20) — with ΔBIC 46,639; but the admissibility
 ///   rule "negligible" refuses it: misfit_rms 16.15 → 16.08 (0.45 % < 1 %) over the whole
 ///   20–5000 Hz band, where the modes still missing elsewhere dominate misfit_rms.
+///
 /// So the loss is the two rules together, both as issue 33 specifies them; lifting it needs
 /// a peak rule that tells a shoulder from a mode's own residue (a window of the mode's
 /// half-power band, not 0.3 %) and a size rule judged where the mode acts rather than on
