@@ -71,6 +71,7 @@ fn refused(
             model: m,
             measures: after,
             reference: &BEFORE,
+            reference_model: None,
             allow_mains: mains,
         },
         d,
