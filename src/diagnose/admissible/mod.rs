@@ -20,9 +20,7 @@
 //!   median over the top n lines (5 % of them, at most 20), divided by √n), a friction pole whose
 //!   relative effect at the band bottom `p/ω_min` is below the noise's relative resolution
 //!   there (`r/|G|`), or any effect whose removal changes `misfit_rms` by less than 1 %
-//!   (unless it is what makes the model consistent), whatever its ΔBIC — for a mode, the
-//!   `misfit_rms` over the lines where it acts (within `max(5·2ζω_n, 3 lines)` of `ω_n`),
-//!   not the whole band's, which dilutes a local term's size by the band's width;
+//!   (unless it is what makes the model consistent), whatever its ΔBIC;
 //! * **not identified** — from the refit's covariance `(2JᵀJ)⁻¹`: a defining parameter of
 //!   the effect (`ω_n`, `ζ`, a pole, a delay) with relative σ > 1/3, or correlated above 0.99
 //!   with a parameter of another term.  The `ζ` of a mode narrower than the lines (seen on its
@@ -117,9 +115,6 @@ pub struct Child<'a> {
     pub measures: &'a Measures,
     /// The measures of the model it is compared against (the parent, or the retune).
     pub reference: &'a Measures,
-    /// The model a mode's local size is compared against (the parent the joint refit
-    /// started from); `None`: the refit with the mode removed.
-    pub reference_model: Option<&'a PhysicalModel>,
     /// Write modes at mains frequencies anyway.
     pub allow_mains: bool,
 }

@@ -71,7 +71,6 @@ fn refused(
             model: m,
             measures: after,
             reference: &BEFORE,
-            reference_model: None,
             allow_mains: mains,
         },
         d,

@@ -74,7 +74,6 @@ pub(super) fn judge(
                 model: &model,
                 measures: &m,
                 reference: j.reference,
-                reference_model: Some(&node.model),
                 allow_mains: j.allow_mains,
             },
             data,

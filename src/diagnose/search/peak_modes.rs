@@ -9,10 +9,7 @@
 //!
 //! Peaks at a mode the model already has (what is left of its fit: a retune's job, or a
 //! cancelling pair if a second mode were put there) and at the screen's own mode candidate
-//! are skipped — except a **shoulder** ([`is_shoulder`]): a peak far out of the noise whose
-//! line lies outside the existing mode's half-power band, proposed as a second mode beside
-//! it (pyfrf's 3665 Hz shoulder of the 3669 Hz mode, 28.6 noise units 2.5 Hz from a mode
-//! 1.5 Hz half-wide).
+//! are skipped.
 
 use super::peaks::{find_peaks, fit_at, residual, AtPeak, MAX_PEAKS};
 #[cfg(test)]
@@ -49,17 +46,14 @@ pub(super) fn peak_modes(
         .take(MAX_PEAKS)
         .filter(|p| {
             let inside = |w: f64| (p.lo..=p.hi).contains(&w);
-            !taken.iter().any(|w| inside(*w))
-                && (p.height >= SHOULDER_MIN_HEIGHT
-                    || !model.mode.iter().any(|m| inside(m.omega_n)))
+            !taken.iter().any(|w| inside(*w)) && !model.mode.iter().any(|m| inside(m.omega_n))
         })
-        .map(|p| shoulder_start(p, model, &data.omega, &e))
         .collect();
     let ln2f = (2.0 * data.n_data() as f64).ln();
     let n_new = Cand::Mode.n_params(data.n_ch()) as f64 * ln2f;
     let w_band = (data.omega[0], *data.omega.last().expect("data"));
-    // (the fit, whether it is proposed singly, whether as a shoulder).
-    let fits: Vec<(Screened, bool, bool)> = peaks
+    // (the fit, whether it passes on all lines).
+    let fits: Vec<(Screened, bool)> = peaks
         .par_iter()
         .filter_map(|p| {
             let AtPeak {
@@ -70,19 +64,6 @@ pub(super) fn peak_modes(
             } = fit_at(&pb, p, data)?;
             let w = mods.theta[0].exp();
             if !(p.lo..=p.hi).contains(&w) {
-                return None;
-            }
-            // A peak at a mode of the model: proposed only as a shoulder (see `is_shoulder`).
-            let beside = model
-                .mode
-                .iter()
-                .any(|m| (p.lo..=p.hi).contains(&m.omega_n));
-            if !model
-                .mode
-                .iter()
-                .filter(|m| (p.lo..=p.hi).contains(&m.omega_n))
-                .all(|m| is_shoulder(w, m))
-            {
                 return None;
             }
             let measures = pb.measures(&mods);
@@ -98,94 +79,33 @@ pub(super) fn peak_modes(
             );
             let plausible = no_fit.is_none() && flags.is_empty();
             let locally = plausible && 2.0 * local_gain - n_new > min_delta_bic;
-            // A shoulder is judged where it stands: fitted alone on top of its neighbour as
-            // it is (whose fit absorbed it, broadened), its whole-band ΔBIC means nothing;
-            // the joint refit, which moves both, decides.
-            let on_band = plausible && delta_bic > min_delta_bic && improves(&measures, &cur);
-            let shoulder = !on_band && beside && locally;
-            let passes = on_band || shoulder;
+            let passes = plausible && delta_bic > min_delta_bic && improves(&measures, &cur);
             (passes || locally).then_some((
                 Screened {
                     cand: Cand::Mode,
                     mods,
                     v,
                     measures,
-                    // A shoulder's screen ΔBIC is its local one (see above).
-                    delta_bic: if shoulder {
-                        2.0 * local_gain - n_new
-                    } else {
-                        delta_bic
-                    },
+                    delta_bic,
                     flags,
                     no_fit,
                     jtj,
                 },
                 passes,
-                shoulder,
             ))
         })
         .collect();
     let (mut out, mut local): (Vec<_>, Vec<_>) = fits.into_iter().partition(|f| f.1);
-    // Shoulders apart: their whole-band ΔBIC (negative) would rank them last and cut them.
-    let (mut shoulders, mut out): (Vec<_>, Vec<_>) = out.drain(..).partition(|f| f.2);
     out.sort_by(|a, b| b.0.delta_bic.total_cmp(&a.0.delta_bic));
-    shoulders.sort_by(|a, b| b.0.delta_bic.total_cmp(&a.0.delta_bic));
     local.sort_by(|a, b| b.0.delta_bic.total_cmp(&a.0.delta_bic));
-    let mut singles = one_per_resonance(out);
-    singles.extend(one_per_resonance(shoulders));
-    Ok((singles, one_per_resonance(local)))
-}
-
-/// A residual peak this high (noise units, `|e|/r`) whose window holds a mode of the model
-/// may be a shoulder: a mode is fitted there, and proposed when [`is_shoulder`].
-pub const SHOULDER_MIN_HEIGHT: f64 = 10.0;
-
-/// Whether a mode fitted at `w` (rad/s) at a residual peak whose window holds the model's
-/// mode `m` is a **shoulder** — a mode of its own beside `m` — rather than what is left of
-/// `m`'s fit: the peak stands at least [`SHOULDER_MIN_HEIGHT`] noise units out of the noise
-/// (the per-peak account's statistic; checked by the caller) and the mode fitted there on
-/// top of the model lies outside `m`'s half-power band `ω_n(1 ± ζ)` (a misfit of `m`'s own
-/// frequency, damping or residue is fitted within it).  A shoulder is proposed as a new mode
-/// next to `m`; the joint refit and the admissibility rules decide (a close pair whose
-/// residues cancel is refused as an artefact).
-pub(super) fn is_shoulder(w: f64, m: &crate::model::physical::ModeSpec) -> bool {
-    (w - m.omega_n).abs() > m.zeta * m.omega_n
-}
-
-/// A peak whose window holds a mode of the model is fitted from the highest residual line
-/// (`e`, noise units) of its window outside every such mode's half-power band (where a
-/// shoulder stands; started at the mode's own line, the lone fit slides onto the mode or
-/// away from both); unchanged when none reaches [`SHOULDER_MIN_HEIGHT`].
-fn shoulder_start(
-    p: super::peaks::RawPeak,
-    model: &PhysicalModel,
-    omega: &[f64],
-    e: &[f64],
-) -> super::peaks::RawPeak {
-    let inside: Vec<_> = model
-        .mode
-        .iter()
-        .filter(|m| (p.lo..=p.hi).contains(&m.omega_n))
-        .collect();
-    if inside.is_empty() {
-        return p;
-    }
-    let best = (0..omega.len())
-        .filter(|&k| {
-            (p.lo..=p.hi).contains(&omega[k]) && inside.iter().all(|m| is_shoulder(omega[k], m))
-        })
-        .max_by(|a, b| e[*a].total_cmp(&e[*b]));
-    match best {
-        Some(k) if e[k] >= SHOULDER_MIN_HEIGHT => super::peaks::RawPeak { k, ..p },
-        _ => p,
-    }
+    Ok((one_per_resonance(out), one_per_resonance(local)))
 }
 
 /// One proposal per resonance (two peaks' fits that met at one frequency are one), at most
 /// [`MAX_PEAK_MODES`].
-fn one_per_resonance(fits: Vec<(Screened, bool, bool)>) -> Vec<Screened> {
+fn one_per_resonance(fits: Vec<(Screened, bool)>) -> Vec<Screened> {
     let mut kept: Vec<Screened> = Vec::new();
-    for (sc, _, _) in fits {
+    for (sc, _) in fits {
         let w = sc.mods.theta[0].exp();
         if !kept
             .iter()
