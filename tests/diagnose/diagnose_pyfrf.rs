@@ -321,8 +321,29 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 /// the whole band's misfit_rms — not changed here (the acceptance suite is built on them).
 /// A longer walk (14 steps, measured once, session 10) does not find it either: steps 11–14
 /// add 4163, 851 and 3035 Hz and a delay.
+///
+/// Both rules changed, tried and not landed (disc33z, commit 7c5193a, reverted by e29aab9):
+/// (1) a mode's "negligible" size judged on `misfit_rms` over the lines within
+/// `max(5·2ζω_n, 3 lines)` of it, against the parent model; (2) a residual peak whose window
+/// holds a mode of the model proposed anyway when it reaches 10 noise units, fitted from the
+/// window's highest line outside that mode's half-power band, kept when the fit lands
+/// outside it, screened on its local ΔBIC.  Measured (release, this test): the peak the
+/// residual locates is at the 3669 Hz line itself (16.4 noise units at step 9, 18.7 at step
+/// 10; the 28.6 at 3666 Hz is `e`, not the locating `s`), so a rule "peak line outside the
+/// mode's half-power band" alone proposes nothing; started at 3665 Hz the lone mode fits to
+/// 3662.5–3662.6 Hz (local ΔBIC 40,700–52,000, whole-band ΔBIC −103,000 to −134,000: on top
+/// of a neighbour whose broadened damping absorbed it, the lone fit is no measure); its joint
+/// refit is then an admissible child at steps 9 and 10 (joint ΔBIC 42,652 and 44,585, no
+/// refusal), but each one-effect step chooses a larger child (3008.7 Hz at step 10, 4163 Hz
+/// at step 11) and at step 11 the lone fit from 3666 Hz slides to 3636.5 Hz (ζ 6.0e-3, out
+/// of the window): the walk still ends, at 10 and at 11 steps, without 3664 Hz.  The local
+/// size rule also refused a joint refit at step 9 whose moved neighbour (3668.5 Hz) changed
+/// the local `misfit_rms` by 0.81 %, and makes the 1e-16-residue mode of
+/// `admissible::tests::a_mode_the_covariance_does_not_determine_is_not_identified`
+/// negligible before the covariance rule is reached.  The release discovery suites were
+/// not run on it.
 #[test]
-#[ignore = "the whole band, ten steps: about 60 s in release; fails today: no mode within 3 Hz of 3664 Hz — the data hold three modes there (3665.1, 3668.9, 3689.3 Hz, pyfrf_3665_local.py), the walk ends with 3668.5 and 3689.2 Hz; the 3665 Hz shoulder is never proposed (its peak lies within the 0.3 % window of the 3668.5 Hz mode) and, forced in, is refused as negligible (misfit_rms −0.45 % over the whole band, ΔBIC 46,639)"]
+#[ignore = "the whole band, ten steps: about 60 s in release; fails today: no mode within 3 Hz of 3664 Hz — the data hold three modes there (3665.1, 3668.9, 3689.3 Hz, pyfrf_3665_local.py), the walk ends with 3668.5 and 3689.2 Hz; the 3665 Hz shoulder is never proposed (its peak lies within the 0.3 % window of the 3668.5 Hz mode) and, forced in, is refused as negligible (misfit_rms −0.45 % over the whole band, ΔBIC 46,639); with a local size rule and shoulder proposals (7c5193a, not landed) it is an admissible child at steps 9–10 but never the largest"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);
