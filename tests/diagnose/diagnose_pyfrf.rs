@@ -336,7 +336,8 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 /// refit is then an admissible child at steps 9 and 10 (joint ΔBIC 42,652 and 44,585, no
 /// refusal), but each one-effect step chooses a larger child (3008.7 Hz at step 10, 4163 Hz
 /// at step 11) and at step 11 the lone fit from 3666 Hz slides to 3636.5 Hz (ζ 6.0e-3, out
-/// of the window): the walk still ends, at 10 and at 11 steps, without 3664 Hz.  The local
+/// of the window): the walk still ends, at 10, 11 and 14 steps, without 3664 Hz (steps 11–14
+/// add 4163, 851 and 3035 Hz and a delay, as without the rules).  The local
 /// size rule also refused a joint refit at step 9 whose moved neighbour (3668.5 Hz) changed
 /// the local `misfit_rms` by 0.81 %, and makes the 1e-16-residue mode of
 /// `admissible::tests::a_mode_the_covariance_does_not_determine_is_not_identified`
