@@ -18,12 +18,14 @@
 //! * `search`: `rank` (screening and physical plausibility), `node` (an effect set written
 //!   into the model), `beam` (the beam search over effect sets with joint refits),
 //!   `first_level`, `polish` (the consistency polish), `ties` (sets the data cannot tell
-//!   apart), `holdout` (the final set checked on held-out data), `backward` (backward
+//!   apart), `holdout` (the final set checked on held-out data), `choice` (the set kept after the
+//!   holdout and the elimination), `backward` (backward
 //!   elimination), `peaks` (every peak of the residual and its fate), `peak_modes` (a mode
 //!   proposed at each peak), `assign` (added modes matched to the refit's), `final_effects`,
 //!   `final_refit`;
 //! * on top: `engine` (the whole `diagnose`: entry points [`diagnose`],
-//!   [`diagnose_channels`], [`apply_candidate`]), `verdict` (the verdict and the stop
+//!   [`diagnose_channels`], [`apply_candidate`]), `conclude` (after the search: the set kept,
+//!   the report; [`conclude`] also concludes a search done elsewhere), `verdict` (the verdict and the stop
 //!   explanation in words), `report` (what it reports; the per-peak account in
 //!   `peak_account`), `changes` (the
 //!   parameter changes and their σ), [`admissible`] (physical admissibility of a refit),
@@ -38,6 +40,7 @@ pub mod admissible;
 pub(crate) mod agreement;
 pub(crate) mod changes;
 pub(crate) mod compare;
+pub(crate) mod conclude;
 pub(crate) mod effects;
 pub(crate) mod engine;
 pub(crate) mod factor_form;
@@ -55,6 +58,7 @@ pub use changes::{changes, Changes, CommonGain, ParamChange};
 pub use compare::{
     compare, misfit, prepare, Band, CompareReport, CompareRow, CompareVerdict, PlantModel, Siso,
 };
+pub use conclude::conclude;
 pub use effects::candidates::{Cand, Sel, EFFECT_NAMES};
 pub use engine::{apply_candidate, apply_chosen, diagnose, diagnose_channels};
 pub use factor_form::physical_from_factors;
@@ -74,7 +78,7 @@ pub use report::{
 };
 pub use revision::{params_text, write_revision, Apply, Revise, Revision};
 pub use search::backward::eliminate;
-pub use search::beam::SearchSettings;
+pub use search::beam::{SearchResult, SearchSettings};
 pub use search::final_effects::final_effects;
 pub use search::holdout::{model_of, same_set};
 pub use search::node::{add_effect, Node};

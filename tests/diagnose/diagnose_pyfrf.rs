@@ -299,15 +299,52 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 /// single-mode compromise 3663.8 Hz (ζ 7.6e-4; a single mode's least-squares optimum there
 /// is 3664.7 Hz, ζ 6.6e-4); step 8 adds 3668.6 Hz and its joint refit moves the compromise
 /// mode on to the unexplained 3689 Hz peak; the walk ends (ten steps) with 3668.5 and
-/// 3689.2 Hz and the 3665 Hz mode missing.  No admissibility rule refused anything there:
-/// the greedy one-mode steps with free joint refits lose the weak mode when its compromise
-/// slot is taken over; the next steps add modes elsewhere (4694, 3009 Hz).  A longer walk
-/// (14 steps, measured once) does not find it either: steps 11–14 add 4163, 851 and
-/// 3035 Hz and a delay; the 3665 Hz shoulder is absorbed by the 3668.6 Hz mode's broadened
-/// damping (ζ 3.9e-4, against 2.0e-4 in the three-mode fit) and never shows as a residual
-/// peak of the per-peak account.
+/// 3689.2 Hz (ζ 3.98e-4 and 3.09e-4) and the 3665 Hz mode missing.  Why (measured on the
+/// tenth step's model, issue 33 disc33y): the mode is **never proposed, and would be refused
+/// if it were**.
+/// * Never proposed: the residual keeps a shoulder peak, 28.6 noise units at 3666 Hz (27.2
+///   at 3667, falling to 20.0 at the 3669 Hz line), but a residual peak's window is at least
+///   ±0.3 % (`peaks::MIN_WINDOW_REL`, ±11 Hz here) and a peak whose window holds a mode of
+///   the model is skipped as "what is left of its fit" (`peak_modes`, the guard against
+///   cancelling pairs); no mode candidate, refusal or peak line falls in 3640–3710 Hz at
+///   steps 9 and 10.  No admissibility rule is involved up to here.
+/// * Proposed by hand (a mode at 3665.1 Hz, ζ 8.7e-4, written into that model and refit
+///   jointly): it refits to 3664.4 Hz (ζ 7.3e-4, residue +0.50) and its neighbour returns
+///   to 3668.94 Hz (ζ 2.02e-4, residue +1.23) — the three-mode local fit above (3665.1 Hz,
+///   8.7e-4, +0.60; 3668.94 Hz, 2.02e-4, +1.20) — with ΔBIC 46,639; but the admissibility
+///   rule "negligible" refuses it: misfit_rms 16.15 → 16.08 (0.45 % < 1 %) over the whole
+///   20–5000 Hz band, where the modes still missing elsewhere dominate misfit_rms.
+///
+/// So the loss is the two rules together, both as issue 33 specifies them; lifting it needs
+/// a peak rule that tells a shoulder from a mode's own residue (a window of the mode's
+/// half-power band, not 0.3 %) and a size rule judged where the mode acts rather than on
+/// the whole band's misfit_rms — not changed here (the acceptance suite is built on them).
+/// A longer walk (14 steps, measured once, session 10) does not find it either: steps 11–14
+/// add 4163, 851 and 3035 Hz and a delay.
+///
+/// Both rules changed, tried and not landed (disc33z, commit 7c5193a, reverted by e29aab9):
+/// (1) a mode's "negligible" size judged on `misfit_rms` over the lines within
+/// `max(5·2ζω_n, 3 lines)` of it, against the parent model; (2) a residual peak whose window
+/// holds a mode of the model proposed anyway when it reaches 10 noise units, fitted from the
+/// window's highest line outside that mode's half-power band, kept when the fit lands
+/// outside it, screened on its local ΔBIC.  Measured (release, this test): the peak the
+/// residual locates is at the 3669 Hz line itself (16.4 noise units at step 9, 18.7 at step
+/// 10; the 28.6 at 3666 Hz is `e`, not the locating `s`), so a rule "peak line outside the
+/// mode's half-power band" alone proposes nothing; started at 3665 Hz the lone mode fits to
+/// 3662.5–3662.6 Hz (local ΔBIC 40,700–52,000, whole-band ΔBIC −103,000 to −134,000: on top
+/// of a neighbour whose broadened damping absorbed it, the lone fit is no measure); its joint
+/// refit is then an admissible child at steps 9 and 10 (joint ΔBIC 42,652 and 44,585, no
+/// refusal), but each one-effect step chooses a larger child (3008.7 Hz at step 10, 4163 Hz
+/// at step 11) and at step 11 the lone fit from 3666 Hz slides to 3636.5 Hz (ζ 6.0e-3, out
+/// of the window): the walk still ends, at 10, 11 and 14 steps, without 3664 Hz (steps 11–14
+/// add 4163, 851 and 3035 Hz and a delay, as without the rules).  The local
+/// size rule also refused a joint refit at step 9 whose moved neighbour (3668.5 Hz) changed
+/// the local `misfit_rms` by 0.81 %, and makes the 1e-16-residue mode of
+/// `admissible::tests::a_mode_the_covariance_does_not_determine_is_not_identified`
+/// negligible before the covariance rule is reached.  The release discovery suites were
+/// not run on it.
 #[test]
-#[ignore = "the whole band, ten steps: about 60 s in release; fails today: no mode within 3 Hz of 3664 Hz — the data hold three modes there (3665.1, 3668.9, 3689.3 Hz, pyfrf_3665_local.py), the walk ends with 3668.5 and 3689.2 Hz (the weak 3665 Hz mode lost when step 8's refit moves its compromise slot to 3689 Hz)"]
+#[ignore = "the whole band, ten steps: about 60 s in release; fails today: no mode within 3 Hz of 3664 Hz — the data hold three modes there (3665.1, 3668.9, 3689.3 Hz, pyfrf_3665_local.py), the walk ends with 3668.5 and 3689.2 Hz; the 3665 Hz shoulder is never proposed (its peak lies within the 0.3 % window of the 3668.5 Hz mode) and, forced in, is refused as negligible (misfit_rms −0.45 % over the whole band, ΔBIC 46,639); with a local size rule and shoulder proposals (7c5193a, not landed) it is an admissible child at steps 9–10 but never the largest"]
 fn pyfrf_accelerance_whole_band() {
     let data = pyfrf(20.0, 5000.0);
     let steps = walk(&data, 10);

@@ -24,6 +24,7 @@ mod diagnose_holdout;
 mod diagnose_honest_report;
 mod diagnose_mimo;
 mod diagnose_output_effects;
+mod diagnose_path_after_elimination;
 mod diagnose_path_after_holdout;
 mod diagnose_progress;
 mod diagnose_pyfrf;

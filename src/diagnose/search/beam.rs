@@ -75,7 +75,7 @@ pub struct SearchResult {
     /// Index of the chosen node.
     pub chosen: usize,
     /// The root's screened candidates (first level) and the children made of them.
-    pub first_level: Vec<(Screened, Option<Node>, Option<Refusal>)>,
+    pub(crate) first_level: Vec<(Screened, Option<Node>, Option<Refusal>)>,
     /// Effects whose joint refit passed the likelihood but not physical admissibility
     /// ([`crate::diagnose::admissible`]), one per (effect, rule, frequency), in the order met.
     pub refused: Vec<(usize, Refusal)>,
@@ -83,16 +83,36 @@ pub struct SearchResult {
     pub expanded: usize,
     /// Joint refits.
     pub joint_refits: usize,
-    /// Joint refits given up ([`GIVE_UP_FACTOR`]).
+    /// Joint refits given up (`GIVE_UP_FACTOR`).
     pub gave_up: usize,
     /// Wall time of the screens and of the joint refits.
     pub phases: Phases,
     /// Frequencies (Hz) of the modes proposed at residual peaks and refit jointly
-    /// ([`super::peak_modes`]), whatever became of them.
+    /// (`search::peak_modes`), whatever became of them.
     pub peak_modes_hz: Vec<f64>,
     /// Frequencies (Hz) of each group of modes proposed together and refit jointly
-    /// ([`super::multi_mode`]), whatever became of them.
+    /// (`search::multi_mode`), whatever became of them.
     pub multi_modes_hz: Vec<Vec<f64>>,
+}
+
+impl SearchResult {
+    /// The result of a search done elsewhere (or constructed): its `nodes` (the configured
+    /// model and its retune first, as `search::beam::roots` makes them) and the index of the chosen one;
+    /// no first-level screen, refusal or statistics.
+    pub fn of_nodes(nodes: Vec<Node>, chosen: usize) -> Self {
+        SearchResult {
+            nodes,
+            chosen,
+            first_level: vec![],
+            refused: vec![],
+            expanded: 0,
+            joint_refits: 0,
+            gave_up: 0,
+            phases: Phases::default(),
+            peak_modes_hz: vec![],
+            multi_modes_hz: vec![],
+        }
+    }
 }
 
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {

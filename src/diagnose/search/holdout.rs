@@ -11,6 +11,7 @@
 
 use crate::diagnose::effects::candidates::Cand;
 use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::problem::Problem;
 use crate::diagnose::lsq::retune::{cost, retune_within};
 use crate::diagnose::report::Holdout;
 use crate::diagnose::search::node::{add_effect, Node};
@@ -18,87 +19,6 @@ use crate::diagnose::search::rank::{EXTRAPOLATION_SPLIT, MIN_SPLIT_DATA};
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
-
-/// How many next-best effect sets are tried when the holdout drops part of the chosen one.
-pub const MAX_ALTERNATIVES: usize = 3;
-
-/// The chosen set after the holdout, or a next-best set when the holdout drops part of it.
-#[derive(Debug, Clone)]
-pub struct Passing {
-    /// The node kept (its model refit without what the holdout dropped).
-    pub node: Node,
-    /// The holdout rows of the kept set.
-    pub holdout: Vec<Holdout>,
-    /// Labels the holdout dropped from the search's chosen set.
-    pub dropped: Vec<String>,
-    /// The index in the search's nodes of the set kept instead of the chosen one, when one
-    /// was (issue 20: a spurious chosen mode must not cost a whole step).
-    pub replaced_by: Option<usize>,
-}
-
-/// The next-best effect sets after `chosen`: the search's nodes with effects, by BIC, not
-/// the chosen set ([`same_set`]), one per set, at most `cap`.
-pub fn alternatives(nodes: &[Node], chosen: usize, cap: usize) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..nodes.len())
-        .filter(|i| *i != chosen && !nodes[*i].configured && !nodes[*i].effects.is_empty())
-        .filter(|i| !same_set(&nodes[*i].effects, &nodes[chosen].effects))
-        .collect();
-    order.sort_by(|a, b| nodes[*a].bic.total_cmp(&nodes[*b].bic));
-    let mut out: Vec<usize> = Vec::new();
-    for i in order {
-        if !out
-            .iter()
-            .any(|o| same_set(&nodes[*o].effects, &nodes[i].effects))
-        {
-            out.push(i);
-        }
-    }
-    out.truncate(cap);
-    out
-}
-
-/// Runs the final holdout `check` (which drops failing effects from a node and returns its
-/// rows and the labels dropped) on the chosen node; when it drops something, tries the next
-/// [`MAX_ALTERNATIVES`] sets of [`alternatives`] in BIC order and keeps the first whose
-/// holdout drops nothing and that holds more effects than the reduced chosen set.  Without
-/// this a spurious chosen mode (one the data do not confirm on held-out lines) made
-/// `diagnose` report "no candidate passes" though a next-best set passed: a whole step lost.
-pub fn first_passing<F>(nodes: &[Node], chosen: usize, mut check: F) -> Result<Passing>
-where
-    F: FnMut(&mut Node) -> Result<(Vec<Holdout>, Vec<String>)>,
-{
-    let mut node = nodes[chosen].clone();
-    let (holdout, dropped) = check(&mut node)?;
-    if dropped.is_empty() {
-        return Ok(Passing {
-            node,
-            holdout,
-            dropped,
-            replaced_by: None,
-        });
-    }
-    for i in alternatives(nodes, chosen, MAX_ALTERNATIVES) {
-        if nodes[i].effects.len() <= node.effects.len() {
-            continue;
-        }
-        let mut alt = nodes[i].clone();
-        let (alt_holdout, alt_dropped) = check(&mut alt)?;
-        if alt_dropped.is_empty() {
-            return Ok(Passing {
-                node: alt,
-                holdout: alt_holdout,
-                dropped,
-                replaced_by: Some(i),
-            });
-        }
-    }
-    Ok(Passing {
-        node,
-        holdout,
-        dropped,
-        replaced_by: None,
-    })
-}
 
 /// The effects of a set with its `j`-th left out (the set the holdout and the backward
 /// elimination compare against).
@@ -151,18 +71,30 @@ pub fn model_of(
     nodes: &[Node],
     data: &Channels,
 ) -> PhysicalModel {
+    fit_of(root, effects, nodes, data).0
+}
+
+/// [`model_of`] with the least-squares cost `V` of its fit (the node's `v_fit`, or the
+/// refit's).
+pub fn fit_of(
+    root: &PhysicalModel,
+    effects: &[(Cand, Vec<f64>)],
+    nodes: &[Node],
+    data: &Channels,
+) -> (PhysicalModel, f64) {
     let found = nodes
         .iter()
         .filter(|n| !n.configured && same_set(&n.effects, effects))
         .min_by(|a, b| a.v_fit.total_cmp(&b.v_fit));
     if let Some(n) = found {
-        return n.model.clone();
+        return (n.model.clone(), n.v_fit);
     }
     let mut m = root.clone();
     for (c, th) in effects {
         m = add_effect(&m, c, th, data);
     }
-    retune_within(&m, root, data, None, true).model
+    let r = retune_within(&m, root, data, None, true);
+    (r.model, r.v_after)
 }
 
 /// Final-set holdout of every effect of `node` (see the module docs); `nodes` are the
@@ -214,99 +146,47 @@ pub fn holdouts(
         .collect()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::diagnose::lsq::measures::Measures;
-
-    /// A node holding one added mode at `f_hz` with BIC `bic`.
-    fn node(f_hz: f64, bic: f64) -> Node {
-        Node {
-            effects: vec![(Cand::Mode, vec![(std::f64::consts::TAU * f_hz).ln(), -7.0])],
-            model: PhysicalModel::default(),
-            measures: Measures {
-                v: bic,
-                misfit_rms: 2.0,
-                invalid_fraction: 0.5,
-            },
-            v_fit: bic,
-            n_params: 3,
-            bic,
-            steps: vec![],
-            configured: false,
-        }
+/// The final holdout ([`crate::diagnose::search::holdout`]) of the chosen set; an effect that fails it is
+/// dropped and the rest refit.  A fit below 70 % of the band cannot place an additive effect
+/// (a mode, a feedthrough) that acts above it, so the extrapolation test decides only for
+/// sets of multiplicative effects; otherwise it is reported.  Returns the holdout rows and
+/// the labels dropped.
+pub(crate) fn drop_failing_holdout(
+    base: &PhysicalModel,
+    node: &mut Node,
+    nodes: &[Node],
+    data: &Channels,
+) -> Result<(Vec<Holdout>, Vec<String>)> {
+    let holdout = holdouts(base, node, nodes, data);
+    let all_mult = node.effects.iter().all(|e| e.0.multiplicative());
+    let failing: Vec<usize> = holdout
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| !h.interleaved_ok || (all_mult && h.extrapolation_ok == Some(false)))
+        .map(|(i, _)| i)
+        .collect();
+    if failing.is_empty() {
+        return Ok((holdout, Vec::new()));
     }
-
-    fn f_of(n: &Node) -> f64 {
-        (n.effects[0].1[0].exp() / std::f64::consts::TAU).round()
-    }
-
-    /// The fake holdout: drops every effect of a node whose mode is not at a frequency in
-    /// `pass` (as `drop_failing_holdout` does), and records the nodes it saw.
-    fn check<'a>(
-        pass: &'a [f64],
-        seen: &'a mut Vec<f64>,
-    ) -> impl FnMut(&mut Node) -> Result<(Vec<Holdout>, Vec<String>)> + 'a {
-        move |n: &mut Node| {
-            let f = f_of(n);
-            seen.push(f);
-            let ok = pass.contains(&f);
-            let rows = vec![Holdout {
-                effect: "mode".into(),
-                interleaved_ok: ok,
-                extrapolation_ok: None,
-            }];
-            if ok {
-                Ok((rows, vec![]))
-            } else {
-                n.effects.clear();
-                Ok((rows, vec!["mode".into()]))
-            }
-        }
-    }
-
-    /// A chosen mode the holdout drops: the next sets are tried in BIC order (a duplicate of
-    /// the chosen set and the roots skipped) and the first that passes is kept.
-    #[test]
-    fn a_dropped_chosen_mode_gives_way_to_the_next_passing_set() {
-        let mut root = node(1.0, 50.0);
-        root.effects.clear();
-        root.configured = true;
-        let nodes = vec![
-            root,
-            node(824.0, 0.0),
-            node(1000.0, 1.0),
-            node(824.5, 1.5), // the chosen set again (within 1 % in frequency)
-            node(500.0, 2.0),
-            node(300.0, 3.0),
-        ];
-        let mut seen = Vec::new();
-        let p = first_passing(&nodes, 1, check(&[500.0, 300.0], &mut seen)).unwrap();
-        assert_eq!(p.replaced_by, Some(4));
-        assert_eq!(f_of(&p.node), 500.0);
-        assert_eq!(p.dropped, vec!["mode".to_string()]);
-        assert!(p.holdout.iter().all(|h| h.interleaved_ok));
-        assert_eq!(seen, vec![824.0, 1000.0, 500.0]);
-    }
-
-    /// At most [`MAX_ALTERNATIVES`] sets are tried; when none passes the chosen set stays,
-    /// reduced, and a chosen set that passes is kept without trying anything else.
-    #[test]
-    fn alternatives_are_capped_and_a_passing_chosen_set_is_kept() {
-        let nodes: Vec<Node> = [824.0, 1000.0, 700.0, 600.0, 500.0]
-            .iter()
-            .enumerate()
-            .map(|(k, f)| node(*f, k as f64))
-            .collect();
-        assert_eq!(alternatives(&nodes, 0, MAX_ALTERNATIVES), vec![1, 2, 3]);
-        let mut seen = Vec::new();
-        let p = first_passing(&nodes, 0, check(&[500.0], &mut seen)).unwrap();
-        assert_eq!(p.replaced_by, None);
-        assert!(p.node.effects.is_empty());
-        assert_eq!(seen, vec![824.0, 1000.0, 700.0, 600.0]);
-        let mut seen = Vec::new();
-        let p = first_passing(&nodes, 0, check(&[824.0, 500.0], &mut seen)).unwrap();
-        assert_eq!((p.replaced_by, p.dropped.len()), (None, 0));
-        assert_eq!(seen, vec![824.0]);
-    }
+    let keep: Vec<_> = node
+        .effects
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !failing.contains(i))
+        .map(|(_, e)| e.clone())
+        .collect();
+    let dropped: Vec<String> = failing.iter().map(|i| node.effects[*i].0.label()).collect();
+    let model = model_of(base, &keep, nodes, data);
+    node.measures = Problem::new(&model, data)?.measures(&Default::default());
+    node.v_fit = node.measures.v;
+    node.model = model;
+    // Steps and effects are parallel (one effect per step): drop the failing ones by
+    // position, not by label (a dropped mode is not every mode).
+    let mut k = 0;
+    node.steps.retain(|_| {
+        k += 1;
+        !failing.contains(&(k - 1))
+    });
+    node.effects = keep;
+    Ok((holdout, dropped))
 }

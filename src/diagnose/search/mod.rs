@@ -11,6 +11,7 @@
 //! * `polish`: the consistency polish;
 //! * `ties`: sets the data cannot tell apart;
 //! * `holdout`: the final set checked on held-out data;
+//! * `choice`: the set kept after the holdout and the elimination (a next-best set when they drop part of it);
 //! * `path`: the chosen path and the runner-ups once the holdout or the elimination dropped effects;
 //! * `backward`: backward elimination;
 //! * `peaks`: every peak of the residual and its fate;
@@ -24,6 +25,7 @@ pub(crate) mod assign;
 pub(crate) mod backward;
 pub(crate) mod beam;
 pub(crate) mod child;
+pub(crate) mod choice;
 pub(crate) mod expand;
 pub(crate) mod final_effects;
 pub(crate) mod final_refit;
