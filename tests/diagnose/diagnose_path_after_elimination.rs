@@ -230,6 +230,20 @@ fn mode_omegas(v: &[BTreeMap<String, f64>]) -> Vec<f64> {
     w
 }
 
+/// The report's final effects are exactly the modes the written file adds.
+fn assert_final_effects_written(d: &Diagnosis, added: &[f64]) {
+    let fe = mode_omegas(
+        &d.final_effects
+            .iter()
+            .map(|e| e.params.clone())
+            .collect::<Vec<_>>(),
+    );
+    assert!(
+        close(&fe, added, 1e-9),
+        "final_effects {fe:?} vs written {added:?}"
+    );
+}
+
 fn close(a: &[f64], b: &[f64], rel: f64) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= rel * x.abs())
 }
@@ -296,16 +310,7 @@ fn an_eliminated_middle_step_renumbers_the_path_and_restates_its_successor() {
     assert!(s2.misfit_rms_before_refit >= s2.misfit_rms);
     // The written file adds exactly the modes the report names.
     let (added, text) = written_added(&c, &d);
-    let fe = mode_omegas(
-        &d.final_effects
-            .iter()
-            .map(|e| e.params.clone())
-            .collect::<Vec<_>>(),
-    );
-    assert!(
-        close(&fe, &added, 1e-9),
-        "final_effects {fe:?} vs written {added:?}"
-    );
+    assert_final_effects_written(&d, &added);
     let st = mode_omegas(&d.steps.iter().map(|s| s.params.clone()).collect::<Vec<_>>());
     assert!(
         close(&st, &added, 1e-2),
@@ -355,16 +360,7 @@ fn a_runner_up_that_passes_beats_the_set_the_rules_reduced() {
     );
     let (added, _) = written_added(&c, &d);
     assert!(close(&added, &[W_A], 0.01), "written {added:?}, want {W_A}");
-    let fe = mode_omegas(
-        &d.final_effects
-            .iter()
-            .map(|e| e.params.clone())
-            .collect::<Vec<_>>(),
-    );
-    assert!(
-        close(&fe, &added, 1e-9),
-        "final_effects {fe:?} vs written {added:?}"
-    );
+    assert_final_effects_written(&d, &added);
     // No runner-up scores better than the set kept, and the set reduced is not one.
     assert!(
         d.runner_up.iter().all(|r| r.bic_gap > 0.0),
