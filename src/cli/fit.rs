@@ -90,12 +90,11 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let a1 = |w: f64| f.a1_limit(w);
             let settings = settings.with_a1_model(f);
             run_fit(&env, Some(&a1), &settings, a.order, Some(progress)).map_err(|e| {
-                // Why no order can pass, when the envelope shows it.
-                let gaps = crate::pipeline::a1_conflict::a1_conflicts(&env, f);
-                // Where first and what to do last: a long message keeps both ends.
-                match crate::pipeline::a1_conflict::hint_parts(&gaps) {
-                    Some((at, todo)) => anyhow!("{at}; {e}; {todo}"),
-                    None => e.into(),
+                // Why no order can pass, when the envelope shows it (the words of `run`).
+                match crate::pipeline::explain_fit_failure(e, &env, Some(f)) {
+                    crate::pipeline::FitFailure::A1Conflict { message, .. } => anyhow!(message),
+                    crate::pipeline::FitFailure::Fit(e) => e.into(),
+                    other => other.into(),
                 }
             })
         }

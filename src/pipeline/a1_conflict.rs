@@ -53,7 +53,7 @@ impl A1Conflict {
 /// What a fit failure says about the gaps of [`a1_conflicts`] (worst first, at most two
 /// named): `(where, what to do)`, `None` without gaps.  The second part stays under 150
 /// characters, so that it survives the CLI's cut of long messages.
-pub fn hint_parts(gaps: &[A1Conflict]) -> Option<(String, String)> {
+fn hint_parts(gaps: &[A1Conflict]) -> Option<(String, String)> {
     let first = gaps.first()?;
     let named: Vec<String> = gaps
         .iter()
@@ -95,9 +95,11 @@ pub fn hint_parts(gaps: &[A1Conflict]) -> Option<(String, String)> {
     })
 }
 
-/// [`hint_parts`] as one sentence.
-pub fn hint(gaps: &[A1Conflict]) -> Option<String> {
-    hint_parts(gaps).map(|(w, todo)| format!("{w}: {todo}"))
+/// The fit's `error` explained by the gaps, when there are any: where first, the error, what
+/// to do last (a long message keeps both ends in view).  `rshape fit` and the pipeline's fit
+/// (`run`, `batch`, Python) say it in these words.
+pub fn explain(error: &dyn std::fmt::Display, gaps: &[A1Conflict]) -> Option<String> {
+    hint_parts(gaps).map(|(at, todo)| format!("{at}; {error}; {todo}"))
 }
 
 /// Per interval between neighbouring data with finite positive `r_min`, its sample of
@@ -169,7 +171,15 @@ mod tests {
         let e = env(vec![0.99, 1.01], vec![0.05, 0.06]);
         let gaps = a1_conflicts(&e, &f);
         let c = gaps.first().expect("the notch (depth 1e-3) is below 0.05");
-        assert!(c.impossible() && hint(&gaps).unwrap().starts_with("no r of any order"));
+        let said = explain(&"the fit failed", &gaps).unwrap();
+        assert!(
+            c.impossible() && said.starts_with("no r of any order"),
+            "{said}"
+        );
+        assert!(
+            said.contains("; the fit failed; M̃ is nearly singular"),
+            "{said}"
+        );
         // The sample is its own proof: σ_min there, recomputed, is below the level.
         assert!(f.a1_limit(c.omega) < 0.05 && c.level == 0.05);
         assert!(c.omega > 0.99 && c.omega < 1.01 && c.between == (0.99, 1.01));
@@ -183,7 +193,9 @@ mod tests {
         assert_eq!(a1_conflicts(&e, &notch(0.5)), vec![]);
         let gaps = a1_conflicts(&e, &notch(0.07));
         assert!(!gaps[0].impossible() && (gaps[0].ratio() - 1.4).abs() < 0.05);
-        assert!(hint(&gaps).unwrap().contains("squeeze"));
+        assert!(explain(&"e", &gaps)
+            .unwrap()
+            .contains("squeeze through; e; "));
         // An infinite or zero r_min sets no level.
         let e = env(vec![0.99, 1.01], vec![f64::INFINITY, 0.0]);
         assert_eq!(a1_conflicts(&e, &f), vec![]);

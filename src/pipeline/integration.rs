@@ -104,13 +104,14 @@ pub enum FitFailure {
     #[error("fit: {0}")]
     Fit(#[from] crate::fit::FitError),
     /// The fit failed and the envelope shows why: A1 leaves `r` no or little room between two
-    /// data ([`super::a1_conflict`]); the hint says where and what to do.
-    #[error("fit: {fit}; {hint}")]
+    /// data ([`super::a1_conflict`]); the message says where, the fit's error, what to do.
+    #[error("{message}")]
     A1Conflict {
         /// The fit's own error.
         fit: crate::fit::FitError,
-        /// Where A1 and the envelope conflict, and what to change.
-        hint: String,
+        /// Where A1 and the envelope conflict, the fit's error, and what to change
+        /// ([`super::a1_conflict::explain`]).
+        message: String,
     },
     /// The fitted `r` could not be written as `r.json` (rshape's own document: a bug).
     #[error("r.json: {0}")]
@@ -179,14 +180,14 @@ pub fn fit_r(
 
 /// A fit failure with the reason no order can succeed, when the envelope shows one
 /// ([`super::a1_conflict`]).
-fn explain(
+pub fn explain(
     fit: crate::fit::FitError,
     env: &Envelope,
     a1_model: Option<&crate::model::Factorization>,
 ) -> FitFailure {
     let gaps = a1_model.map(|f| super::a1_conflict::a1_conflicts(env, f));
-    match gaps.and_then(|g| super::a1_conflict::hint(&g)) {
-        Some(hint) => FitFailure::A1Conflict { fit, hint },
+    match gaps.and_then(|g| super::a1_conflict::explain(&fit, &g)) {
+        Some(message) => FitFailure::A1Conflict { fit, message },
         None => FitFailure::Fit(fit),
     }
 }
