@@ -364,9 +364,10 @@ fn pyfrf_accelerance_walk_finds_the_three_close_modes() {
 ///   modes, among them 5000.0 Hz (the band top) and a residual term at 5250 Hz.  At its
 ///   step 4 the re-check refused a mode of the reduced set: 2640.2 Hz as mains (44 × 60 Hz,
 ///   its half-power half-width ζf 0.70 Hz narrower than the 1 Hz lines, 0.195 Hz from the
-///   harmonic).  The stabilization diagram holds a mode there; the search had it only
-///   because a mode added elsewhere moved there in a joint refit (the one-effect walk: 3007.6
-///   → 2640.2 Hz at step 8), which no rule re-checks; step 5 adds it back.  The mains rule
+///   harmonic).  The issue lists a mode there; the search had it only as a mode that
+///   reached it in a joint refit (the one-effect walk: the mode added at 3007.6 Hz is read at
+///   2640.2 Hz after step 8's refit, whose rules judged the new mode, read at 3668.6 Hz); no
+///   rule re-checked it before; step 5 adds it back.  The mains rule
 ///   counts every harmonic: at the 44th, ±0.7 Hz of one of the 50 or 60 Hz harmonics covers
 ///   about 5 % of the band.
 #[test]
