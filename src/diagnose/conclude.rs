@@ -3,6 +3,7 @@
 //! elimination, a next-best set when they drop part of the chosen one), the last refit, the
 //! runner-ups and ties, the peak account and the verdict.
 
+use crate::diagnose::admissible::Refusal;
 use crate::diagnose::changes::changes;
 use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::problem::Problem;
@@ -15,6 +16,7 @@ use crate::diagnose::search::first_level::{ranked_candidates, Root};
 use crate::diagnose::search::holdout::drop_failing_holdout;
 use crate::diagnose::search::node::Node;
 use crate::diagnose::search::path::{restate_path, runner_ups};
+use crate::diagnose::search::recheck::Recheck;
 use crate::diagnose::search::ties::{candidate_ties, set_ties};
 use crate::diagnose::verdict::{
     residual_account, stop_explanation, unreached_modes, verdict_message,
@@ -47,6 +49,7 @@ struct Fits<'a, 'o> {
     nodes: &'a [Node],
     data: &'a Channels,
     min_delta_bic: f64,
+    allow_mains: bool,
     options: &'a DiagnoseOptions<'o>,
     phases: &'a mut Phases,
     told: [bool; 2],
@@ -79,6 +82,27 @@ impl Rules for Fits<'_, '_> {
         let (base, nodes, data) = (self.base, self.nodes, self.data);
         self.phases
             .time("holdout", || restate_path(node, orig, nodes, base, data))
+    }
+    fn refusal(&mut self, node: &Node) -> Result<Option<(usize, Refusal)>> {
+        let r = self.recheck();
+        self.phases
+            .time("admissibility re-check", || r.first_refusal(node))
+    }
+    fn remove(&mut self, node: &mut Node, j: usize) -> Result<()> {
+        let r = self.recheck();
+        self.phases
+            .time("admissibility re-check", || r.remove(node, j))
+    }
+}
+
+impl<'a> Fits<'a, '_> {
+    fn recheck(&self) -> Recheck<'a> {
+        Recheck {
+            base: self.base,
+            nodes: self.nodes,
+            data: self.data,
+            allow_mains: self.allow_mains,
+        }
     }
 }
 
@@ -127,6 +151,7 @@ pub fn conclude(
             nodes: &res.nodes,
             data,
             min_delta_bic: s.min_delta_bic,
+            allow_mains: s.allow_mains,
             options,
             phases: &mut phases,
             told: [false; 2],
@@ -141,6 +166,7 @@ pub fn conclude(
         eliminated,
         replaced_by: _,
         set_node,
+        refused: refused_in_kept,
     } = kept;
     // Runner-ups and ties are relative to the set kept: a node of the search (its own path,
     // BIC and ties), or no node (then no set tie can be stated against it: `set_ties`
@@ -178,6 +204,10 @@ pub fn conclude(
                 candidates: &candidates,
                 dropped: &dropped,
                 eliminated: &eliminated,
+                refused_in_kept: &refused_in_kept
+                    .iter()
+                    .map(|r| r.1.clone())
+                    .collect::<Vec<_>>(),
                 min_delta_bic: s.min_delta_bic,
             },
             data,
@@ -245,10 +275,15 @@ pub fn conclude(
         refused: res
             .refused
             .iter()
-            .map(|(step, r)| crate::diagnose::report::RefusedEffect {
-                step: *step,
-                refusal: r.clone(),
-            })
+            .map(|(step, r)| (step, r, false))
+            .chain(refused_in_kept.iter().map(|(step, r)| (step, r, true)))
+            .map(
+                |(step, r, in_kept_set)| crate::diagnose::report::RefusedEffect {
+                    step: *step,
+                    refusal: r.clone(),
+                    in_kept_set,
+                },
+            )
             .collect(),
         dampings_not_identified,
         residual,

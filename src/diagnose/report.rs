@@ -106,11 +106,16 @@ impl CandidateReport {
 /// An effect refused by physical admissibility, at the search level (`step`) it was met.
 #[derive(Debug, Clone, Serialize)]
 pub struct RefusedEffect {
-    /// Search level (1 = on the configured or retuned model).
+    /// Search level (1 = on the configured or retuned model); for a refusal of the kept
+    /// set's re-check, the step the effect had in the chosen path.
     pub step: usize,
     /// The refusal.
     #[serde(flatten)]
     pub refusal: crate::diagnose::admissible::Refusal,
+    /// Refused when the set the holdout and the backward elimination left was re-checked on
+    /// its own refit (`search::recheck`), and removed from it; absent from JSON otherwise.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub in_kept_set: bool,
 }
 
 /// A tie between two effects or two effect sets.

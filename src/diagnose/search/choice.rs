@@ -4,12 +4,18 @@
 //! reduced chosen set and the search's next-best sets that pass both rules as they are
 //! (nothing dropped), compared by the BIC of their joint refits — never the chosen set
 //! itself, and never a set equal to the reduced one.  The search's nodes are admissible by
-//! construction ([`super::child`]); the reduced set is a subset of an admissible one, refit.
+//! construction ([`super::child`]), one step at a time; the reduced set is a subset of an
+//! admissible one, refit, and its refit can break a rule: it is re-checked whole
+//! ([`super::recheck`], issue 33, stop 46), and an effect refused there is removed (the rest
+//! refit, the backward elimination run again, the set re-checked; at most
+//! [`MAX_RECHECKS`] rounds, after which nothing is kept of it).  The next-best sets are
+//! re-checked whole too before one is kept.
 //!
 //! Before issue 33's stop 45 only larger sets were tried after a holdout drop, the first that
 //! passed won whatever its BIC, and none after an elimination: a reduced set could be kept
 //! though a next-best set that passes scored better.
 
+use crate::diagnose::admissible::Refusal;
 use crate::diagnose::report::Holdout;
 use crate::diagnose::search::holdout::same_set;
 use crate::diagnose::search::node::Node;
@@ -18,6 +24,10 @@ use crate::error::Result;
 /// How many next-best effect sets (scoring better than the reduced chosen set) are tried when
 /// the holdout or the elimination drops part of the chosen set.
 pub const MAX_ALTERNATIVES: usize = 3;
+
+/// Most effects the admissibility re-check removes from a reduced set (each removal costs a
+/// refit per effect left); a set still refused after that many keeps none of its effects.
+pub const MAX_RECHECKS: usize = 3;
 
 /// The set kept after the holdout and the backward elimination.
 #[derive(Debug, Clone)]
@@ -36,12 +46,15 @@ pub struct Passing {
     /// The search's node holding the kept set, when one does (the chosen node when nothing
     /// was dropped).
     pub set_node: Option<usize>,
+    /// The effects of the reduced set the admissibility re-check refused and removed, each
+    /// with the step it had in the chosen path.
+    pub refused: Vec<(usize, Refusal)>,
 }
 
 impl Passing {
     /// Something was dropped from the search's chosen set.
     pub fn reduced(&self) -> bool {
-        !self.dropped.is_empty() || !self.eliminated.is_empty()
+        !self.dropped.is_empty() || !self.eliminated.is_empty() || !self.refused.is_empty()
     }
 }
 
@@ -75,28 +88,64 @@ pub trait Rules {
     /// Restates the path and BIC of `node`, reduced from `orig`; the node of the search that
     /// holds the same set, if any ([`super::path::restate_path`]).
     fn restate(&mut self, node: &mut Node, orig: &Node) -> Result<Option<usize>>;
+    /// The first effect of `node` an admissibility rule refuses on its refit, with the
+    /// refusal ([`super::recheck`]).
+    fn refusal(&mut self, node: &Node) -> Result<Option<(usize, Refusal)>>;
+    /// Removes effect `j` of `node` and its step, the rest refit.
+    fn remove(&mut self, node: &mut Node, j: usize) -> Result<()>;
+}
+
+/// Re-checks the reduced set `node` (see the module docs): each refused effect is removed,
+/// its refusal recorded with the step it had (`refused`), the rest refit and eliminated again
+/// (`eliminated`); after [`MAX_RECHECKS`] removals a set still refused is emptied.
+fn admit<R: Rules>(
+    node: &mut Node,
+    rules: &mut R,
+    refused: &mut Vec<(usize, Refusal)>,
+    eliminated: &mut Vec<String>,
+) -> Result<()> {
+    for round in 0..=MAX_RECHECKS {
+        let Some((j, r)) = rules.refusal(node)? else {
+            return Ok(());
+        };
+        let step = node.steps.get(j).map_or(j + 1, |s| s.step);
+        refused.push((step, r));
+        if round == MAX_RECHECKS {
+            while !node.effects.is_empty() {
+                rules.remove(node, 0)?;
+            }
+            return Ok(());
+        }
+        rules.remove(node, j)?;
+        eliminated.extend(rules.eliminate(node)?);
+    }
+    Ok(())
 }
 
 /// The set kept (see the module docs): the chosen node through the holdout and the
-/// elimination; when they drop part of it, the first of the next [`MAX_ALTERNATIVES`] sets
-/// scoring better than the reduced set ([`alternatives`] below its BIC, in BIC order) that
-/// both rules leave whole, else the reduced set.
+/// elimination; when they drop part of it, the reduced set re-checked for admissibility
+/// (refused effects removed), then the first of the next [`MAX_ALTERNATIVES`] sets scoring
+/// better than it ([`alternatives`] below its BIC, in BIC order) that both rules leave whole
+/// and the re-check admits whole, else the reduced set.
 pub fn keep<R: Rules>(nodes: &[Node], chosen: usize, rules: &mut R) -> Result<Passing> {
     let orig = &nodes[chosen];
     let mut node = orig.clone();
     let (holdout, dropped) = rules.holdout(&mut node)?;
-    let eliminated = rules.eliminate(&mut node)?;
+    let mut eliminated = rules.eliminate(&mut node)?;
     let mut out = Passing {
         node,
         holdout,
         dropped,
-        eliminated,
+        eliminated: vec![],
         replaced_by: None,
         set_node: Some(chosen),
+        refused: vec![],
     };
-    if !out.reduced() {
+    if !out.reduced() && eliminated.is_empty() {
         return Ok(out);
     }
+    admit(&mut out.node, rules, &mut out.refused, &mut eliminated)?;
+    out.eliminated = eliminated;
     out.set_node = rules.restate(&mut out.node, orig)?;
     let better: Vec<usize> = alternatives(nodes, chosen)
         .into_iter()
@@ -107,7 +156,10 @@ pub fn keep<R: Rules>(nodes: &[Node], chosen: usize, rules: &mut R) -> Result<Pa
     for i in better {
         let mut alt = nodes[i].clone();
         let (alt_holdout, alt_dropped) = rules.holdout(&mut alt)?;
-        if !alt_dropped.is_empty() || !rules.eliminate(&mut alt)?.is_empty() {
+        if !alt_dropped.is_empty()
+            || !rules.eliminate(&mut alt)?.is_empty()
+            || rules.refusal(&alt)?.is_some()
+        {
             continue;
         }
         out.node = alt;
@@ -122,6 +174,7 @@ pub fn keep<R: Rules>(nodes: &[Node], chosen: usize, rules: &mut R) -> Result<Pa
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diagnose::admissible::Rule;
     use crate::diagnose::effects::candidates::Cand;
     use crate::diagnose::lsq::measures::Measures;
     use crate::model::physical::PhysicalModel;
@@ -162,6 +215,10 @@ mod tests {
         vacuous: &'a [f64],
         bic_of: &'a [(&'a [f64], f64)],
         seen: Vec<Vec<f64>>,
+        /// Modes the admissibility re-check refuses.
+        refuse: &'a [f64],
+        /// The sets the re-check saw.
+        checked: Vec<Vec<f64>>,
     }
 
     impl Rules for Fake<'_> {
@@ -203,6 +260,28 @@ mod tests {
                 .expect("a BIC for every reduced set");
             Ok(None)
         }
+        fn refusal(&mut self, n: &Node) -> Result<Option<(usize, Refusal)>> {
+            let fs = f_of(n);
+            self.checked.push(fs.clone());
+            Ok(fs.iter().position(|f| self.refuse.contains(f)).map(|j| {
+                (
+                    j,
+                    Refusal {
+                        effect: "mode".into(),
+                        frequency_hz: Some(fs[j]),
+                        rule: Rule::Artefact,
+                        reason: "constructed".into(),
+                    },
+                )
+            }))
+        }
+        fn remove(&mut self, n: &mut Node, j: usize) -> Result<()> {
+            n.effects.remove(j);
+            if j < n.steps.len() {
+                n.steps.remove(j);
+            }
+            Ok(())
+        }
     }
 
     fn fake<'a>(pass: &'a [f64], vacuous: &'a [f64], bic_of: &'a [(&'a [f64], f64)]) -> Fake<'a> {
@@ -211,6 +290,8 @@ mod tests {
             vacuous,
             bic_of,
             seen: vec![],
+            refuse: &[],
+            checked: vec![],
         }
     }
 
@@ -307,5 +388,61 @@ mod tests {
         let p = keep(&nodes, 1, &mut r).unwrap();
         assert_eq!((p.dropped.len(), p.eliminated.len()), (0, 1));
         assert_eq!((p.replaced_by, f_of(&p.node)), (Some(3), vec![900.0]));
+    }
+
+    /// Issue 33, stop 46: the elimination leaves {824, 60} of {824, 999, 60}; the re-check
+    /// refuses 60 Hz on that refit, so it is removed (its step and refusal reported) and
+    /// {824} re-checked and kept; a better-scoring next-best set the re-check refuses whole
+    /// is not kept; a reduced set the re-check admits is kept as before, checked once.
+    #[test]
+    fn an_inadmissible_reduced_set_loses_the_refused_effect() {
+        let nodes = vec![
+            root(),
+            node(&[824.0, 999.0, 60.0], 0.0),
+            node(&[824.0, 60.0], 1.0),  // passes both rules, refused whole
+            node(&[700.0, 300.0], 9.0), // passes, worse than {824}
+        ];
+        let bic_of: &[(&[f64], f64)] = &[(&[824.0], 5.0), (&[824.0, 60.0], 1.0)];
+        let mut r = fake(&[824.0, 999.0, 60.0, 700.0, 300.0], &[999.0], bic_of);
+        r.refuse = &[60.0];
+        let p = keep(&nodes, 1, &mut r).unwrap();
+        assert_eq!(f_of(&p.node), [824.0]);
+        assert_eq!(p.replaced_by, None);
+        assert_eq!(p.refused.len(), 1);
+        assert_eq!(p.refused[0].1.frequency_hz, Some(60.0));
+        assert_eq!(p.eliminated.len(), 1);
+        assert!(p.reduced());
+        // {824, 60} checked (refused), {824} checked (admitted), the runner-up {824, 60}
+        // checked whole (refused); {700, 300} scores worse and is never tried.
+        assert_eq!(
+            r.checked,
+            vec![vec![824.0, 60.0], vec![824.0], vec![824.0, 60.0]]
+        );
+        // The same search without the refusal keeps {824, 60}: the re-check passed it once
+        // and the runner-up (the same set) is not tried.
+        let mut r = fake(&[824.0, 999.0, 60.0, 700.0, 300.0], &[999.0], bic_of);
+        let p = keep(&nodes, 1, &mut r).unwrap();
+        assert_eq!((f_of(&p.node), p.refused.len()), (vec![824.0, 60.0], 0));
+        assert_eq!(r.checked, vec![vec![824.0, 60.0]]);
+    }
+
+    /// The cap: a reduced set whose every effect is refused loses [`MAX_RECHECKS`] of them
+    /// one at a time, then the rest at once (no refit round per effect beyond the cap).
+    #[test]
+    fn the_recheck_is_capped() {
+        let fs = [100.0, 200.0, 300.0, 400.0, 500.0, 999.0];
+        let nodes = vec![root(), node(&fs, 0.0)];
+        let mut r = fake(&fs, &[999.0], &[(&[], 50.0)]);
+        r.refuse = &fs;
+        let p = keep(&nodes, 1, &mut r).unwrap();
+        assert!(p.node.effects.is_empty(), "{:?}", f_of(&p.node));
+        assert_eq!(r.checked.len(), MAX_RECHECKS + 1);
+        assert_eq!(p.refused.len(), MAX_RECHECKS + 1);
+        let refused: Vec<f64> = p
+            .refused
+            .iter()
+            .map(|x| x.1.frequency_hz.unwrap())
+            .collect();
+        assert_eq!(refused, [100.0, 200.0, 300.0, 400.0]);
     }
 }

@@ -14,6 +14,7 @@
 //! * `choice`: the set kept after the holdout and the elimination (a next-best set when they drop part of it);
 //! * `path`: the chosen path and the runner-ups once the holdout or the elimination dropped effects;
 //! * `backward`: backward elimination;
+//! * `recheck`: the reduced set re-checked for admissibility;
 //! * `peaks`: every peak of the residual and its fate;
 //! * `peak_modes`: a mode proposed at every peak that would pass the screen;
 //! * `multi_mode`: those modes proposed together, in one step;
@@ -38,5 +39,6 @@ pub(crate) mod peak_modes;
 pub(crate) mod peaks;
 pub(crate) mod polish;
 pub(crate) mod rank;
+pub(crate) mod recheck;
 pub(crate) mod settings;
 pub(crate) mod ties;

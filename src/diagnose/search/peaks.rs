@@ -37,6 +37,7 @@ use crate::diagnose::lsq::channels::Channels;
 use crate::diagnose::lsq::problem::{Mods, Problem};
 use crate::diagnose::report::{CandidateReport, Peak, PeakFate, PeakProbe};
 use crate::diagnose::search::rank::{improves, plausibility};
+use crate::diagnose::search::recheck::removed_at;
 use crate::error::Result;
 use crate::model::physical::PhysicalModel;
 use rayon::prelude::*;
@@ -148,6 +149,8 @@ pub(crate) struct Outcome<'a> {
     pub dropped: &'a [String],
     /// Effects the backward elimination dropped.
     pub eliminated: &'a [String],
+    /// Effects the re-check of the reduced set refused and removed.
+    pub refused_in_kept: &'a [crate::diagnose::admissible::Refusal],
     /// The ΔBIC an effect must exceed ([`crate::diagnose::SearchSettings::min_delta_bic`]):
     /// what a probe's "would pass the screen" is judged by.
     pub min_delta_bic: f64,
@@ -242,8 +245,13 @@ pub(crate) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                 Some(pr) => pr.verdict(&p, o.min_delta_bic),
                 None => "one mode started here did not converge".into(),
             };
-            match proposed {
-                Some(c) => (
+            match (proposed, removed_at(o.refused_in_kept, |w| p.contains(w))) {
+                (_, Some((effect, why))) => (
+                    PeakFate::Rejected,
+                    Some(effect),
+                    format!("{why}; probe on the final model: {verdict}"),
+                ),
+                (Some(c), None) => (
                     PeakFate::Rejected,
                     Some(format!(
                         "mode {} Hz",
@@ -259,7 +267,7 @@ pub(crate) fn account(o: &Outcome<'_>, data: &Channels) -> Result<(Vec<Peak>, us
                         }
                     ),
                 ),
-                None => (
+                (None, None) => (
                     PeakFate::NotProposed,
                     None,
                     format!(
