@@ -372,3 +372,16 @@ pub fn write_fit_text(
     text.push_str(&crate::fit::work_line(&outcome.result, outcome.seconds));
     Ok((text, outcome.result.r))
 }
+
+/// The subcommands that do not apply `[scaling]` yet refuse it (exit 2) rather than mix
+/// units: `compare` and `diagnose` resolve noise on the data as given, `synthesize` would
+/// export the controller of the scaled plant.
+pub fn refuse_scaling(config: &Config, command: &str) -> Result<()> {
+    match &config.scaling {
+        Some(_) => Err(anyhow!(
+            "{}: rshape {command} does not apply [scaling] yet; remove [scaling] from the config (or use a copy without it) for {command}",
+            config.path.display()
+        )),
+        None => Ok(()),
+    }
+}

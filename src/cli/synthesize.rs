@@ -60,6 +60,7 @@ const LARGE_PLANT_STATES: usize = 100;
 pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     crate::synthesis::check_gamma_factor(a.gamma_factor)?;
     let config = super::common::load_config(&a.config)?;
+    super::common::refuse_scaling(&config, "synthesize")?;
     // A large model's synthesis is dense linear algebra of O(n³) for minutes, silent while it
     // runs: say what is going on (issue 34: 200 modes ran minutes without a line).
     let f = &config.factorization;

@@ -29,7 +29,19 @@ pub(super) fn noise_radii(
     data: &FrfData,
     cli: Option<f64>,
 ) -> Result<Option<Vec<f64>>> {
-    let radii = crate::model::noise::noise_radii(cli, Some(config), data)?;
+    let radii = match &config.scaling {
+        // Every noise source (a radius, `--noise-radius`, a std or coherence file, the
+        // output bound, the data column) is in the data file's units: resolved on the
+        // unscaled data, the radii then scale like the entries (`d_o·d_i`, SISO).
+        Some(s) => {
+            let raw = s.unscale_frf(data.clone());
+            crate::model::noise::noise_radii(cli, Some(config), &raw)?.map(|r| {
+                let k = s.radius_factor().unwrap_or(1.0);
+                r.into_iter().map(|x| x * k).collect::<Vec<_>>()
+            })
+        }
+        None => crate::model::noise::noise_radii(cli, Some(config), data)?,
+    };
     Ok(radii.filter(|r| r.iter().any(|x| *x > 0.0)))
 }
 
@@ -204,4 +216,36 @@ pub fn write_fit_exports(
 /// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` and returns the files written.
 pub fn export_r(fit: &FittedR, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
     crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir)
+}
+
+/// The `scaling` entry of `r.json` and `report.json` for a config with `[scaling]`: the
+/// diagonals of `D_o`, `D_i` and what `r` refers to.
+pub fn scaling_json(s: &crate::model::Scaling) -> Value {
+    serde_json::json!({
+        "outputs": s.outputs,
+        "inputs": s.inputs,
+        "auto": s.auto,
+        "r_refers_to": "the scaled plant G_s = D_o·G·D_i (D_o = diag(outputs), D_i = diag(inputs)); a controller K for G is K_s = D_i⁻¹·K·D_o⁻¹ for G_s",
+    })
+}
+
+/// Adds the config's `scaling` ([`scaling_json`]) to `dir/r.json` (rewritten atomically); no
+/// change without `[scaling]` or without an `r.json`.
+pub fn note_scaling(dir: &std::path::Path, scaling: Option<&crate::model::Scaling>) -> Result<()> {
+    let (Some(s), p) = (scaling, dir.join("r.json")) else {
+        return Ok(());
+    };
+    if !p.exists() {
+        return Ok(());
+    }
+    let text = crate::util::read_text_file(&p)?;
+    let mut v: Value = serde_json::from_str(&text)
+        .map_err(|e| crate::error::Error::Invalid(format!("{}: {e}", p.display())))?;
+    if let Some(obj) = v.as_object_mut() {
+        obj.insert("scaling".into(), scaling_json(s));
+    }
+    let text = serde_json::to_string_pretty(&v)
+        .map_err(|e| crate::error::Error::Invalid(format!("r.json: {e}")))?;
+    crate::util::write_atomic(&p, text.as_bytes())?;
+    Ok(())
 }
