@@ -374,14 +374,32 @@ pub fn write_fit_text(
 }
 
 /// The subcommands that do not apply `[scaling]` yet refuse it (exit 2) rather than mix
-/// units: `compare` and `diagnose` resolve noise on the data as given, `synthesize` would
-/// export the controller of the scaled plant.
+/// units: `diagnose` revises the model in the data's own units, `synthesize` would export
+/// the controller of the scaled plant.
 pub fn refuse_scaling(config: &Config, command: &str) -> Result<()> {
     match &config.scaling {
         Some(_) => Err(anyhow!(
-            "{}: rshape {command} does not apply [scaling] yet; remove [scaling] from the config (or use a copy without it) for {command}",
+            "{}: rshape {command} cannot be converted ([scaling] is not applied by {command} yet: remove [scaling] from the config, or use a copy without it, for {command})",
             config.path.display()
         )),
         None => Ok(()),
+    }
+}
+
+/// `compare` with `[scaling]`: the scaled data against the scaled model, which is exact when
+/// there is no noise or the noise comes from a coherence (`ε·|H|` scales with `H`); a noise
+/// given in the data file's units (a radius, `--noise-radius`, a std file, an output bound,
+/// a `noise_radius` column) is refused (exit 2) rather than compared in mixed units.
+pub fn refuse_scaled_noise(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<()> {
+    use crate::model::NoiseSource;
+    if config.scaling.is_none() {
+        return Ok(());
+    }
+    match crate::model::noise_source(cli, Some(config), data.noise_radius.is_some()) {
+        None | Some(NoiseSource::ConfigCoherence) => Ok(()),
+        Some(src) => Err(anyhow!(
+            "{}: rshape compare does not scale a noise given in the data's units ({src:?}) by [scaling] yet; use a config without [scaling] for compare (its verdict does not depend on units)",
+            config.path.display()
+        )),
     }
 }

@@ -235,14 +235,9 @@ impl Scaling {
         self.outputs.iter().chain(&self.inputs).all(|x| *x == 1.0)
     }
 
-    /// `D_o = diag(..), D_i = diag(..)` for messages, 4 significant digits.
+    /// `D_o = diag(..), D_i = diag(..)` for messages, each number as written in a config.
     pub fn describe(&self) -> String {
-        let list = |v: &[f64]| {
-            v.iter()
-                .map(|x| crate::report::fmt::fmt_g(*x))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let list = |v: &[f64]| v.iter().map(|x| short(*x)).collect::<Vec<_>>().join(", ");
         format!(
             "D_o = diag({}), D_i = diag({})",
             list(&self.outputs),
@@ -252,12 +247,7 @@ impl Scaling {
 
     /// The table to copy into a config: `[scaling] outputs = [..] inputs = [..]`.
     pub fn as_toml(&self) -> String {
-        let list = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{x:e}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
+        let list = |v: &[f64]| v.iter().map(|x| short(*x)).collect::<Vec<_>>().join(", ");
         format!(
             "[scaling] outputs = [{}], inputs = [{}]",
             list(&self.outputs),
@@ -266,18 +256,33 @@ impl Scaling {
     }
 }
 
+/// A scaling as one would write it: `0.001`, `250`, `1e-6`, `2.5e-7` (shortest round trip).
+fn short(x: f64) -> String {
+    if (1e-3..1e4).contains(&x) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Number of frequencies of the grid of [`auto_scaling`].
 pub const AUTO_POINTS: usize = 200;
 
-/// `scaling = "auto"`: diagonal scalings that bring the plant's gain near 1 on average.
+/// `scaling = "auto"`: diagonal scalings that bring the plant's peak gains near 1.
 ///
-/// Per entry the geometric mean `g_kl` of `|G_kl(jω)|` over [`AUTO_POINTS`] log-spaced
+/// Why the peak: for normalized coprime factors `σ_min(M̃) ≈ 1/√(1 + ‖G‖²)`, so where the
+/// scaled gain is large the A1 limit leaves `r` a notch (a lightly damped mode of gain 2e6
+/// leaves 5e-7); with every peak near 1 the limit stays near `1/√2` or above and `r` is
+/// close to the additive misfit.  (A geometric mean near 1 leaves the peaks large.)
+///
+/// Per entry the peak `g_kl` of `|G_kl(jω)|` over [`AUTO_POINTS`] log-spaced
 /// frequencies from a decade below the slowest to a decade above the fastest nonzero pole
 /// of the plant (0.1 to 10 rad/s for a static gain); entries below `1e-12·max g` (structural
 /// zeros) are left out.  Then `log d_o,k + log d_i,l = −log g_kl` is solved in least squares
 /// (alternating exact minimizations, capped at 200 sweeps), the free common factor split so
 /// that `D_o` and `D_i` have the same geometric mean, and each `d` rounded to 3 significant
 /// digits, so that the printed table is exactly what was used.  SISO: `d_o = d_i = 1/√g`.
+/// The band comes from the model, not the data: a peak outside the data's band counts.
 pub fn auto_scaling(g: &StateSpace) -> Result<Scaling, String> {
     let (p, m) = (g.d.nrows(), g.d.ncols());
     let poles = if g.a.nrows() == 0 {
@@ -298,19 +303,18 @@ pub fn auto_scaling(g: &StateSpace) -> Result<Scaling, String> {
             mags.iter().copied().fold(0.0, f64::max) * 10.0,
         )
     };
-    let mut sum = DMatrix::<f64>::zeros(p, m);
+    let mut peak = DMatrix::<f64>::zeros(p, m);
     let mut count = 0usize;
     for w in crate::system::logspace(lo, hi, AUTO_POINTS) {
         // A frequency on a pole of the imaginary axis is skipped.
         let Some(h) = g.freq(w) else { continue };
-        let logs = h.map(|x| x.norm().max(f64::MIN_POSITIVE).ln());
-        sum += logs;
+        peak.zip_apply(&h, |x, v| *x = x.max(v.norm()));
         count += 1;
     }
-    if count == 0 {
+    if count == 0 || peak.iter().any(|x| !x.is_finite()) {
         return Err("scaling = \"auto\": the plant cannot be evaluated on its band; give [scaling] outputs and inputs".into());
     }
-    let log_g = sum / count as f64;
+    let log_g = peak.map(|x| x.max(f64::MIN_POSITIVE).ln());
     let top = log_g.max();
     let used = log_g.map(|x| x > top + (1e-12f64).ln());
     let solved = solve_log_scalings(&log_g, &used)
@@ -385,10 +389,10 @@ mod tests {
         assert!((mx - my).abs() < 1e-9);
     }
 
-    /// SISO `k/(s+1)`: the geometric mean of `|G|` on the grid, computed here directly,
-    /// gives `d_o = d_i = 1/√g` (to the 3 digits kept).
+    /// SISO `k/(s+1)`: the peak of `|G|` on the grid (at its first point, 0.1 rad/s),
+    /// computed here in closed form, gives `d_o = d_i = 1/√g` (to the 3 digits kept).
     #[test]
-    fn auto_siso_is_inverse_square_root_of_mean_gain() {
+    fn auto_siso_is_inverse_square_root_of_peak_gain() {
         let k = 2.5e6;
         let g = StateSpace {
             a: DMatrix::from_element(1, 1, -1.0),
@@ -397,13 +401,8 @@ mod tests {
             d: DMatrix::zeros(1, 1),
         };
         let s = auto_scaling(&g).expect("auto");
-        let grid = crate::system::logspace(0.1, 10.0, AUTO_POINTS);
-        let mean_log = grid
-            .iter()
-            .map(|w| (k / (1.0 + w * w).sqrt()).ln())
-            .sum::<f64>()
-            / grid.len() as f64;
-        let d = (-mean_log / 2.0).exp();
+        let peak = k / (1.0f64 + 0.1 * 0.1).sqrt();
+        let d = 1.0 / peak.sqrt();
         assert!(
             (s.outputs[0] / d - 1.0).abs() < 5e-3,
             "{} vs {d}",
