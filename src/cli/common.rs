@@ -374,12 +374,15 @@ pub fn write_fit_text(
 }
 
 /// The subcommands that do not apply `[scaling]` yet refuse it (exit 2) rather than mix
-/// units: `diagnose` revises the model in the data's own units, `synthesize` would export
-/// the controller of the scaled plant.
+/// units: `diagnose` revises the model in the data's own units.
 pub fn refuse_scaling(config: &Config, command: &str) -> Result<()> {
     match &config.scaling {
+        Some(_) if command == "diagnose" => Err(anyhow!(
+            "{}: diagnose adds effects to a [physical] model in the data's own units, and this model cannot be converted ([scaling] is not applied by diagnose yet); remove [scaling], or use a copy of the config without it, to diagnose",
+            config.path.display()
+        )),
         Some(_) => Err(anyhow!(
-            "{}: rshape {command} cannot be converted ([scaling] is not applied by {command} yet: remove [scaling] from the config, or use a copy without it, for {command})",
+            "{}: rshape {command} does not apply [scaling] yet (its answer would be in the scaled units); remove [scaling], or use a copy of the config without it, for {command}",
             config.path.display()
         )),
         None => Ok(()),

@@ -108,7 +108,10 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             if s.auto { " (auto)" } else { "" }
         );
         if s.auto {
-            outln!("            to fix them: {}", s.as_toml());
+            outln!(
+                "            to fix them, replace scaling = \"auto\" by: {}",
+                s.as_toml()
+            );
         }
     }
     outln!(

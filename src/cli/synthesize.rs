@@ -60,7 +60,6 @@ const LARGE_PLANT_STATES: usize = 100;
 pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     crate::synthesis::check_gamma_factor(a.gamma_factor)?;
     let config = super::common::load_config(&a.config)?;
-    super::common::refuse_scaling(&config, "synthesize")?;
     // A large model's synthesis is dense linear algebra of O(n³) for minutes, silent while it
     // runs: say what is going on (issue 34: 200 modes ran minutes without a line).
     let f = &config.factorization;
@@ -140,6 +139,12 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     let mut fit_text = String::new();
     if let Some(fit) = fit {
         fit_text = super::common::write_fit_text(fit, &a.out)?.0;
+    }
+    // With [scaling] the controller was designed for G_s = D_o·G·D_i; the files hold
+    // K = D_i·K_s·D_o for G itself (what `stability --controller` reads with the same config).
+    let mut outcome = outcome;
+    if let Some(s) = &config.scaling {
+        outcome.gm.k = s.unscale_controller(&outcome.gm.k);
     }
     let written = synthesize::write_outputs(&a.out, &outcome)?;
     let code = if outcome.robust { 0 } else { 1 };

@@ -35,13 +35,38 @@ use serde::{Deserialize, Serialize};
 /// outputs = [1e-3, 1e-3]    # D_o = diag(outputs): y_s = D_o·y  (default all ones)
 /// inputs = [1, 1]           # D_i = diag(inputs):  u = D_i·u_s  (default all ones)
 /// ```
-#[derive(Debug, Clone, Deserialize, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
 pub enum ScalingSpec {
     /// `scaling = "auto"` (a `[plant]` only): see [`auto_scaling`].
     Keyword(String),
     /// The `[scaling]` table.
     Diagonal(ScalingSection),
+}
+
+/// A string or a table, each with its own message (an untagged enum would only say that
+/// nothing matched): `unknown field `output`, expected `outputs` or `inputs``.
+impl<'de> Deserialize<'de> for ScalingSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl<'de> serde::de::Visitor<'de> for Visitor {
+            type Value = ScalingSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("scaling = \"auto\" or a table [scaling] with outputs = [...] and inputs = [...]")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<ScalingSpec, E> {
+                Ok(ScalingSpec::Keyword(v.to_string()))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(
+                self,
+                map: A,
+            ) -> Result<ScalingSpec, A::Error> {
+                ScalingSection::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+                    .map(ScalingSpec::Diagonal)
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// The `[scaling]` table: the diagonals of `D_o` and `D_i`.
@@ -146,6 +171,17 @@ impl Scaling {
         inverse.plant(k)
     }
 
+    /// `K = D_i·K_s·D_o`: a controller of the scaled plant back in the plant's own units
+    /// (the inverse of [`Scaling::controller`]), for the controller files `synthesize` writes.
+    pub fn unscale_controller(&self, k_s: &StateSpace) -> StateSpace {
+        Scaling {
+            outputs: self.inputs.clone(),
+            inputs: self.outputs.clone(),
+            auto: self.auto,
+        }
+        .plant(k_s)
+    }
+
     /// The scaled factorization of a `[model]` (see the module doc): standard
     /// `(D_o·M̃·D_o⁻¹, D_o·Ñ·D_i)`, special `(D_o·C, M̃, Ñ, J·D_i)`.  Factors given by a
     /// realization (a `[plant]`) are scaled before they are computed, never here.
@@ -245,11 +281,13 @@ impl Scaling {
         )
     }
 
-    /// The table to copy into a config: `[scaling] outputs = [..] inputs = [..]`.
+    /// The key to copy into a config in place of `scaling = "auto"`:
+    /// `scaling = { outputs = [..], inputs = [..] }` (an inline table, valid where the
+    /// top-level key was).
     pub fn as_toml(&self) -> String {
         let list = |v: &[f64]| v.iter().map(|x| short(*x)).collect::<Vec<_>>().join(", ");
         format!(
-            "[scaling] outputs = [{}], inputs = [{}]",
+            "scaling = {{ outputs = [{}], inputs = [{}] }}",
             list(&self.outputs),
             list(&self.inputs)
         )

@@ -38,4 +38,5 @@ mod progress_cli;
 mod quiet_output;
 mod run_cli;
 mod sample_time;
+mod scaling_cli;
 mod settings_validate;
