@@ -313,7 +313,7 @@ pub const AUTO_POINTS: usize = 200;
 /// leaves 5e-7); with every peak near 1 the limit stays near `1/√2` or above and `r` is
 /// close to the additive misfit.  (A geometric mean near 1 leaves the peaks large.)
 ///
-/// Per entry the peak `g_kl` of `|G_kl(jω)|` over [`AUTO_POINTS`] log-spaced
+/// Per entry the peak `g_kl` of `|G_kl(jω)|` over `AUTO_POINTS` (200) log-spaced
 /// frequencies from a decade below the slowest to a decade above the fastest nonzero pole
 /// of the plant (0.1 to 10 rad/s for a static gain); entries below `1e-12·max g` (structural
 /// zeros) are left out.  Then `log d_o,k + log d_i,l = −log g_kl` is solved in least squares

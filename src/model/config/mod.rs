@@ -138,7 +138,7 @@ pub struct RawConfig {
     pub v: Option<RSection>,
     /// Units scaling `G_s = D_o·G·D_i` of the model, the data and a controller
     /// (`[scaling] outputs = [..], inputs = [..]`, or `scaling = "auto"` for a `[plant]`;
-    /// see [`super::scaling`]).
+    /// see [`crate::model::Scaling`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scaling: Option<super::scaling::ScalingSpec>,
 }
@@ -202,7 +202,7 @@ pub struct Config {
     /// its open-loop equivalent and `r` holds the weight `V` of `[v]`.
     pub closed_loop: Option<super::closed_loop::ClosedLoopModel>,
     /// The units scaling of `[scaling]`: `factorization` is then that of `D_o·G·D_i`, and
-    /// the pipeline scales the data and a controller alike ([`super::scaling`]).
+    /// the pipeline scales the data and a controller alike ([`crate::model::Scaling`]).
     pub scaling: Option<super::scaling::Scaling>,
 }
 
