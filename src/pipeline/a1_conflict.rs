@@ -74,7 +74,7 @@ pub fn hint_parts(gaps: &[A1Conflict]) -> Option<(String, String)> {
         n if n > 2 => format!(" (and {} more)", n - 2),
         _ => String::new(),
     };
-    let todo = "M̃ is nearly singular there (a lightly damped model pole, or a large gain: σ_min(M̃) ≈ 1/‖G‖): damp or move that mode, or rescale the plant's units ([scaling] in the config)";
+    let todo = "M̃ is nearly singular there (a lightly damped model pole, or a large gain: σ_min(M̃) ≈ 1/‖G‖): damp or move that mode, or rescale the plant's units";
     Some(if first.impossible() {
         (
             format!(
