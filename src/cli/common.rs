@@ -73,16 +73,13 @@ impl InputArgs {
     }
 
     /// The envelope alone, streamed when the noise-free theorems apply
-    /// ([`crate::pipeline::envelope::envelope_of_file`]).
-    pub fn envelope_only(&self) -> Result<Envelope> {
+    /// ([`crate::pipeline::envelope::envelope_of_file`]), with the config it was computed for.
+    pub fn envelope_only(&self) -> Result<(Config, Envelope)> {
         let config = load_config(&self.config)?;
         self.check_noise_radius()?;
         let path = self.data_path(&config)?;
-        Ok(crate::pipeline::envelope::envelope_of_file(
-            &config,
-            &path,
-            self.noise_radius,
-        )?)
+        let env = crate::pipeline::envelope::envelope_of_file(&config, &path, self.noise_radius)?;
+        Ok((config, env))
     }
 
     /// Loads inputs and computes their envelope ([`crate::pipeline::envelope::envelope`]).

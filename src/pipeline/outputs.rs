@@ -117,8 +117,8 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
     };
     // The figures of a scaled config show the scaled plant and data (D_o·G·D_i).
     let name = match &config.scaling {
-        Some(_) => format!("{name} (scaled units)"),
-        None => name,
+        Some(_) if !name.contains("scaled") => format!("{name} (scaled units)"),
+        _ => name,
     };
     let mut svgs = Vec::new();
     let cl = config.closed_loop.is_some();
