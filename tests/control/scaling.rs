@@ -407,3 +407,80 @@ fn stability_with_scaling_equals_the_hand_scaled_loop() {
         "{ra} vs {rb}"
     );
 }
+
+/// Every noise source is read in the data file's units and its radius scaled by `d_o·d_i`
+/// (SISO): a std file (`3·std·d_o·d_i`, computed here), a coherence (`3·ε·|Φ_s|`,
+/// `ε = √(1 − γ²)/(|γ|√(2n))`, computed here from the scaled data), the output bound of
+/// Sec. III and `--noise-radius` (each the unscaled config's radii times `d_o·d_i`).
+#[test]
+fn every_noise_source_scales_like_the_entries() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = repo("configs/plant_first.csv");
+    let raw = rshape::read_frf_csv(&csv).unwrap();
+    let n = raw.len();
+    let (co, ci) = (0.02, 3.0);
+    let k = co * ci;
+    let std: Vec<f64> = (0..n).map(|i| 0.002 * (1.0 + i as f64 / 10.0)).collect();
+    let coh: Vec<f64> = (0..n).map(|i| 0.95 - 0.5 * i as f64 / n as f64).collect();
+    let column = |name: &str, v: &[f64]| {
+        let mut t = format!("omega_rad_s,{name}\n");
+        for (w, x) in raw.omega.iter().zip(v) {
+            t += &format!("{w:e},{x:e}\n");
+        }
+        t
+    };
+    let std_file = dir.path().join("std.csv");
+    std::fs::write(&std_file, column("std_1_1", &std)).unwrap();
+    let coh_file = dir.path().join("coh.csv");
+    std::fs::write(&coh_file, column("coh_1_1", &coh)).unwrap();
+    let head = format!(
+        "data = \"{}\"\n[plant]\ntf = [[{{ num = [1], den = [1, 1, 0] }}]]\n",
+        csv.display()
+    );
+    let scaled = format!("[scaling]\noutputs = [{co}]\ninputs = [{ci}]\n");
+    let radii = |noise: &str, scaling: &str, name: &str, cli: Option<f64>| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, format!("{head}{noise}{scaling}")).unwrap();
+        let cfg = Config::load(&p).unwrap_or_else(|e| panic!("{e}"));
+        let data = load_data(&cfg, cfg.data.as_ref().unwrap()).unwrap();
+        let opts = RunOptions::noise_radius(cli);
+        let out = rshape::envelope(&cfg, &data, &opts).unwrap();
+        (out.noise_radii.expect("noisy"), data)
+    };
+    let std_noise = format!("[noise]\nstd_file = \"{}\"\n", std_file.display());
+    let (r, _) = radii(&std_noise, &scaled, "std.toml", None);
+    for i in 0..n {
+        assert!(close(r[i], 3.0 * std[i] * k, 1e-12), "std, datum {i}");
+    }
+    let coh_noise = format!(
+        "[noise]\ncoherence = \"{}\"\naverages = 5\n",
+        coh_file.display()
+    );
+    let (r, data_s) = radii(&coh_noise, &scaled, "coh.toml", None);
+    for i in 0..n {
+        let g2 = coh[i];
+        let eps = (1.0 - g2).sqrt() / (g2.sqrt() * (2.0f64 * 5.0).sqrt());
+        let want = 3.0 * eps * data_s.response[i][(0, 0)].norm();
+        assert!(
+            close(r[i], want, 1e-9),
+            "coherence, datum {i}: {} vs {want}",
+            r[i]
+        );
+        assert!(close(
+            data_s.response[i][(0, 0)].norm(),
+            raw.response[i][(0, 0)].norm() * k,
+            1e-12
+        ));
+    }
+    let bound = "[noise]\noutput_bound = 1e-6\ninput_amplitude = 2.0\n";
+    let (r1, _) = radii(bound, &scaled, "bound_s.toml", None);
+    let (r0, _) = radii(bound, "", "bound.toml", None);
+    for i in 0..n {
+        assert!(close(r1[i], r0[i] * k, 1e-9), "output bound, datum {i}");
+    }
+    let (r1, _) = radii("", &scaled, "cli_s.toml", Some(0.03));
+    assert!(
+        r1.iter().all(|x| close(*x, 0.03 * k, 1e-12)),
+        "--noise-radius"
+    );
+}
