@@ -103,6 +103,21 @@ fn bad_scalings_exit_2_naming_the_key() {
         err.contains("[scaling] is for a [plant] or a [model], not a [physical] model"),
         "{err}"
     );
+    let cl = std::fs::read_to_string(repo("configs/closed_loop_retuned_noisy.toml")).unwrap();
+    let cl = cl.replace(
+        "data = \"",
+        &format!("data = \"{}/", repo("configs").display()),
+    );
+    let cfg = write(
+        dir.path(),
+        "cl.toml",
+        &format!("{cl}\n[scaling]\noutputs = [2]\n"),
+    );
+    let out = rshape(&["check", cfg.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("not a [closed_loop] model"), "{err}");
 }
 
 /// `run` with `scaling = "auto"` says the scalings and the line to copy; `r.json` and
