@@ -484,3 +484,31 @@ fn every_noise_source_scales_like_the_entries() {
         "--noise-radius"
     );
 }
+
+/// SISO, only the product `d_o·d_i` scales `G` and `Φ`: `(2, 0.5)` is the identity for the
+/// normalized factors of a `[plant]` (the same envelope as no scaling, datum for datum), and
+/// `(3, 5)` equals `(15, 1)`.
+#[test]
+fn siso_plant_scaling_depends_on_the_product_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let head = format!(
+        "data = \"{}\"\n[plant]\ntf = [[{{ num = [1], den = [1, 1, 0] }}]]\n",
+        repo("configs/plant_first.csv").display()
+    );
+    let with = |o: f64, i: f64, name: &str| {
+        envelope_of(
+            &format!("{head}[scaling]\noutputs = [{o}]\ninputs = [{i}]\n"),
+            &dir.path().join(name),
+        )
+        .0
+    };
+    let plain = envelope_of(&head, &dir.path().join("plain.toml")).0;
+    let unit = with(2.0, 0.5, "unit.toml");
+    let a = with(3.0, 5.0, "a.toml");
+    let b = with(15.0, 1.0, "b.toml");
+    for k in 0..plain.len() {
+        assert!(close(plain[k], unit[k], 1e-9), "datum {k}");
+        assert!(close(a[k], b[k], 1e-9), "datum {k}");
+    }
+    assert!(plain.iter().zip(&a).any(|(x, y)| !close(*x, *y, 1e-3)));
+}
