@@ -229,8 +229,9 @@ pub fn scaling_json(s: &crate::model::Scaling) -> Value {
     })
 }
 
-/// Adds the config's `scaling` ([`scaling_json`]) to `dir/r.json` (rewritten atomically); no
-/// change without `[scaling]` or without an `r.json`.
+/// Adds the config's `scaling` ([`scaling_json`]) to `dir/r.json` and a first comment line
+/// saying so to `r.m`, `r.py`, `r.jl` (each rewritten atomically); no change without
+/// `[scaling]` or without an `r.json`.
 pub fn note_scaling(dir: &std::path::Path, scaling: Option<&crate::model::Scaling>) -> Result<()> {
     let (Some(s), p) = (scaling, dir.join("r.json")) else {
         return Ok(());
@@ -247,5 +248,18 @@ pub fn note_scaling(dir: &std::path::Path, scaling: Option<&crate::model::Scalin
     let text = serde_json::to_string_pretty(&v)
         .map_err(|e| crate::error::Error::Invalid(format!("r.json: {e}")))?;
     crate::util::write_atomic(&p, text.as_bytes())?;
+    // The MATLAB, Python and Julia exports say it in a comment line.
+    let line = format!(
+        "r refers to the scaled plant G_s = D_o*G*D_i, {}",
+        s.describe()
+    );
+    for (name, comment) in [("r.m", "%"), ("r.py", "#"), ("r.jl", "#")] {
+        let p = dir.join(name);
+        if p.exists() {
+            let text = crate::util::read_text_file(&p)?;
+            let text = format!("{comment} {line}\n{text}");
+            crate::util::write_atomic(&p, text.as_bytes())?;
+        }
+    }
     Ok(())
 }

@@ -126,9 +126,9 @@ fn bad_scalings_exit_2_naming_the_key() {
 fn run_reports_the_scaling_and_the_auto_values_round_trip() {
     let dir = tempfile::tempdir().unwrap();
     let data = repo("configs/plant_first.csv");
-    // 1/(s(s+1)) times 1e4: peak gain 1e5 on the model's band.
+    // 1/(s(s+1)), the model of the data: peak gain about 10 on the model's band.
     let text = format!(
-        "data = \"{}\"\nscaling = \"auto\"\n[plant]\ntf = [[{{ num = [1e4], den = [1, 1, 0] }}]]\n",
+        "data = \"{}\"\nscaling = \"auto\"\n[plant]\ntf = [[{{ num = [1], den = [1, 1, 0] }}]]\n",
         data.display()
     );
     let cfg = write(dir.path(), "auto.toml", &text);
@@ -169,16 +169,23 @@ fn run_reports_the_scaling_and_the_auto_values_round_trip() {
     assert_eq!(s["auto"], serde_json::Value::Bool(true), "{s}");
     let d_o = s["outputs"][0].as_f64().unwrap();
     let d_i = s["inputs"][0].as_f64().unwrap();
-    // SISO auto: d_o = d_i = 1/√(peak gain), the peak of 1e4/|jω(jω+1)| at the grid's first
-    // point, a decade below the slowest nonzero pole (1 rad/s): 1e4/(0.1·√1.01).
-    let peak = 1e4 / (0.1 * (1.0f64 + 0.01).sqrt());
+    // SISO auto: d_o = d_i = 1/√(peak gain), the peak of 1/|jω(jω+1)| at the grid's first
+    // point, a decade below the slowest nonzero pole (1 rad/s): 1/(0.1·√1.01).
+    let peak = 1.0 / (0.1 * (1.0f64 + 0.01).sqrt());
     assert!((d_o * peak.sqrt() - 1.0).abs() < 5e-3 && d_o == d_i, "{s}");
     assert!(s["r_refers_to"].as_str().unwrap().contains("scaled plant"));
-    if out_dir.join("r.json").exists() {
-        let r: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out_dir.join("r.json")).unwrap())
-                .unwrap();
-        assert_eq!(&r["scaling"], s);
+    assert!(out_dir.join("r.json").exists(), "the fit failed: {so}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("r.json")).unwrap()).unwrap();
+    assert_eq!(&r["scaling"], s);
+    for (f, c) in [("r.m", "% "), ("r.py", "# "), ("r.jl", "# ")] {
+        let text = std::fs::read_to_string(out_dir.join(f)).unwrap();
+        assert!(
+            text.starts_with(&format!(
+                "{c}r refers to the scaled plant G_s = D_o*G*D_i, D_o = diag("
+            )),
+            "{f}: {text}"
+        );
     }
     // The copied line in place of "auto": the same envelope, datum for datum.
     let fixed = write(
