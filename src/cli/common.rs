@@ -332,7 +332,7 @@ pub fn fit_bound(
     out: &std::path::Path,
 ) -> Result<(String, crate::system::TransferFunction)> {
     let outcome = fit_bound_in_memory(label, input)?;
-    write_fit_text(outcome, out)
+    write_fit_text(outcome, out, input.0.config.scaling.as_ref())
 }
 
 /// As [`fit_bound`], writing nothing: the caller checks the rest, then writes the fit and
@@ -357,13 +357,15 @@ pub fn fit_bound_in_memory(
 }
 
 /// Writes the fit's exports into `out` (`pipeline::write_fit_exports`) and returns its
-/// printable text (the files written, the work line) and the fitted `r`.
+/// printable text (the files written, the work line) and the fitted `r`; a config's
+/// `[scaling]` is noted in them.
 pub fn write_fit_text(
     outcome: crate::fit::FitOutcome,
     out: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
 ) -> Result<(String, crate::system::TransferFunction)> {
     let mut text = outcome.text.clone();
-    for f in crate::pipeline::write_fit_exports(&outcome, out)? {
+    for f in crate::pipeline::write_fit_exports(&outcome, out, scaling)? {
         text.push_str(&format!("wrote {}\n", f.display()));
     }
     text.push_str(&crate::fit::work_line(&outcome.result, outcome.seconds));

@@ -107,8 +107,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     view.finish();
     let outcome = outcome?;
     print!("{}", outcome.text);
-    let written = crate::pipeline::write_fit_exports(&outcome, &a.out)?;
-    crate::pipeline::integration::note_scaling(&a.out, scaling.as_ref())?;
+    let written = crate::pipeline::write_fit_exports(&outcome, &a.out, scaling.as_ref())?;
     for f in written {
         println!("wrote {}", f.display());
     }

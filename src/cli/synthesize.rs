@@ -138,7 +138,7 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
     let mut fit_text = String::new();
     if let Some(fit) = fit {
-        fit_text = super::common::write_fit_text(fit, &a.out)?.0;
+        fit_text = super::common::write_fit_text(fit, &a.out, config.scaling.as_ref())?.0;
     }
     // With [scaling] the controller was designed for G_s = D_o·G·D_i; the files hold
     // K = D_i·K_s·D_o for G itself (what `stability --controller` reads with the same config).

@@ -174,7 +174,7 @@ pub fn fit_r(
             (r, None)
         }
     };
-    let text = crate::report::export::r_json(&result, table.as_deref());
+    let text = crate::report::export::r_json(&result, table.as_deref(), None);
     let json: Value = serde_json::from_str(&text).map_err(|e| FitFailure::Json(e.to_string()))?;
     let certificate = json
         .get("certificate")
@@ -205,61 +205,29 @@ fn explain(
 
 /// Writes the exports of `rshape fit`'s outcome (`r.json`, `r.m`, `r.py`, `r.jl`) into `dir`
 /// and returns the files written: the fit ([`crate::fit::run_fit`]) computes, the pipeline
-/// writes.
+/// writes.  With a config's `[scaling]`, `r.json` carries its `scaling` entry
+/// ([`crate::report::ScalingNote`]) and the others a first comment line saying so.
 pub fn write_fit_exports(
     outcome: &crate::fit::FitOutcome,
     dir: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
 ) -> Result<Vec<std::path::PathBuf>> {
-    crate::report::write_fit_exports(&outcome.result, outcome.table.as_deref(), dir)
+    let note = crate::report::ScalingNote::of_opt(scaling);
+    crate::report::write_fit_exports(
+        &outcome.result,
+        outcome.table.as_deref(),
+        dir,
+        note.as_ref(),
+    )
 }
 
-/// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` and returns the files written.
-pub fn export_r(fit: &FittedR, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
-    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir)
-}
-
-/// The `scaling` entry of `r.json` and `report.json` for a config with `[scaling]`: the
-/// diagonals of `D_o`, `D_i` and what `r` refers to.
-pub fn scaling_json(s: &crate::model::Scaling) -> Value {
-    serde_json::json!({
-        "outputs": s.outputs,
-        "inputs": s.inputs,
-        "auto": s.auto,
-        "r_refers_to": "the scaled plant G_s = D_o·G·D_i (D_o = diag(outputs), D_i = diag(inputs)); a controller K for G is K_s = D_i⁻¹·K·D_o⁻¹ for G_s",
-    })
-}
-
-/// Adds the config's `scaling` ([`scaling_json`]) to `dir/r.json` and a first comment line
-/// saying so to `r.m`, `r.py`, `r.jl` (each rewritten atomically); no change without
-/// `[scaling]` or without an `r.json`.
-pub fn note_scaling(dir: &std::path::Path, scaling: Option<&crate::model::Scaling>) -> Result<()> {
-    let (Some(s), p) = (scaling, dir.join("r.json")) else {
-        return Ok(());
-    };
-    if !p.exists() {
-        return Ok(());
-    }
-    let text = crate::util::read_text_file(&p)?;
-    let mut v: Value = serde_json::from_str(&text)
-        .map_err(|e| crate::error::Error::Invalid(format!("{}: {e}", p.display())))?;
-    if let Some(obj) = v.as_object_mut() {
-        obj.insert("scaling".into(), scaling_json(s));
-    }
-    let text = serde_json::to_string_pretty(&v)
-        .map_err(|e| crate::error::Error::Invalid(format!("r.json: {e}")))?;
-    crate::util::write_atomic(&p, text.as_bytes())?;
-    // The MATLAB, Python and Julia exports say it in a comment line.
-    let line = format!(
-        "r refers to the scaled plant G_s = D_o*G*D_i, {}",
-        s.describe()
-    );
-    for (name, comment) in [("r.m", "%"), ("r.py", "#"), ("r.jl", "#")] {
-        let p = dir.join(name);
-        if p.exists() {
-            let text = crate::util::read_text_file(&p)?;
-            let text = format!("{comment} {line}\n{text}");
-            crate::util::write_atomic(&p, text.as_bytes())?;
-        }
-    }
-    Ok(())
+/// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` (noting the config's `[scaling]` as
+/// [`write_fit_exports`] does) and returns the files written.
+pub fn export_r(
+    fit: &FittedR,
+    dir: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
+) -> Result<Vec<std::path::PathBuf>> {
+    let note = crate::report::ScalingNote::of_opt(scaling);
+    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir, note.as_ref())
 }

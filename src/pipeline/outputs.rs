@@ -55,11 +55,10 @@ pub fn write_outputs(
     write_atomic(&p, envelope_csv(env).as_bytes())?;
     files.push(p);
     if let Ok(fit) = &out.fit {
-        let written = out
-            .timings
-            .time("exports", || super::integration::export_r(fit, dir))?;
+        let written = out.timings.time("exports", || {
+            super::integration::export_r(fit, dir, config.scaling.as_ref())
+        })?;
         files.extend(written);
-        super::integration::note_scaling(dir, config.scaling.as_ref())?;
     }
     let t = std::time::Instant::now();
     let svgs = figures(config, data, out)?;
@@ -74,18 +73,8 @@ pub fn write_outputs(
     let report_path = dir.join("report.json");
     files.push(report_path.clone());
     let report = RunReport::new(config, data, out, &files);
-    let json_err = |e: serde_json::Error| Error::Invalid(format!("report.json: {e}"));
-    let text = match &config.scaling {
-        // The report's own key order is kept for runs without scaling.
-        None => serde_json::to_string_pretty(&report).map_err(json_err)?,
-        Some(s) => {
-            let mut value = serde_json::to_value(&report).map_err(json_err)?;
-            if let Some(obj) = value.as_object_mut() {
-                obj.insert("scaling".into(), super::integration::scaling_json(s));
-            }
-            serde_json::to_string_pretty(&value).map_err(json_err)?
-        }
-    };
+    let text = serde_json::to_string_pretty(&report)
+        .map_err(|e| Error::Invalid(format!("report.json: {e}")))?;
     write_atomic(&report_path, text.as_bytes())?;
     Ok((report, files))
 }
