@@ -7,7 +7,7 @@
 use crate::model::Scaling;
 use serde::{Deserialize, Serialize};
 
-/// What `r` refers to in a scaled config.
+/// What `r` refers to in a scaled config (the `r_refers_to` entry).
 pub const R_REFERS_TO: &str = "the scaled plant G_s = D_o·G·D_i (D_o = diag(outputs), D_i = diag(inputs)); a controller K for G is K_s = D_i⁻¹·K·D_o⁻¹ for G_s";
 
 /// The `scaling` entry of the JSON outputs.
@@ -19,7 +19,7 @@ pub struct ScalingNote {
     pub inputs: Vec<f64>,
     /// Computed by `scaling = "auto"`.
     pub auto: bool,
-    /// [`R_REFERS_TO`].
+    /// What `r` refers to: the scaled plant, and how a controller of `G` maps to `G_s`.
     pub r_refers_to: String,
 }
 
