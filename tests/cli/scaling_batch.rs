@@ -112,6 +112,35 @@ fn batch_notes_the_scaling_as_run_does_in_the_unscaled_key_order() {
     ] {
         assert!(json(&p).get("scaling").is_none(), "{}", p.display());
     }
+    // A merge of the shards of a scaled batch (its config read back from batch.json): the
+    // same note.
+    let shard = dir.path().join("shard");
+    let merged = dir.path().join("merged");
+    let cfg = dir.path().join("scaled.toml");
+    let data_dir = data_dir.to_str().unwrap();
+    let order = ["--order", "2", "--out"];
+    let shard_args = [
+        &[
+            "batch",
+            cfg.to_str().unwrap(),
+            "--data-dir",
+            data_dir,
+            "--shard",
+            "0/1",
+        ],
+        &order[..],
+    ]
+    .concat();
+    ok(&[&shard_args[..], &[shard.to_str().unwrap()]].concat());
+    ok(&[
+        &["merge", shard.to_str().unwrap()],
+        &order[..],
+        &[merged.to_str().unwrap()],
+    ]
+    .concat());
+    for p in [merged.join("r.json"), merged.join("batch.json")] {
+        assert_eq!(json(&p)["scaling"], note, "{}", p.display());
+    }
     // The MATLAB export of the batch says it too, as run's does.
     let first = |p: &Path| read(p).lines().next().unwrap().to_string();
     assert_eq!(first(&batch.join("r.m")), first(&run.join("r.m")));
