@@ -66,6 +66,7 @@ fn batch_1000(bencher: divan::Bencher) {
                 batch::FinishInput {
                     config: config.path.clone(),
                     config_digest: None,
+                    scaling: rshape::report::ScalingNote::of_opt(config.scaling.as_ref()),
                     r_configured: config.r.as_ref(),
                     n_total: list.len(),
                     shard: Shard::ALL,

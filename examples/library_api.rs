@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     print!("{}", outcome.text);
     let out = std::env::temp_dir().join("rshape-library-api");
-    for file in rshape::pipeline::write_fit_exports(&outcome, &out)? {
+    for file in rshape::pipeline::write_fit_exports(&outcome, &out, config.scaling.as_ref())? {
         println!("wrote {}", file.display());
     }
     Ok(())

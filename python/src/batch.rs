@@ -233,6 +233,7 @@ pub fn _batch(
                     batch::FinishInput {
                         config: cfg.path.clone(),
                         config_digest: batch::config_digest(&cfg.path),
+                        scaling: rshape::report::ScalingNote::of_opt(cfg.scaling.as_ref()),
                         r_configured: cfg.r.as_ref(),
                         n_total: sets.len(),
                         shard: batch::Shard::ALL,

@@ -125,10 +125,10 @@ impl Envelope {
     }
 }
 
-/// The data of a config: `frf` when given (its `[channel]` applied), else the config's file.
+/// The data of a config: `frf` when given (its `[channel]` and `[scaling]` applied), else the config's file.
 pub fn config_data(config: &rshape::Config, frf: Option<&Frf>) -> PyResult<rshape::FrfData> {
     match frf {
-        Some(d) => env_mod::select_channel(config, (*d.inner).clone()).py(),
+        Some(d) => env_mod::prepare_data(config, (*d.inner).clone()).py(),
         None => {
             let path = config.data.clone().ok_or_else(|| {
                 input(format!(

@@ -123,6 +123,8 @@ pub fn merge_then(
         FinishInput {
             config: first.config.clone(),
             config_digest: first.config_digest.clone(),
+            // The shards ran with the same config (its digest): the same scaling.
+            scaling: first.scaling.clone(),
             r_configured: r.as_ref(),
             n_total: first.n_total,
             shard: Shard::ALL,

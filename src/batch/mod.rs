@@ -66,6 +66,9 @@ pub struct BatchReport {
     /// configs); absent in outputs of older versions.
     #[serde(default)]
     pub config_digest: Option<String>,
+    /// The config's `[scaling]`: every `r` and `r_min` here is that of the scaled plant.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scaling: Option<crate::report::ScalingNote>,
     /// The configured `r`, if any.
     pub r_configured: Option<CoeffsOwned>,
     /// Datasets in the full (unsharded) list.
@@ -181,6 +184,8 @@ pub struct FinishInput<'a> {
     pub config: PathBuf,
     /// Digest of the config file ([`config_digest`]).
     pub config_digest: Option<String>,
+    /// The config's `[scaling]`, noted in `r.json` and `batch.json`.
+    pub scaling: Option<crate::report::ScalingNote>,
     /// The configured `r`.
     pub r_configured: Option<&'a TransferFunction>,
     /// Datasets in the full list.
@@ -233,7 +238,7 @@ pub fn finish(
         )?;
     }
     if let Some(Ok(f)) = &fit {
-        integration::export_r(f, out)?;
+        crate::report::write_fit_exports(&f.result, f.table.as_deref(), out, inp.scaling.as_ref())?;
     }
     write_atomic(&out.join("summary.csv"), summary::render(rows).as_bytes())?;
     if let Some(env) = combined {
@@ -255,6 +260,7 @@ pub fn finish(
         rshape_version: env!("CARGO_PKG_VERSION").to_string(),
         config: inp.config,
         config_digest: inp.config_digest,
+        scaling: inp.scaling,
         r_configured: inp.r_configured.map(CoeffsOwned::from),
         n_total: inp.n_total,
         shard: inp.shard,

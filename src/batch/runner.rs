@@ -25,6 +25,9 @@ pub struct DatasetResult {
     pub name: String,
     /// The data file.
     pub path: std::path::PathBuf,
+    /// The config's `[scaling]`: `max_r_min` and the envelope are those of the scaled plant.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scaling: Option<crate::report::ScalingNote>,
     /// `None` on success, else the error on one line.
     pub error: Option<String>,
     /// Number of data.
@@ -66,6 +69,7 @@ pub fn run_one(config: &Config, d: &Dataset, opts: &BatchSettings, out: &Path) -
         index: d.index,
         name: d.name.clone(),
         path: d.path.clone(),
+        scaling: crate::report::ScalingNote::of_opt(config.scaling.as_ref()),
         error: None,
         n_data: 0,
         max_r_min: None,

@@ -164,6 +164,7 @@ pub fn run(a: &BatchArgs) -> Result<i32> {
         FinishInput {
             config: config.path.clone(),
             config_digest: batch::config_digest(&config.path),
+            scaling: crate::report::ScalingNote::of_opt(config.scaling.as_ref()),
             r_configured: config.r.as_ref(),
             n_total: all.len(),
             shard,

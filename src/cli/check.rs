@@ -103,6 +103,12 @@ pub fn run(a: &CheckArgs) -> Result<i32> {
                 list(&rep.failing_omegas)
             );
         }
+        if let Some(s) = &inputs.config.scaling {
+            println!(
+                "scaling: {}: {w} and r_min refer to the scaled plant G_s = D_o·G·D_i",
+                s.describe()
+            );
+        }
         match rep.verdict {
             Verdict::Consistent => {
                 println!("consistent: {w} explains all {} data", rep.rows.len())

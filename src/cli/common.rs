@@ -73,16 +73,13 @@ impl InputArgs {
     }
 
     /// The envelope alone, streamed when the noise-free theorems apply
-    /// ([`crate::pipeline::envelope::envelope_of_file`]).
-    pub fn envelope_only(&self) -> Result<Envelope> {
+    /// ([`crate::pipeline::envelope::envelope_of_file`]), with the config it was computed for.
+    pub fn envelope_only(&self) -> Result<(Config, Envelope)> {
         let config = load_config(&self.config)?;
         self.check_noise_radius()?;
         let path = self.data_path(&config)?;
-        Ok(crate::pipeline::envelope::envelope_of_file(
-            &config,
-            &path,
-            self.noise_radius,
-        )?)
+        let env = crate::pipeline::envelope::envelope_of_file(&config, &path, self.noise_radius)?;
+        Ok((config, env))
     }
 
     /// Loads inputs and computes their envelope ([`crate::pipeline::envelope::envelope`]).
@@ -335,7 +332,7 @@ pub fn fit_bound(
     out: &std::path::Path,
 ) -> Result<(String, crate::system::TransferFunction)> {
     let outcome = fit_bound_in_memory(label, input)?;
-    write_fit_text(outcome, out)
+    write_fit_text(outcome, out, input.0.config.scaling.as_ref())
 }
 
 /// As [`fit_bound`], writing nothing: the caller checks the rest, then writes the fit and
@@ -360,15 +357,51 @@ pub fn fit_bound_in_memory(
 }
 
 /// Writes the fit's exports into `out` (`pipeline::write_fit_exports`) and returns its
-/// printable text (the files written, the work line) and the fitted `r`.
+/// printable text (the files written, the work line) and the fitted `r`; a config's
+/// `[scaling]` is noted in them.
 pub fn write_fit_text(
     outcome: crate::fit::FitOutcome,
     out: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
 ) -> Result<(String, crate::system::TransferFunction)> {
     let mut text = outcome.text.clone();
-    for f in crate::pipeline::write_fit_exports(&outcome, out)? {
+    for f in crate::pipeline::write_fit_exports(&outcome, out, scaling)? {
         text.push_str(&format!("wrote {}\n", f.display()));
     }
     text.push_str(&crate::fit::work_line(&outcome.result, outcome.seconds));
     Ok((text, outcome.result.r))
+}
+
+/// The subcommands that do not apply `[scaling]` yet refuse it (exit 2) rather than mix
+/// units: `diagnose` revises the model in the data's own units.
+pub fn refuse_scaling(config: &Config, command: &str) -> Result<()> {
+    match &config.scaling {
+        Some(_) if command == "diagnose" => Err(anyhow!(
+            "{}: diagnose adds effects to a [physical] model in the data's own units, and this model cannot be converted ([scaling] is not applied by diagnose yet); remove [scaling], or use a copy of the config without it, to diagnose",
+            config.path.display()
+        )),
+        Some(_) => Err(anyhow!(
+            "{}: rshape {command} does not apply [scaling] yet (its answer would be in the scaled units); remove [scaling], or use a copy of the config without it, for {command}",
+            config.path.display()
+        )),
+        None => Ok(()),
+    }
+}
+
+/// `compare` with `[scaling]`: the scaled data against the scaled model, which is exact when
+/// there is no noise or the noise comes from a coherence (`ε·|H|` scales with `H`); a noise
+/// given in the data file's units (a radius, `--noise-radius`, a std file, an output bound,
+/// a `noise_radius` column) is refused (exit 2) rather than compared in mixed units.
+pub fn refuse_scaled_noise(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<()> {
+    use crate::model::NoiseSource;
+    if config.scaling.is_none() {
+        return Ok(());
+    }
+    match crate::model::noise_source(cli, Some(config), data.noise_radius.is_some()) {
+        None | Some(NoiseSource::ConfigCoherence) => Ok(()),
+        Some(src) => Err(anyhow!(
+            "{}: rshape compare does not scale a noise given in the data's units ({src:?}) by [scaling] yet; use a config without [scaling] for compare (its verdict does not depend on units)",
+            config.path.display()
+        )),
+    }
 }

@@ -51,6 +51,7 @@ pub fn run_compare(
     band: Option<(f64, f64)>,
 ) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
     let inputs = input.load()?;
+    super::common::refuse_scaled_noise(&inputs.config, &inputs.data, input.noise_radius)?;
     // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
     // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
     let inputs = crate::pipeline::closed_loop::discovery_inputs(
@@ -150,6 +151,8 @@ pub fn run(a: &CompareArgs) -> Result<i32> {
         Some(p) => {
             let inputs = a.input.load()?;
             let other = crate::pipeline::envelope::read_data_file(&inputs.config, p)?;
+            // In the units of the compared data: the config's [scaling], if any.
+            let other = crate::pipeline::envelope::scale_data(&inputs.config, other)?;
             let sb = prepare(
                 &inputs.config,
                 &other,

@@ -27,7 +27,7 @@ pub fn run(a: &EnvelopeArgs) -> Result<i32> {
         .collect();
     // `--out` is checked before the work: a refusal must not cost the user the envelope.
     let _manifest = super::common::prepare_out(&a.out, &inputs)?;
-    let env = a.input.envelope_only()?;
+    let (config, env) = a.input.envelope_only()?;
     let path = a.out.join("envelope.csv");
     let mut file = AtomicFile::create(&path)?;
     write_envelope_csv(&env, file.writer()).map_err(|source| crate::error::Error::Io {
@@ -59,6 +59,12 @@ pub fn run(a: &EnvelopeArgs) -> Result<i32> {
             "warning: r_min reaches the A1 limit at {} datum(s) (omega = {}): no admissible r explains them; the nominal model must change",
             beyond.len(),
             fmt_omegas(&env.omega, &beyond)
+        );
+    }
+    if let Some(s) = &config.scaling {
+        println!(
+            "scaling: {}: r_min and the A1 limit are those of the scaled plant G_s = D_o·G·D_i",
+            s.describe()
         );
     }
     println!("wrote {}", path.display());

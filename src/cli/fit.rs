@@ -70,6 +70,8 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     let view = super::progress::FitProgressView::new("fit");
     let progress = |p| view.update(p);
     let progress: crate::fit::ProgressFn<'_> = &progress;
+    // The config's [scaling], recorded in r.json (r is then that of the scaled plant).
+    let mut scaling = None;
     let outcome = match (&a.envelope, &a.config) {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
@@ -83,6 +85,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
                 noise_radius: a.noise_radius,
             };
             let inputs = input.load()?;
+            scaling.clone_from(&inputs.config.scaling);
             // `--out` is checked before the work: a refusal must not cost the user the envelope.
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             let env = input.envelope_of(&inputs)?;
@@ -103,7 +106,8 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     view.finish();
     let outcome = outcome?;
     print!("{}", outcome.text);
-    for f in crate::pipeline::write_fit_exports(&outcome, &a.out)? {
+    let written = crate::pipeline::write_fit_exports(&outcome, &a.out, scaling.as_ref())?;
+    for f in written {
         println!("wrote {}", f.display());
     }
     print!("{}", work_line(&outcome.result, outcome.seconds));

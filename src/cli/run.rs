@@ -100,6 +100,20 @@ pub fn run(a: &RunArgs) -> Result<i32> {
             fmt_g(ts)
         );
     }
+    if let Some(s) = &config.scaling {
+        // Said once: every number below refers to the scaled plant D_o·G·D_i.
+        outln!(
+            "  scaling   {}{}: data, model and {w} in the scaled units (G_s = D_o·G·D_i)",
+            s.describe(),
+            if s.auto { " (auto)" } else { "" }
+        );
+        if s.auto {
+            outln!(
+                "            to fix them, replace scaling = \"auto\" by: {}",
+                s.as_toml()
+            );
+        }
+    }
     outln!(
         "  envelope  {}, max {wmin} = {}",
         // The name report.json and the docs use (`theorem4_mu`), not the Rust one.

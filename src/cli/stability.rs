@@ -49,6 +49,8 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
     // The controller's size is checked before anything is written (the loop itself, dear on
     // a large model, is built once, by `stability::run`).
     crate::stability::controller_fits(&config.factorization, &controller)?;
+    // With [scaling] the loop is that of G_s = D_o·G·D_i and K_s = D_i⁻¹·K·D_o⁻¹.
+    let controller = crate::pipeline::stability::scaled_controller(&config, controller);
     // The output folder policy of every subcommand (see `prepare_out`): not a file, not an
     // input's folder (refused before any work); the previous run's listed files are cleared.
     let inputs: Vec<&Path> = [a.config.as_path(), a.controller.as_path()]
@@ -111,6 +113,12 @@ pub fn run(a: &StabilityArgs) -> Result<i32> {
         return Ok(code);
     }
     print!("{fit_text}");
+    if let Some(s) = &config.scaling {
+        outln!(
+            "scaling: {}; the loop of G_s = D_o·G·D_i and K_s = D_i^-1·K·D_o^-1 (the same loop as G and K)",
+            s.describe()
+        );
+    }
     print!("{}", stability::text(&outcome));
     if outcome.report.internally_stable {
         for f in &written {

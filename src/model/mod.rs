@@ -16,6 +16,8 @@
 //!   precedence, [`ResolvedNoise`], [`NoiseSource`]), [`resolve_noise_for_channel`],
 //!   [`noise_source`], [`is_noise_free`], [`noise_radii`], and the `L∞` output-bound model
 //!   [`linf_disk_radius`], [`phase_bound`], [`radii_from_output_bound`];
+//! * units: `[scaling]`, `G_s = D_o·G·D_i` applied to the model, the data and a controller
+//!   ([`Scaling`], [`ScalingSpec`], [`ScalingSection`], [`auto_scaling`]);
 //! * a controller `K` for the robust-stability test: [`Controller`] ([`ControllerSection`],
 //!   [`Feedback`]);
 //! * models described by their physics: the [`physical`] folder; the closed-loop model of
@@ -29,6 +31,7 @@ pub(crate) mod factorization;
 pub(crate) mod noise;
 pub mod physical;
 pub(crate) mod plant;
+pub(crate) mod scaling;
 
 pub use config::{
     ChannelSection, Config, ModelSection, NoiseSection, RSection, RationalEntry, RawConfig, TfEntry,
@@ -44,3 +47,4 @@ pub use noise::{
     radii_from_output_bound, resolve_noise, resolve_noise_for_channel, NoiseSource, ResolvedNoise,
 };
 pub use plant::PlantSection;
+pub use scaling::{auto_scaling, Scaling, ScalingSection, ScalingSpec};

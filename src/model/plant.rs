@@ -246,7 +246,26 @@ impl PlantSection {
     /// The standard factorization by the normalized left coprime factors of the plant,
     /// refused when the factors do not reproduce the plant (`‖M̃G − Ñ‖ ≤ 1e-5`).
     pub fn to_factorization(&self, base: &Path) -> std::result::Result<Factorization, String> {
+        Ok(self.to_scaled_factorization(base, None)?.0)
+    }
+
+    /// [`PlantSection::to_factorization`] of the scaled plant `D_o·G·D_i` when a `scaling`
+    /// is given (resolved against the plant's size; `"auto"` from the plant itself), with
+    /// the scalings used.
+    pub fn to_scaled_factorization(
+        &self,
+        base: &Path,
+        scaling: Option<&super::scaling::ScalingSpec>,
+    ) -> std::result::Result<(Factorization, Option<super::scaling::Scaling>), String> {
         let ss = self.state_space(base)?;
+        let (ss, used) = match scaling {
+            Some(spec) => {
+                let s = spec.resolve(ss.d.nrows(), ss.d.ncols(), Some(&ss))?;
+                (s.plant(&ss), Some(s))
+            }
+            None => (ss, None),
+        };
+        let scaled = used.is_some();
         let ncf = NormalizedLcf::new(ss).map_err(|e| format!("[plant]: {e}"))?;
         // The factors checked against the plant itself: a gain far from 1 leaves M̃ ≈ 1/G
         // without a correct digit, and every later answer wrong or a puzzling failure.
@@ -255,10 +274,11 @@ impl PlantSection {
             .map_err(|e| format!("[plant]: {e}"))?;
         if res.is_nan() || res > FACTOR_RESIDUAL_MAX {
             return Err(format!(
-                "[plant]: its gain |G| ≈ {gain:.1e} at {w:.3e} rad/s is too far from 1 for normalized coprime factors in double precision (‖M̃G − Ñ‖ = {res:.1e}, needs ≤ {FACTOR_RESIDUAL_MAX:.0e}); rescale the plant (its output or input units) so that its gain is nearer 1"
+                "[plant]: its gain |G| ≈ {gain:.1e} at {w:.3e} rad/s is too far from 1 for normalized coprime factors in double precision (‖M̃G − Ñ‖ = {res:.1e}, needs ≤ {FACTOR_RESIDUAL_MAX:.0e}); rescale the plant (its output or input units) so that its gain is nearer 1{}",
+                if scaled { " (after its [scaling])" } else { ": [scaling] outputs = [...], inputs = [...] in the config" }
             ));
         }
-        Ok(Factorization::normalized(ncf))
+        Ok((Factorization::normalized(ncf), used))
     }
 }
 

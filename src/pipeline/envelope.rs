@@ -73,7 +73,8 @@ pub fn envelope_of_file(
     data_path: &Path,
     cli_noise: Option<f64>,
 ) -> Result<Envelope> {
-    if config.closed_loop.is_none() {
+    // Scaled data are read whole: the scaling applies to each datum before the envelope.
+    if config.closed_loop.is_none() && config.scaling.is_none() {
         let rows = FrfRows::open(data_path)?.with_sample_time(config.sample_time());
         if cli_noise.is_none() {
             config.raw.noise.validate().map_err(|msg| Error::Config {
@@ -90,10 +91,32 @@ pub fn envelope_of_file(
     Ok(envelope(config, &data, &RunOptions::noise_radius(cli_noise))?.envelope)
 }
 
-/// Reads a config's data file (closed-loop spectra or FRF) and applies its `[channel]` when
-/// the data are larger than the model.
+/// Reads a config's data file (closed-loop spectra or FRF), applies its `[channel]` when
+/// the data are larger than the model, then its `[scaling]` ([`prepare_data`]).
 pub fn load_data(config: &Config, data_path: &Path) -> Result<FrfData> {
-    select_channel(config, read_data_file(config, data_path)?)
+    prepare_data(config, read_data_file(config, data_path)?)
+}
+
+/// Data in the model's terms: the config's `[channel]` ([`select_channel`]), then its
+/// `[scaling]` ([`scale_data`]).  The one place data read from a file or given as arrays
+/// (the Python package) meet the model.
+pub fn prepare_data(config: &Config, data: FrfData) -> Result<FrfData> {
+    scale_data(config, select_channel(config, data)?)
+}
+
+/// `Φ_s = D_o·Φ·D_i` for a config with `[scaling]` (data of the model's size), the data
+/// unchanged otherwise.  A size that does not fit is an error naming the key and the file.
+pub fn scale_data(config: &Config, data: FrfData) -> Result<FrfData> {
+    match &config.scaling {
+        Some(s) => {
+            let path = data.path.clone();
+            s.frf(data).map_err(|msg| Error::Config {
+                path: config.path.clone(),
+                msg: format!("{msg} ({})", path.display()),
+            })
+        }
+        None => Ok(data),
+    }
 }
 
 /// Reads a data file of a config (closed-loop spectra or FRF) on the config's frequency

@@ -29,7 +29,19 @@ pub(super) fn noise_radii(
     data: &FrfData,
     cli: Option<f64>,
 ) -> Result<Option<Vec<f64>>> {
-    let radii = crate::model::noise::noise_radii(cli, Some(config), data)?;
+    let radii = match &config.scaling {
+        // Every noise source (a radius, `--noise-radius`, a std or coherence file, the
+        // output bound, the data column) is in the data file's units: resolved on the
+        // unscaled data, the radii then scale like the entries (`d_o·d_i`, SISO).
+        Some(s) => {
+            let raw = s.unscale_frf(data.clone());
+            crate::model::noise::noise_radii(cli, Some(config), &raw)?.map(|r| {
+                let k = s.radius_factor().unwrap_or(1.0);
+                r.into_iter().map(|x| x * k).collect::<Vec<_>>()
+            })
+        }
+        None => crate::model::noise::noise_radii(cli, Some(config), data)?,
+    };
     Ok(radii.filter(|r| r.iter().any(|x| *x > 0.0)))
 }
 
@@ -163,7 +175,7 @@ pub fn fit_r(
             (r, None)
         }
     };
-    let text = crate::report::export::r_json(&result, table.as_deref());
+    let text = crate::report::export::r_json(&result, table.as_deref(), None);
     let json: Value = serde_json::from_str(&text).map_err(|e| FitFailure::Json(e.to_string()))?;
     let certificate = json
         .get("certificate")
@@ -194,15 +206,29 @@ pub fn explain(
 
 /// Writes the exports of `rshape fit`'s outcome (`r.json`, `r.m`, `r.py`, `r.jl`) into `dir`
 /// and returns the files written: the fit ([`crate::fit::run_fit`]) computes, the pipeline
-/// writes.
+/// writes.  With a config's `[scaling]`, `r.json` carries its `scaling` entry
+/// ([`crate::report::ScalingNote`]) and the others a first comment line saying so.
 pub fn write_fit_exports(
     outcome: &crate::fit::FitOutcome,
     dir: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
 ) -> Result<Vec<std::path::PathBuf>> {
-    crate::report::write_fit_exports(&outcome.result, outcome.table.as_deref(), dir)
+    let note = crate::report::ScalingNote::of_opt(scaling);
+    crate::report::write_fit_exports(
+        &outcome.result,
+        outcome.table.as_deref(),
+        dir,
+        note.as_ref(),
+    )
 }
 
-/// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` and returns the files written.
-pub fn export_r(fit: &FittedR, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>> {
-    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir)
+/// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` (noting the config's `[scaling]` as
+/// [`write_fit_exports`] does) and returns the files written.
+pub fn export_r(
+    fit: &FittedR,
+    dir: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
+) -> Result<Vec<std::path::PathBuf>> {
+    let note = crate::report::ScalingNote::of_opt(scaling);
+    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir, note.as_ref())
 }

@@ -55,9 +55,9 @@ pub fn write_outputs(
     write_atomic(&p, envelope_csv(env).as_bytes())?;
     files.push(p);
     if let Ok(fit) = &out.fit {
-        let written = out
-            .timings
-            .time("exports", || super::integration::export_r(fit, dir))?;
+        let written = out.timings.time("exports", || {
+            super::integration::export_r(fit, dir, config.scaling.as_ref())
+        })?;
         files.extend(written);
     }
     let t = std::time::Instant::now();
@@ -103,6 +103,11 @@ pub fn figures(config: &Config, data: &FrfData, out: &RunOutcome) -> Result<Vec<
         format!("{}…", name.chars().take(63).collect::<String>())
     } else {
         name
+    };
+    // The figures of a scaled config show the scaled plant and data (D_o·G·D_i).
+    let name = match &config.scaling {
+        Some(_) if !name.contains("scaled") => format!("{name} (scaled units)"),
+        _ => name,
     };
     let mut svgs = Vec::new();
     let cl = config.closed_loop.is_some();

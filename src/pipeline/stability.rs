@@ -377,3 +377,17 @@ pub fn text(o: &StabilityOutcome) -> String {
     }
     s
 }
+
+/// The controller of a config's loop: `K` itself, or `K_s = D_i⁻¹·K·D_o⁻¹` when the config
+/// has `[scaling]` (its factors are those of `G_s = D_o·G·D_i`; the loop `G_s·K_s` is
+/// `D_o·G·K·D_o⁻¹`, so internal stability and the closed-loop poles are those of `G`, `K`).
+/// `K` must have the plant's size (checked by [`crate::stability::controller_fits`]).
+pub fn scaled_controller(
+    config: &Config,
+    mut controller: crate::model::Controller,
+) -> crate::model::Controller {
+    if let Some(s) = &config.scaling {
+        controller.k = s.controller(&controller.k);
+    }
+    controller
+}

@@ -26,6 +26,10 @@ struct RJson<'a> {
     b: Vec<Vec<f64>>,
     c: Vec<Vec<f64>>,
     d: Vec<Vec<f64>>,
+    // Where the description of r ends and the fit's record begins: r is that of the
+    // scaled plant.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    scaling: Option<&'a super::ScalingNote>,
     order: usize,
     objective: crate::fit::Objective,
     objective_value: f64,
@@ -52,8 +56,12 @@ fn list(v: &[f64], sep: &str) -> String {
     v.iter().map(|x| num(*x)).collect::<Vec<_>>().join(sep)
 }
 
-/// The JSON text of `r.json`.
-pub fn r_json(fit: &FitResult, table: Option<&[OrderRow]>) -> String {
+/// The JSON text of `r.json`, with the `scaling` entry of a scaled config.
+pub fn r_json(
+    fit: &FitResult,
+    table: Option<&[OrderRow]>,
+    scaling: Option<&super::ScalingNote>,
+) -> String {
     let ss = crate::fit::realization::realize(&crate::fit::Zpk {
         gain: fit.gain,
         zeros: fit.zeros.clone(),
@@ -74,6 +82,7 @@ pub fn r_json(fit: &FitResult, table: Option<&[OrderRow]>) -> String {
         b: rows(&ss.b),
         c: rows(&ss.c),
         d: rows(&ss.d),
+        scaling,
         order: fit.order,
         objective: fit.objective,
         objective_value: fit.objective_value,
@@ -127,17 +136,24 @@ pub fn r_julia(fit: &FitResult) -> String {
     )
 }
 
-/// Writes `r.json`, `r.m`, `r.py` and `r.jl` into `dir`; returns the paths.
+/// Writes `r.json`, `r.m`, `r.py` and `r.jl` into `dir`; returns the paths.  With the
+/// `scaling` of a scaled config, `r.json` carries it and the others say it in a first
+/// comment line.
 pub fn write_fit_exports(
     fit: &FitResult,
     table: Option<&[OrderRow]>,
     dir: &Path,
+    scaling: Option<&super::ScalingNote>,
 ) -> Result<Vec<PathBuf>> {
+    let note = |comment: &str, text: String| match scaling {
+        Some(s) => format!("{comment} {}\n{text}", s.comment()),
+        None => text,
+    };
     let files = [
-        ("r.json", r_json(fit, table)),
-        ("r.m", r_matlab(fit)),
-        ("r.py", r_python(fit)),
-        ("r.jl", r_julia(fit)),
+        ("r.json", r_json(fit, table, scaling)),
+        ("r.m", note("%", r_matlab(fit))),
+        ("r.py", note("#", r_python(fit))),
+        ("r.jl", note("#", r_julia(fit))),
     ];
     let mut out = Vec::new();
     for (name, text) in files {

@@ -58,6 +58,10 @@ pub struct RunReport {
     /// their frequencies were divided by it, so every frequency here is in rad/s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sample_time: Option<f64>,
+    /// The config's `[scaling]`: every `r`, `r_min` and datum here is that of the scaled
+    /// plant `D_o·G·D_i`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scaling: Option<super::ScalingNote>,
     /// Number of data.
     pub n_data: usize,
     /// Outputs × inputs of the data.
@@ -152,6 +156,7 @@ impl RunReport {
             config: config.path.clone(),
             data: data.path.clone(),
             sample_time: config.sample_time(),
+            scaling: super::ScalingNote::of_opt(config.scaling.as_ref()),
             n_data: env.len(),
             size: [data.outputs(), data.inputs()],
             method: env.method,

@@ -38,4 +38,6 @@ mod progress_cli;
 mod quiet_output;
 mod run_cli;
 mod sample_time;
+mod scaling_batch;
+mod scaling_cli;
 mod settings_validate;

@@ -19,6 +19,7 @@ mod iss_reduction;
 mod loop_poles_structure;
 mod modal_cascade_rows;
 mod progress_stages;
+mod scaling;
 mod stability;
 mod stability_special;
 mod synthesize;

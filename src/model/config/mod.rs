@@ -136,6 +136,11 @@ pub struct RawConfig {
     /// The weight `V` of the closed-loop model (eq. (2)), the analogue of `[r]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub v: Option<RSection>,
+    /// Units scaling `G_s = D_o·G·D_i` of the model, the data and a controller
+    /// (`[scaling] outputs = [..], inputs = [..]`, or `scaling = "auto"` for a `[plant]`;
+    /// see [`crate::model::Scaling`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scaling: Option<super::scaling::ScalingSpec>,
 }
 
 impl RawConfig {
@@ -196,6 +201,9 @@ pub struct Config {
     /// The closed-loop model when the config has `[closed_loop]`; then `factorization` is
     /// its open-loop equivalent and `r` holds the weight `V` of `[v]`.
     pub closed_loop: Option<super::closed_loop::ClosedLoopModel>,
+    /// The units scaling of `[scaling]`: `factorization` is then that of `D_o·G·D_i`, and
+    /// the pipeline scales the data and a controller alike ([`crate::model::Scaling`]).
+    pub scaling: Option<super::scaling::Scaling>,
 }
 
 fn tf_rows(
@@ -262,16 +270,34 @@ impl Config {
             }
         })?;
         let closed_loop = super::closed_loop::from_raw(&raw).map_err(err)?;
+        if raw.scaling.is_some() && (raw.physical.is_some() || closed_loop.is_some()) {
+            let what = if closed_loop.is_some() {
+                "[closed_loop]"
+            } else {
+                "[physical]"
+            };
+            return Err(err(format!(
+                "[scaling] is for a [plant] or a [model], not a {what} model: remove [scaling] (a {what} model is in the units of its data{})",
+                if raw.physical.is_some() { "; its modal envelope (Theorem 3) does not depend on them" } else { "" }
+            )));
+        }
+        let mut scaling = None;
         let plant_factorization = match &raw.plant {
             Some(_) if raw.model.is_some() || raw.physical.is_some() || closed_loop.is_some() => {
                 return Err(err(
                     "give the model as one of [model], [physical], [plant] or [closed_loop], not several".into(),
                 ))
             }
-            Some(pl) => Some(
-                pl.to_factorization(path.parent().unwrap_or(Path::new(".")))
-                    .map_err(err)?,
-            ),
+            Some(pl) => {
+                let (f, used) = pl
+                    .to_scaled_factorization(
+                        path.parent().unwrap_or(Path::new(".")),
+                        raw.scaling.as_ref(),
+                    )
+                    .map_err(err)?;
+                scaling = used;
+                Some(f)
+            }
             None => None,
         };
         let (factorization, physical) = match (&raw.model, &raw.physical) {
@@ -284,7 +310,18 @@ impl Config {
                     .map_err(err)?,
                 None,
             ),
-            (Some(m), None) => (Self::build_factorization(m).map_err(err)?, None),
+            (Some(m), None) => {
+                let f = Self::build_factorization(m).map_err(err)?;
+                match &raw.scaling {
+                    Some(spec) => {
+                        let s = spec.resolve(f.outputs(), f.inputs(), None).map_err(err)?;
+                        let scaled = s.factorization(&f).map_err(err)?;
+                        scaling = Some(s);
+                        (scaled, None)
+                    }
+                    None => (f, None),
+                }
+            }
             (None, Some(ph)) => {
                 ph.validate().map_err(err)?;
                 (ph.to_factorization().map_err(err)?, Some(ph.clone()))
@@ -351,6 +388,7 @@ impl Config {
             physical,
             noise_std,
             closed_loop,
+            scaling,
         })
     }
 
