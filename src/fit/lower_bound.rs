@@ -199,9 +199,15 @@ fn check(prep: &Prepared, n: usize, t: f64, ids: &[RowId], y: &[f64], mu: f64) -
 }
 
 /// Solves the relaxation of order `n` at level `t` and checks a certificate of
-/// infeasibility; one LP.
-pub(crate) fn prove_below(prep: &Prepared, n: usize, t: f64) -> Verdict {
-    match certificate(prep, n, t) {
+/// infeasibility (a few LPs: working-set rounds).
+#[cfg(test)]
+fn prove_below(prep: &Prepared, n: usize, t: f64) -> Verdict {
+    prove_counted(prep, n, t, &mut 0)
+}
+
+/// [`prove_below`], adding the LPs it solved (working-set rounds) to `lps`.
+fn prove_counted(prep: &Prepared, n: usize, t: f64, lps: &mut usize) -> Verdict {
+    match certificate(prep, n, t, lps) {
         Ok((ids, y, mu)) => match check(prep, n, t, &ids, &y, mu) {
             Some(m) => Verdict::Proved(m),
             None => Verdict::Undecided(SolverStatus::PrimalInfeasible),
@@ -210,37 +216,122 @@ pub(crate) fn prove_below(prep: &Prepared, n: usize, t: f64) -> Verdict {
     }
 }
 
-/// The rows of the relaxation and Clarabel's certificate `(y, μ)` of its infeasibility at
-/// `t`, unchecked; or the verdict without one.
+/// The rows of the relaxation and a certificate `(y, μ)` of its infeasibility at `t`,
+/// unchecked; or the verdict without one.
+///
+/// The certificate is the dual of the *depth* LP `max s` s.t. `g_iᵀv ≥ s` (every row),
+/// `s ≤ 1`, `a₀ + b₀ = 1`, not Clarabel's ray after `PrimalInfeasible`: the depth LP is
+/// always feasible, its dual at the optimum has `Σy ≤ 1` and `μ = −s* > 0` when the level
+/// is infeasible, the deepest certificate there is.  On envelope 4 of the sweep at order 1
+/// the level sets are thin near `u = 1` (`A` and `B` may both vanish at infinity, where no
+/// row holds their ratio), `s* = −10⁻⁶…−10⁻⁸`, and Clarabel's ray had `Σy/μ ≈ 10¹³–10¹⁴`:
+/// the round-off bound of the check rejected it 0.7 decade below the optimum.
 #[allow(clippy::type_complexity)]
-fn certificate(prep: &Prepared, n: usize, t: f64) -> Result<(Vec<RowId>, Vec<f64>, f64), Verdict> {
+fn certificate(
+    prep: &Prepared,
+    n: usize,
+    t: f64,
+    lps: &mut usize,
+) -> Result<(Vec<RowId>, Vec<f64>, f64), Verdict> {
     if !(t.is_finite() && t > 0.0) {
         return Err(Verdict::Undecided(SolverStatus::SetupError));
     }
-    let ids = row_ids(prep, n);
-    let lp = Lp {
-        n: 2 * (n + 1),
-        c: vec![0.0; 2 * (n + 1)],
-        ge: ids
-            .iter()
-            .map(|id| (row(prep, n, t, *id, by_recurrence), 0.0))
-            .collect(),
-        eq: vec![(normalization(n), 1.0)],
-    };
-    let (status, _, z) = lp.solve_with_dual(MAX_ITER, true);
-    match status {
-        SolverStatus::Solved => Err(Verdict::Feasible),
-        SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible
-            if z.len() == ids.len() + 1 =>
-        {
-            // Clarabel's form `A v + s = b`: the equality's dual is `−μ`; tiny negative
-            // weights of inequalities are round-off, and dropping them only changes `r`,
-            // which the check computes itself.
-            let y: Vec<f64> = z[1..].iter().map(|v| v.max(0.0)).collect();
-            Ok((ids, y, -z[0]))
+    let all = row_ids(prep, n);
+    let rows: Vec<Vec<f64>> = all
+        .iter()
+        .map(|id| row(prep, n, t, *id, by_recurrence))
+        .collect();
+    // A working set: the coefficient rows, the rows at about 40 grid points; rows the
+    // solution violates are added.  A certificate of a subset of the rows is one of them
+    // all (the other rows' weights are 0), so the set only has to grow until the check
+    // passes or the point meets every row.
+    let init = super::working_set::initial_points(&prep.grid, 40);
+    let mut active: Vec<bool> = all
+        .iter()
+        .map(|id| match id {
+            RowId::Mean(_) | RowId::Coef(..) => true,
+            RowId::Lower(i) | RowId::A1(i) | RowId::BPos(i) | RowId::Level(i) => init[*i],
+        })
+        .collect();
+    let mut status = SolverStatus::SetupError;
+    for _ in 0..WS_ROUNDS {
+        let idx: Vec<usize> = (0..all.len()).filter(|i| active[*i]).collect();
+        *lps += 1;
+        let (st, v, s, y, mu) = depth(&rows, &idx, n)?;
+        status = st;
+        if s < 0.0 {
+            let ids: Vec<RowId> = idx.iter().map(|i| all[*i]).collect();
+            if check(prep, n, t, &ids, &y, mu).is_some() {
+                return Ok((ids, y, mu));
+            }
         }
-        s => Err(Verdict::Undecided(s)),
+        // Rows below the depth reached (beyond round-off), worst first.
+        let mut viol: Vec<(f64, usize)> = (0..all.len())
+            .filter(|i| !active[*i])
+            .map(|i| {
+                let g: f64 = rows[i].iter().zip(&v).map(|(a, b)| a * b).sum();
+                (g - s.max(0.0), i)
+            })
+            .filter(|(d, _)| *d < -1e-12)
+            .collect();
+        if viol.is_empty() {
+            return Err(if s >= 0.0 && st == SolverStatus::Solved {
+                Verdict::Feasible
+            } else {
+                Verdict::Undecided(st)
+            });
+        }
+        viol.sort_by(|p, q| p.0.total_cmp(&q.0));
+        for (_, i) in viol.into_iter().take(WS_ADD) {
+            active[i] = true;
+        }
     }
+    Err(Verdict::Undecided(status))
+}
+
+/// Working-set rounds of one relaxation level, and rows added per round at most.
+const WS_ROUNDS: usize = 30;
+const WS_ADD: usize = 60;
+
+/// The depth LP on the rows `idx`: its status, point `v`, depth `s*`, and the dual
+/// `(y, μ)` on those rows.
+#[allow(clippy::type_complexity)]
+fn depth(
+    rows: &[Vec<f64>],
+    idx: &[usize],
+    n: usize,
+) -> Result<(SolverStatus, Vec<f64>, f64, Vec<f64>, f64), Verdict> {
+    let nv = 2 * (n + 1);
+    let mut ge: Vec<(Vec<f64>, f64)> = idx
+        .iter()
+        .map(|i| {
+            let mut g = rows[*i].clone();
+            g.push(-1.0);
+            (g, 0.0)
+        })
+        .collect();
+    let mut cap = vec![0.0; nv + 1];
+    cap[nv] = -1.0;
+    ge.push((cap, -1.0));
+    let mut e = normalization(n);
+    e.push(0.0);
+    let mut c = vec![0.0; nv + 1];
+    c[nv] = -1.0;
+    let lp = Lp {
+        n: nv + 1,
+        c,
+        ge,
+        eq: vec![(e, 1.0)],
+    };
+    let (status, x, z) = lp.solve_with_dual(MAX_ITER, true);
+    if !status.has_solution() || x.len() != nv + 1 || z.len() != idx.len() + 2 {
+        return Err(Verdict::Undecided(status));
+    }
+    // Clarabel's form `A v + s = b`: the equality's multiplier is `−μ`; tiny negative
+    // weights are round-off, and dropping them only changes the residual, which the check
+    // computes itself.
+    let y: Vec<f64> = z[1..=idx.len()].iter().map(|v| v.max(0.0)).collect();
+    Ok((status, x[..nv].to_vec(), x[nv], y, -z[0]))
 }
 
 /// A proven lower bound of one order.
@@ -255,9 +346,22 @@ pub(crate) struct Bound {
 }
 
 /// `LB_n`: bisection on `ln t` over `(0, ln t_hi)` (`t_hi` a level some `r` of order `n`
-/// reaches) until the bracket is `tol_ln` wide or `cap` LPs are spent; a level is raised to
+/// reaches) until the bracket is `tol_ln` wide or `cap` levels are tested; a level is raised to
 /// only by a checked certificate, and both a feasible solve and a doubt lower the top.
 pub(crate) fn lower_bound(prep: &Prepared, n: usize, t_hi: f64, tol_ln: f64, cap: usize) -> Bound {
+    lower_bound_from(prep, n, t_hi, None, tol_ln, cap)
+}
+
+/// [`lower_bound`] whose first level tested is `first` (when inside the bracket) instead of
+/// the floor `t = 1 − 2·10⁻⁶`: the level a caller most needs decided.
+pub(crate) fn lower_bound_from(
+    prep: &Prepared,
+    n: usize,
+    t_hi: f64,
+    first: Option<f64>,
+    tol_ln: f64,
+    cap: usize,
+) -> Bound {
     let mut b = Bound {
         t: None,
         lp_solves: 0,
@@ -269,10 +373,14 @@ pub(crate) fn lower_bound(prep: &Prepared, n: usize, t_hi: f64, tol_ln: f64, cap
     let (mut lo, mut hi) = (0.0f64, t_hi.ln());
     // `t ≥ 1 − 10⁻⁶` for every `r` (the datum's lower bound and level share `U`): test the
     // bottom first, so that a bound at the floor is not bisected for.
-    let mut at = (1.0 - 2.0 * FEASIBLE_TOL).ln();
-    while b.lp_solves < cap {
-        b.lp_solves += 1;
-        match prove_below(prep, n, at.exp()) {
+    let floor = (1.0 - 2.0 * FEASIBLE_TOL).ln();
+    let mut at = first
+        .filter(|f| f.is_finite() && *f > 0.0 && f.ln() < hi)
+        .map_or(floor, f64::ln);
+    let mut levels = 0;
+    while levels < cap {
+        levels += 1;
+        match prove_counted(prep, n, at.exp(), &mut b.lp_solves) {
             Verdict::Proved(_) => {
                 b.t = Some(at.exp());
                 lo = lo.max(at);
@@ -283,7 +391,7 @@ pub(crate) fn lower_bound(prep: &Prepared, n: usize, t_hi: f64, tol_ln: f64, cap
                 hi = at;
             }
         }
-        if b.t.is_none() && at < 0.0 {
+        if b.t.is_none() && at <= floor {
             // Not even the floor is proved: nothing will be.
             break;
         }
@@ -307,6 +415,56 @@ pub(crate) fn log10_offset(prep: &Prepared) -> f64 {
             (prep.rmin[i] > 0.0).then(|| 0.5 * (u / (prep.rmin[i] * prep.rmin[i])).log10())
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// The proven level of one order for its level search, computed once (at the first
+/// doubt that needs it) and then a function of the order alone, whatever the thread or the
+/// order in which attempts ask: a doubtful level below it is decided infeasible
+/// ([`super::polylevel`]).  The bisection first tests `first` (the search's probe just below
+/// the best level known) and resolves to a quarter of the search's tolerance.
+pub(crate) struct Oracle<'a> {
+    prep: &'a Prepared,
+    n: usize,
+    t_known: f64,
+    first: f64,
+    tol_ln: f64,
+    cell: std::sync::OnceLock<Bound>,
+}
+
+/// LPs an [`Oracle`] may spend.
+const ORACLE_CAP: usize = 16;
+
+impl<'a> Oracle<'a> {
+    pub(crate) fn new(prep: &'a Prepared, n: usize, t_known: f64, first: f64, tol_ln: f64) -> Self {
+        Self {
+            prep,
+            n,
+            t_known,
+            first,
+            tol_ln,
+            cell: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// Whether no `r` of the order reaches `t` (a checked certificate at `t` or above).
+    pub(crate) fn proves(&self, t: f64) -> bool {
+        let b = self.cell.get_or_init(|| {
+            lower_bound_from(
+                self.prep,
+                self.n,
+                self.t_known,
+                Some(self.first),
+                0.25 * self.tol_ln,
+                ORACLE_CAP,
+            )
+        });
+        b.t.is_some_and(|lb| t <= lb)
+    }
+
+    /// LPs spent.
+    pub(crate) fn lp_solves(&self) -> usize {
+        self.cell.get().map_or(0, |b| b.lp_solves)
+    }
 }
 
 /// A proven lower bound of one order, in the units of the order table.

@@ -179,7 +179,7 @@ fn certificates_are_checked_not_trusted() {
     let prep = prepared(&env);
     let bf = brute_force_order1(&prep);
     let t = 0.9 * bf;
-    let (ids, y, mu) = certificate(&prep, 1, t).expect("infeasible below the optimum");
+    let (ids, y, mu) = certificate(&prep, 1, t, &mut 0).expect("infeasible below the optimum");
     assert!(check(&prep, 1, t, &ids, &y, mu).is_some());
     let big = (0..y.len()).max_by(|&i, &j| y[i].total_cmp(&y[j])).unwrap();
     let mut neg = y.clone();
@@ -246,4 +246,5 @@ fn degenerate_inputs_prove_nothing() {
     }
     assert_eq!(lower_bound(&prep, 2, 1.0, 1e-3, 10).t, None);
     assert_eq!(lower_bound(&prep, 2, f64::NAN, 1e-3, 10).lp_solves, 0);
+    assert!(lower_bound(&prep, 2, 100.0, 1e-3, 10).lp_solves >= 1);
 }
