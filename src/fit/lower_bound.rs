@@ -417,53 +417,50 @@ pub(crate) fn log10_offset(prep: &Prepared) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// The proven level of one order for its level search, computed once (at the first
-/// doubt that needs it) and then a function of the order alone, whatever the thread or the
-/// order in which attempts ask: a doubtful level below it is decided infeasible
-/// ([`super::polylevel`]).  The bisection first tests `first` (the search's probe just below
-/// the best level known) and resolves to a quarter of the search's tolerance.
+/// Proofs for the level search of one order: whether no `r` of the order reaches a level
+/// `t`, one relaxation solve per level asked (a function of the level alone, remembered, so
+/// that the answer and the LPs counted do not depend on the thread or on the order in
+/// which the attempts at the disk centres ask).  A doubtful level it proves is decided
+/// infeasible ([`super::polylevel`]).
 pub(crate) struct Oracle<'a> {
     prep: &'a Prepared,
     n: usize,
-    t_known: f64,
-    first: f64,
-    tol_ln: f64,
-    cell: std::sync::OnceLock<Bound>,
+    /// Levels asked and their answers; held while a level is solved.
+    memo: std::sync::Mutex<Vec<(f64, bool)>>,
+    lps: std::sync::atomic::AtomicUsize,
 }
 
-/// LPs an [`Oracle`] may spend.
-const ORACLE_CAP: usize = 16;
-
 impl<'a> Oracle<'a> {
-    pub(crate) fn new(prep: &'a Prepared, n: usize, t_known: f64, first: f64, tol_ln: f64) -> Self {
+    pub(crate) fn new(prep: &'a Prepared, n: usize) -> Self {
         Self {
             prep,
             n,
-            t_known,
-            first,
-            tol_ln,
-            cell: std::sync::OnceLock::new(),
+            memo: std::sync::Mutex::new(Vec::new()),
+            lps: std::sync::atomic::AtomicUsize::new(0),
         }
     }
 
-    /// Whether no `r` of the order reaches `t` (a checked certificate at `t` or above).
+    /// Whether no `r` of the order reaches `t` (a checked certificate at `t`).
     pub(crate) fn proves(&self, t: f64) -> bool {
-        let b = self.cell.get_or_init(|| {
-            lower_bound_from(
-                self.prep,
-                self.n,
-                self.t_known,
-                Some(self.first),
-                0.25 * self.tol_ln,
-                ORACLE_CAP,
-            )
-        });
-        b.t.is_some_and(|lb| t <= lb)
+        let Ok(mut memo) = self.memo.lock() else {
+            return false;
+        };
+        if let Some((_, p)) = memo.iter().find(|(u, _)| *u == t) {
+            return *p;
+        }
+        let mut k = 0;
+        let p = matches!(
+            prove_counted(self.prep, self.n, t, &mut k),
+            Verdict::Proved(_)
+        );
+        self.lps.fetch_add(k, std::sync::atomic::Ordering::Relaxed);
+        memo.push((t, p));
+        p
     }
 
     /// LPs spent.
     pub(crate) fn lp_solves(&self) -> usize {
-        self.cell.get().map_or(0, |b| b.lp_solves)
+        self.lps.load(std::sync::atomic::Ordering::Relaxed)
     }
 }
 

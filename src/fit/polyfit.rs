@@ -96,8 +96,7 @@ pub(crate) fn minimax(
     let mut ready: std::collections::VecDeque<Attempt> = std::collections::VecDeque::new();
     // Proofs for the doubtful levels (issue 38, ninth step): a level no `r` of this order
     // reaches is infeasible at every centre, so a doubt there is no reason to try another.
-    let tol = 2.0 * (1.0 + set.bisection_tol).ln();
-    let proofs = Oracle::new(prep, n, t_known, (t_known.ln() - tol).exp(), tol);
+    let proofs = Oracle::new(prep, n);
     let oracle = (std::env::var("RSHAPE_FIT_PROOF").as_deref() != Ok("0")).then_some(&proofs);
     loop {
         if events.len() - first >= allowed {
