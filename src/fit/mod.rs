@@ -49,7 +49,7 @@ mod working_set;
 pub use a1_proof::A1Proof;
 pub use basis::Scaling;
 pub use certificate::{certify, CertInput, Certificate};
-pub use lower_bound::{proven_lower_bounds, ProvenBound};
+pub use lower_bound::{proven_gap_line, proven_lower_bounds, ProvenBound};
 pub use order::format_table;
 pub use order::{fit_auto, OrderRow};
 pub use problem::{SolverEvent, SolverStatus};

@@ -20,7 +20,6 @@
 
 use super::chebseries;
 use super::engine::{Prepared, Scored};
-use super::lower_bound::Oracle;
 use super::polylevel::LevelLp;
 use super::polyrows::B_CUTS;
 use super::problem::{SolverEvent, SolverStatus};
@@ -94,10 +93,6 @@ pub(crate) fn minimax(
     // dropped when the one before it was decisive.  So the fit is that of the sequential
     // search, and at most one attempt is run for nothing.
     let mut ready: std::collections::VecDeque<Attempt> = std::collections::VecDeque::new();
-    // Proofs for the doubtful levels (issue 38, ninth step): a level no `r` of this order
-    // reaches is infeasible at every centre, so a doubt there is no reason to try another.
-    let proofs = Oracle::new(prep, n);
-    let oracle = (std::env::var("RSHAPE_FIT_PROOF").as_deref() != Ok("0")).then_some(&proofs);
     loop {
         if events.len() - first >= allowed {
             events.push(SolverEvent {
@@ -115,7 +110,7 @@ pub(crate) fn minimax(
         }
         let mut a = match ready.pop_front() {
             Some(a) if a.t_start == t_best => a,
-            Some(a) => attempt_at(prep, n, a.attempt, t_best, set, oracle),
+            Some(a) => attempt_at(prep, n, a.attempt, t_best, set),
             None => {
                 let Some(next) = pending.pop_front() else {
                     break;
@@ -124,13 +119,13 @@ pub(crate) fn minimax(
                 // sequential search; a pair there would only run its second attempt for
                 // nothing whenever the first is decisive or lowers the level.
                 if b_cut_used.is_none() || rayon::current_num_threads() < 2 {
-                    attempt_at(prep, n, next, t_best, set, oracle)
+                    attempt_at(prep, n, next, t_best, set)
                 } else {
                     let pair: Vec<(f64, f64)> =
                         std::iter::once(next).chain(pending.pop_front()).collect();
                     let mut done: Vec<Attempt> = pair
                         .par_iter()
-                        .map(|p| attempt_at(prep, n, *p, t_best, set, oracle))
+                        .map(|p| attempt_at(prep, n, *p, t_best, set))
                         .collect();
                     ready.extend(done.drain(1..));
                     done.pop().expect("one attempt")
@@ -161,7 +156,6 @@ pub(crate) fn minimax(
             break;
         }
     }
-    *lp_solves += proofs.lp_solves();
     best
 }
 
@@ -182,7 +176,6 @@ fn attempt_at(
     attempt: (f64, f64),
     t_start: f64,
     set: &FitSettings,
-    oracle: Option<&Oracle<'_>>,
 ) -> Attempt {
     let (mut events, mut lp_solves, mut b_cut_used) = (Vec::new(), 0, false);
     let found = minimax_at(
@@ -191,7 +184,6 @@ fn attempt_at(
         attempt,
         t_start,
         set,
-        oracle,
         &mut events,
         &mut lp_solves,
         &mut b_cut_used,
@@ -215,12 +207,11 @@ fn minimax_at(
     (x0, b_cut): (f64, f64),
     t_known: f64,
     set: &FitSettings,
-    oracle: Option<&Oracle<'_>>,
     events: &mut Vec<SolverEvent>,
     lp_solves: &mut usize,
     b_cut_used: &mut bool,
 ) -> Option<Scored> {
-    let mut lp = LevelLp::new(prep, n, x0, b_cut, set, oracle);
+    let mut lp = LevelLp::new(prep, n, x0, b_cut, set);
     let tol = 2.0 * (1.0 + set.bisection_tol).ln();
     let found = lp
         .bracket(t_known, tol, events)

@@ -6,7 +6,6 @@
 use super::basis::PointKind;
 use super::chebseries::cheb;
 use super::engine::Prepared;
-use super::lower_bound::Oracle;
 use super::polyrows::{
     cut_rows, disk, fixed_rows, level_rows, max_violation, reached_level, relative_cuts,
     relative_level_rows, Rows, B_CUT_GROUP,
@@ -64,8 +63,6 @@ pub(super) struct LevelLp<'a> {
     pub(super) lp_solves: usize,
     /// Whether a cut `B ≥ b_cut` was ever added.
     pub(super) b_cut_used: bool,
-    /// Proofs that no `r` of the order reaches a level ([`super::lower_bound`]).
-    oracle: Option<&'a Oracle<'a>>,
 }
 
 impl<'a> LevelLp<'a> {
@@ -75,7 +72,6 @@ impl<'a> LevelLp<'a> {
         x0: f64,
         b_cut: f64,
         set: &'a FitSettings,
-        oracle: Option<&'a Oracle<'a>>,
     ) -> Self {
         let floor = prep
             .grid
@@ -106,7 +102,6 @@ impl<'a> LevelLp<'a> {
             cuts: Rows::default(),
             lp_solves: 0,
             b_cut_used: false,
-            oracle,
         }
     }
 
@@ -138,34 +133,17 @@ impl<'a> LevelLp<'a> {
     /// costs 2–3× per solve, on every level when always on (2000 data, orders 0–8: 3.3 s CPU
     /// always on, 1.3 s on a doubt only).  A level infeasible only with the cuts on `B`
     /// ([`Level::CutBound`]) is not solved again: refinement does not remove a cut.
-    ///
-    /// A level left undecided (a doubt, or infeasible only with the cuts on `B`) that the
-    /// order's proven lower bound covers is infeasible for every `r` of the order: it is
-    /// decided so, without an event.  The level's LPs were solved as before, so the search at
-    /// this centre takes the same path; what changes is only that a search whose every
-    /// undecided level is proved has decided every level, and the other centres and the
-    /// thorough recheck, which run to decide such levels, are not needed: its bracket's
-    /// bottom is infeasible for every `r`, so no other route can beat its level by more
-    /// than the bisection tolerance.
     fn level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
+        if self.set.thorough {
+            return self.level_with(t, events, true);
+        }
         let before = events.len();
-        let v = if self.set.thorough {
-            self.level_with(t, events, true)
-        } else {
-            match self.level_with(t, events, false) {
-                Level::Doubt => {
-                    events.truncate(before);
-                    self.level_with(t, events, true)
-                }
-                decided => decided,
-            }
-        };
-        match v {
-            Level::Doubt | Level::CutBound if self.oracle.is_some_and(|o| o.proves(t)) => {
+        match self.level_with(t, events, false) {
+            Level::Doubt => {
                 events.truncate(before);
-                Level::Infeasible
+                self.level_with(t, events, true)
             }
-            v => v,
+            decided => decided,
         }
     }
 
