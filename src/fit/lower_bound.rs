@@ -14,8 +14,10 @@
 //! between grid points, no floor on `B`): every such `r` of level `t` gives a feasible point.
 //! So its infeasibility at `t` proves that no such `r` of order `n` reaches `t`.
 //!
-//! **The proof.**  Clarabel's `PrimalInfeasible` returns `y ≥ 0` (inequalities) and `μ`
-//! (the equality `a₀ + b₀ = 1`) with `Gᵀy + μ·e ≈ 0` and `μ > 0`.  It counts only after
+//! **The proof.**  The dual of the depth LP `max s` s.t. every row `≥ s`, `s ≤ 1`
+//! ([`certificate`], Clarabel on a working set of rows) gives `y ≥ 0` (inequalities) and `μ`
+//! (the equality `a₀ + b₀ = 1`) with `Gᵀy + μ·e ≈ 0`, `Σy ≤ 1` and `μ = −s* > 0` when the
+//! level is infeasible.  It counts only after
 //! [`check`] recomputes every row itself (Chebyshev values by `cos(k·acos u)`, not the
 //! solver's recurrence), forms `r = Gᵀy + μ·e` and finds `μ > 2‖r‖₁` plus a bound on the
 //! round-off: a feasible `v` has `‖v‖∞ ≤ 2` by the coefficient rows above, so
