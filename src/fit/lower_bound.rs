@@ -212,7 +212,8 @@ fn prove_counted(prep: &Prepared, n: usize, t: f64, lps: &mut usize) -> Verdict 
     match certificate(prep, n, t, lps) {
         Ok((ids, y, mu)) => match check(prep, n, t, &ids, &y, mu) {
             Some(m) => Verdict::Proved(m),
-            None => Verdict::Undecided(SolverStatus::PrimalInfeasible),
+            // A negative depth whose certificate fails the check: thinner than round-off.
+            None => Verdict::Undecided(SolverStatus::AlmostPrimalInfeasible),
         },
         Err(v) => v,
     }
@@ -351,19 +352,6 @@ pub(crate) struct Bound {
 /// reaches) until the bracket is `tol_ln` wide or `cap` levels are tested; a level is raised to
 /// only by a checked certificate, and both a feasible solve and a doubt lower the top.
 pub(crate) fn lower_bound(prep: &Prepared, n: usize, t_hi: f64, tol_ln: f64, cap: usize) -> Bound {
-    lower_bound_from(prep, n, t_hi, None, tol_ln, cap)
-}
-
-/// [`lower_bound`] whose first level tested is `first` (when inside the bracket) instead of
-/// the floor `t = 1 − 2·10⁻⁶`: the level a caller most needs decided.
-pub(crate) fn lower_bound_from(
-    prep: &Prepared,
-    n: usize,
-    t_hi: f64,
-    first: Option<f64>,
-    tol_ln: f64,
-    cap: usize,
-) -> Bound {
     let mut b = Bound {
         t: None,
         lp_solves: 0,
@@ -376,9 +364,7 @@ pub(crate) fn lower_bound_from(
     // `t ≥ 1 − 10⁻⁶` for every `r` (the datum's lower bound and level share `U`): test the
     // bottom first, so that a bound at the floor is not bisected for.
     let floor = (1.0 - 2.0 * FEASIBLE_TOL).ln();
-    let mut at = first
-        .filter(|f| f.is_finite() && *f > 0.0 && f.ln() < hi)
-        .map_or(floor, f64::ln);
+    let mut at = floor;
     let mut levels = 0;
     while levels < cap {
         levels += 1;
