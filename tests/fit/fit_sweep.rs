@@ -323,3 +323,32 @@ fn bench_case_figures() {
     let a1 = |w: f64| f.a1_limit(w);
     run("ISS stability --fit", &env, Some(&a1));
 }
+
+/// Envelope 15 at order 1 with the events printed (the ninth step's miss: the fit carries
+/// order 0 over at 2.0466 decade while an order-1 form reaches 1.7752).  A probe:
+/// `cargo test --release --test fit fit_sweep::env15_order1_events -- --ignored --nocapture`.
+#[test]
+#[ignore = "a probe: prints the order-1 search of sweep envelope 15"]
+fn env15_order1_events() {
+    let spec = &sweep_specs()[15];
+    let env = envelope(spec);
+    println!(
+        "{}: {} points, ω {:.4e}…{:.4e}",
+        spec.label(),
+        env.omega.len(),
+        env.omega[0],
+        env.omega[env.omega.len() - 1]
+    );
+    let (res, rows) =
+        fit_auto(&env, None, &FitSettings::default(), 1, &Default::default()).expect("fit");
+    for r in &rows {
+        println!(
+            "order {}: max {:.4} LPs {}",
+            r.order, r.max_log10, r.lp_solves
+        );
+    }
+    println!("{}", rshape::fit::events_text(&res));
+    // The order-1 row is the best certified of its ranked candidates, never above order 0.
+    assert!(rows.iter().all(|r| r.status == "ok"), "{rows:?}");
+    assert!(rows[1].max_log10 <= rows[0].max_log10 + 1e-9, "{rows:?}");
+}
