@@ -72,11 +72,17 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     let progress: crate::fit::ProgressFn<'_> = &progress;
     // The config's [scaling], recorded in r.json (r is then that of the scaled plant).
     let mut scaling = None;
+    // `--verbose`: the proven gap of the chosen order (a bisection of checked certificates).
+    let mut gap_line = None;
     let outcome = match (&a.envelope, &a.config) {
         (Some(path), _) => {
             let env = read_envelope_csv(path)?;
             let _manifest = super::common::prepare_out(&a.out, &[path])?;
-            run_fit(&env, None, &settings, a.order, Some(progress)).map_err(anyhow::Error::from)
+            let out = run_fit(&env, None, &settings, a.order, Some(progress));
+            if let (true, Ok(o)) = (a.verbose, &out) {
+                gap_line = crate::fit::proven_gap_line(&env, None, &settings, &o.result);
+            }
+            out.map_err(anyhow::Error::from)
         }
         (None, Some(config)) => {
             let input = InputArgs {
@@ -92,7 +98,11 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let f = &inputs.config.factorization;
             let a1 = |w: f64| f.a1_limit(w);
             let settings = settings.with_a1_model(f);
-            run_fit(&env, Some(&a1), &settings, a.order, Some(progress)).map_err(|e| {
+            let out = run_fit(&env, Some(&a1), &settings, a.order, Some(progress));
+            if let (true, Ok(o)) = (a.verbose, &out) {
+                gap_line = crate::fit::proven_gap_line(&env, Some(&a1), &settings, &o.result);
+            }
+            out.map_err(|e| {
                 // Why no order can pass, when the envelope shows it (the words of `run`).
                 match crate::pipeline::explain_fit_failure(e, &env, Some(f)) {
                     crate::pipeline::FitFailure::A1Conflict { message, .. } => anyhow!(message),
@@ -112,6 +122,7 @@ pub fn run(a: &FitArgs) -> Result<i32> {
     }
     print!("{}", work_line(&outcome.result, outcome.seconds));
     if a.verbose {
+        print!("{}", gap_line.unwrap_or_default());
         print!("{}", events_text(&outcome.result));
     }
     Ok(0)

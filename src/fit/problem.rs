@@ -114,6 +114,20 @@ impl Lp {
 
     /// Solves with Clarabel.  Never panics: a setup failure is `SetupError`.
     pub fn solve(&self, max_iter: u32, refine: bool) -> LpOut {
+        let (status, x, _) = self.solve_with_dual(max_iter, refine);
+        LpOut { status, x }
+    }
+
+    /// [`Self::solve`] with Clarabel's dual vector `z` as well, in the order of the rows
+    /// (equalities first, then `ge`): after `PrimalInfeasible` it is a Farkas certificate
+    /// (`Aᵀz = 0`, `bᵀz < 0` in Clarabel's form `A v + s = b`; for the rows here
+    /// `y = z_ge ≥ 0` and `μ = −z_eq` give `Gᵀy + Eᵀμ = 0`, `hᵀy + eᵀμ > 0`), which
+    /// [`super::lower_bound`] checks itself before it counts.
+    pub fn solve_with_dual(
+        &self,
+        max_iter: u32,
+        refine: bool,
+    ) -> (SolverStatus, Vec<f64>, Vec<f64>) {
         let m = self.eq.len() + self.ge.len();
         // Clarabel form: A v + s = b, s ∈ K.  Equalities: E v + s = e, s ∈ {0};
         // inequalities G v ≥ h  ⇔  −G v + s = −h, s ≥ 0.
@@ -151,10 +165,7 @@ impl Lp {
             cones.push(SupportedConeT::NonnegativeConeT(self.ge.len()));
         }
         let p = CscMatrix::<f64>::zeros((self.n, self.n));
-        let fail = LpOut {
-            status: SolverStatus::SetupError,
-            x: Vec::new(),
-        };
+        let fail = (SolverStatus::SetupError, Vec::new(), Vec::new());
         let Ok(settings) = DefaultSettingsBuilder::default()
             .verbose(false)
             .max_iter(max_iter)
@@ -177,10 +188,11 @@ impl Lp {
         };
         solver.solve();
         let sol = &solver.solution;
-        LpOut {
-            status: SolverStatus::from_clarabel(sol.status),
-            x: sol.x.clone(),
-        }
+        (
+            SolverStatus::from_clarabel(sol.status),
+            sol.x.clone(),
+            sol.z.clone(),
+        )
     }
 }
 

@@ -93,6 +93,10 @@ fn sweep_no_order_rises() {
     let only: Option<Vec<usize>> = std::env::var("RSHAPE_SWEEP_ONLY")
         .ok()
         .map(|v| v.split(',').filter_map(|k| k.trim().parse().ok()).collect());
+    // `RSHAPE_SWEEP_LB=1`: the proven lower bound of every order beside its max (ninth step).
+    let mut lb = std::env::var("RSHAPE_SWEEP_LB")
+        .is_ok()
+        .then(LbTally::default);
     for (k, spec) in sweep_specs().iter().enumerate() {
         if only.as_ref().is_some_and(|o| !o.contains(&k)) {
             continue;
@@ -103,7 +107,7 @@ fn sweep_no_order_rises() {
             std::fs::write(format!("{dir}/env{k:02}.csv"), to_csv(&env)).unwrap();
         }
         let t = Instant::now();
-        let (_, rows) = fit_auto(
+        let (res, rows) = fit_auto(
             &env,
             None,
             &FitSettings::default(),
@@ -123,6 +127,9 @@ fn sweep_no_order_rises() {
             maxes.join(" "),
             per.join(" ")
         );
+        if let Some(lb) = lb.as_mut() {
+            lb.add(k, &env, None, &rows, &res.solver_events);
+        }
         for r in &rows {
             assert_eq!(r.status, "ok", "env {k} order {}: {}", r.order, r.status);
             out.push_str(&format!(
@@ -142,12 +149,129 @@ fn sweep_no_order_rises() {
         }
     }
     println!("total: {lps} LPs, {secs:.1} s; worst rise over the table {worst:+.5} decade");
+    if let Some(lb) = &lb {
+        lb.report();
+    }
     if write && only.is_none() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
         std::fs::write(path, out).unwrap();
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The fit's `STALL_LOG10` (src/fit/order.rs): an order that gains less on the order below
+/// is a stall.
+const STALL_LOG10: f64 = 0.0017;
+
+/// The proven lower bounds of the orders of the sweep (`RSHAPE_SWEEP_LB=1`): per order the gap
+/// `max_n − LB_n`, the orders whose bound proves they cannot beat the order below by
+/// `STALL_LOG10`, and the LPs those orders cost the fit.
+#[derive(Default)]
+struct LbTally {
+    /// Per order: gaps (decades) of the orders with a bound.
+    gaps: Vec<Vec<f64>>,
+    /// Orders proved to stall, and the fit's LPs at them.
+    stalled: usize,
+    stalled_lps: usize,
+    /// Orders with no bound, LPs and seconds of the bounds.
+    unproved: usize,
+    lps: usize,
+    secs: f64,
+    /// Any order whose certified max is below its bound (must never happen).
+    violations: Vec<String>,
+    /// Doubtful levels of the polynomial candidate (`LevelNotFeasible` events with a level),
+    /// those below the order's proven level, and the orders whose every doubt is below it
+    /// (with the fit's LPs at them).
+    doubts: usize,
+    doubts_below: usize,
+    all_below: usize,
+    all_below_lps: usize,
+}
+
+impl LbTally {
+    fn add(
+        &mut self,
+        k: usize,
+        env: &rshape::consistency::Envelope,
+        a1: Option<rshape::fit::A1Fn<'_>>,
+        rows: &[rshape::fit::OrderRow],
+        events: &[rshape::fit::SolverEvent],
+    ) {
+        let maxes: Vec<f64> = rows.iter().map(|r| r.max_log10).collect();
+        let t = Instant::now();
+        let b = rshape::fit::proven_lower_bounds(env, a1, &FitSettings::default(), &maxes, 1e-4)
+            .expect("bounds");
+        self.secs += t.elapsed().as_secs_f64();
+        self.gaps
+            .resize(self.gaps.len().max(rows.len()), Vec::new());
+        let mut line = Vec::new();
+        for (n, (r, b)) in rows.iter().zip(&b).enumerate() {
+            self.lps += b.lp_solves;
+            let Some(lbn) = b.max_log10 else {
+                self.unproved += 1;
+                line.push(format!("{n}: - ({} LPs)", b.lp_solves));
+                continue;
+            };
+            if lbn > r.max_log10 + 1e-9 {
+                self.violations.push(format!(
+                    "env {k} order {n}: bound {lbn:.6} above the certified max {:.6}",
+                    r.max_log10
+                ));
+            }
+            self.gaps[n].push(r.max_log10 - lbn);
+            let level = b.level.expect("a level with the bound");
+            let doubts: Vec<f64> = events
+                .iter()
+                .filter(|e| e.order == n && e.kind == rshape::fit::EventKind::LevelNotFeasible)
+                .filter_map(|e| e.stage.split("t=").nth(1)?.trim().parse::<f64>().ok())
+                .collect();
+            // The events print the level to 4 digits: below means below by more than that.
+            let below = doubts.iter().filter(|d| **d < level * (1.0 - 1e-3)).count();
+            self.doubts += doubts.len();
+            self.doubts_below += below;
+            if !doubts.is_empty() && below == doubts.len() {
+                self.all_below += 1;
+                self.all_below_lps += r.lp_solves;
+            }
+            let stall = n > 0 && lbn >= rows[n - 1].max_log10 - STALL_LOG10;
+            if stall {
+                self.stalled += 1;
+                self.stalled_lps += r.lp_solves;
+            }
+            line.push(format!(
+                "{n}: {:.4}/{lbn:.4}{}",
+                r.max_log10,
+                if stall { "*" } else { "" }
+            ));
+        }
+        println!("   bounds (max/LB, * proved stall): {}", line.join(" "));
+    }
+
+    fn report(&self) {
+        for (n, g) in self.gaps.iter().enumerate() {
+            if g.is_empty() {
+                continue;
+            }
+            let mut s = g.clone();
+            s.sort_by(f64::total_cmp);
+            println!(
+                "order {n}: gap max − LB over {} envelopes: median {:.4}, largest {:.4}",
+                s.len(),
+                s[s.len() / 2],
+                s[s.len() - 1]
+            );
+        }
+        println!(
+            "bounds: {} LPs, {:.1} s; {} orders proved to stall (the fit spent {} LPs on them); {} orders without a bound",
+            self.lps, self.secs, self.stalled, self.stalled_lps, self.unproved
+        );
+        println!(
+            "doubtful levels: {}, below the proven level {}; orders whose every doubt is below it: {} (the fit spent {} LPs on them)",
+            self.doubts, self.doubts_below, self.all_below, self.all_below_lps
+        );
+        assert!(self.violations.is_empty(), "{}", self.violations.join("\n"));
+    }
 }
 
 /// The figures of the bench cases (LPs and seconds of `fit_auto`, orders 0–8): the
@@ -176,6 +300,11 @@ fn bench_case_figures() {
                 res.certificate.max_log10_ratio,
                 per.join(" ")
             );
+            if std::env::var("RSHAPE_SWEEP_LB").is_ok() {
+                let mut lb = LbTally::default();
+                lb.add(0, env, a1, &rows, &res.solver_events);
+                lb.report();
+            }
         };
     for n in [2000, 21] {
         let env = random_envelopes::smooth_bumps(n);
@@ -193,4 +322,33 @@ fn bench_case_figures() {
     let f = &config.factorization;
     let a1 = |w: f64| f.a1_limit(w);
     run("ISS stability --fit", &env, Some(&a1));
+}
+
+/// Envelope 15 at order 1 with the events printed (the ninth step's miss: the fit carries
+/// order 0 over at 2.0466 decade while an order-1 form reaches 1.7752).  A probe:
+/// `cargo test --release --test fit fit_sweep::env15_order1_events -- --ignored --nocapture`.
+#[test]
+#[ignore = "a probe: prints the order-1 search of sweep envelope 15"]
+fn env15_order1_events() {
+    let spec = &sweep_specs()[15];
+    let env = envelope(spec);
+    println!(
+        "{}: {} points, ω {:.4e}…{:.4e}",
+        spec.label(),
+        env.omega.len(),
+        env.omega[0],
+        env.omega[env.omega.len() - 1]
+    );
+    let (res, rows) =
+        fit_auto(&env, None, &FitSettings::default(), 1, &Default::default()).expect("fit");
+    for r in &rows {
+        println!(
+            "order {}: max {:.4} LPs {}",
+            r.order, r.max_log10, r.lp_solves
+        );
+    }
+    println!("{}", rshape::fit::events_text(&res));
+    // The order-1 row is the best certified of its ranked candidates, never above order 0.
+    assert!(rows.iter().all(|r| r.status == "ok"), "{rows:?}");
+    assert!(rows[1].max_log10 <= rows[0].max_log10 + 1e-9, "{rows:?}");
 }

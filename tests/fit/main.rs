@@ -8,6 +8,7 @@ mod common;
 
 mod certificate_exact;
 mod fit_defects;
+mod fit_lower_bound;
 mod fit_paper;
 mod fit_parallel;
 mod fit_random;
