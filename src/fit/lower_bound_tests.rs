@@ -104,6 +104,15 @@ fn brute_force_order1(prep: &Prepared) -> f64 {
     best
 }
 
+/// The smallest upper bound at the data (the constant's level is `max lower / min upper`).
+fn min_upper(prep: &Prepared) -> f64 {
+    prep.grid
+        .iter()
+        .filter(|g| g.kind == PointKind::Datum)
+        .filter_map(|g| g.upper)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Order 0: `r` is a constant `c`, so the optimum is `(1 − 10⁻⁶)·max lower/min U` over the
 /// grid, `(max r_min/min r_min)²` up to the fit's safety factor: the bound reaches it from
 /// below, a level just under it is proved and one just over it is feasible.
@@ -113,12 +122,7 @@ fn order_zero_bound_is_the_closed_form() {
     let env = envelope(vec![0.1, 0.3, 1.0, 3.0, 10.0], r.to_vec());
     let prep = prepared(&env);
     let lmax = prep.grid.iter().map(|g| g.lower).fold(0.0, f64::max);
-    let umin = prep
-        .grid
-        .iter()
-        .filter(|g| g.kind == PointKind::Datum)
-        .filter_map(|g| g.upper)
-        .fold(f64::INFINITY, f64::min);
+    let umin = min_upper(&prep);
     let t_star = (1.0 - FEASIBLE_TOL) * lmax / umin;
     // The same in the data's own terms: the magnitudes' ratio, squared.
     assert!((t_star / 36.0 - 1.0).abs() < 1e-5, "{t_star}");
@@ -192,12 +196,7 @@ fn certificates_are_checked_not_trusted() {
     assert!(check(&prep, 1, t, &ids, &y[1..], mu).is_none());
     // At the constant's level the constant is feasible: no certificate may pass there.
     let c2 = prep.grid.iter().map(|g| g.lower).fold(0.0, f64::max);
-    let umin = prep
-        .grid
-        .iter()
-        .filter(|g| g.kind == PointKind::Datum)
-        .filter_map(|g| g.upper)
-        .fold(f64::INFINITY, f64::min);
+    let umin = min_upper(&prep);
     let t_const = c2 / umin;
     assert!(check(&prep, 1, t_const, &ids, &y, mu).is_none());
     assert_eq!(prove_below(&prep, 1, t_const), Verdict::Feasible);

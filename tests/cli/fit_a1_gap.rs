@@ -3,7 +3,7 @@
 //! with a lightly damped nominal mode).  The named `σ_min(M̃)` is checked against the closed
 //! form of the normalized factors of a SISO plant, `σ_min(M̃(jω)) = 1/√(1 + |G(jω)|²)`.
 
-use crate::common::{rshape, stderr, stdout};
+use crate::common::{after, rshape, stderr, stdout};
 
 /// `G = 1/(s² + 2ζs + 1)`, ζ = 1e-3: `|G(j1)|` = 500, so `σ_min(M̃(j1))` ≈ 0.002.
 const PLANT: &str = "[plant]\ntf = [[{ num = [1], den = [1, 0.002, 1] }]]\n";
@@ -23,20 +23,6 @@ fn sigma_min(w: f64) -> f64 {
     let (re, im) = (1.0 - w * w, 0.002 * w);
     let g2 = 1.0 / (re * re + im * im);
     1.0 / (1.0 + g2).sqrt()
-}
-
-/// The number after `key` in `text`.
-fn after(text: &str, key: &str) -> f64 {
-    let i = text
-        .find(key)
-        .unwrap_or_else(|| panic!("no `{key}` in {text}"))
-        + key.len();
-    let num: String = text[i..]
-        .chars()
-        .take_while(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | '-'))
-        .collect();
-    num.parse()
-        .unwrap_or_else(|_| panic!("`{num}` after `{key}`"))
 }
 
 #[test]

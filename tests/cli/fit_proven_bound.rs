@@ -3,21 +3,7 @@
 //! form; the printed bound must sit at or just below it, never above the certified max, and
 //! the line is `--verbose` only.
 
-use crate::common::{rshape, stdout};
-
-/// The number after `key` in `text`.
-fn after(text: &str, key: &str) -> f64 {
-    let i = text
-        .find(key)
-        .unwrap_or_else(|| panic!("no `{key}` in {text}"))
-        + key.len();
-    let num: String = text[i..]
-        .chars()
-        .take_while(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | '-'))
-        .collect();
-    num.parse()
-        .unwrap_or_else(|_| panic!("`{num}` after `{key}`"))
-}
+use crate::common::{after, rshape, stdout};
 
 #[test]
 fn verbose_fit_prints_a_bound_at_the_closed_form() {

@@ -240,36 +240,9 @@ fn response(path: &Path, w: f64) -> DMatrix<Complex64> {
 fn synthesize_writes_the_controller_of_the_unscaled_plant() {
     let dir = tempfile::tempdir().unwrap();
     let (d_o, d_i) = ([0.01, 0.5], [4.0, 0.25]);
-    let g = [
-        [(100.0, "[1, 1]"), (0.0, "[1]")],
-        [(2.0, "[1, 2]"), (4.0, "[1, 0.5]")],
-    ];
-    let plant = |s: &dyn Fn(usize, usize) -> f64| {
-        let e = |i: usize, j: usize| {
-            let (num, den): (f64, &str) = g[i][j];
-            format!("{{ num = [{:e}], den = {den} }}", num * s(i, j))
-        };
-        format!(
-            "[plant]\ntf = [[{}, {}], [{}, {}]]\n[r]\nnum = [0.05, 0.02]\nden = [1, 1]\n",
-            e(0, 0),
-            e(0, 1),
-            e(1, 0),
-            e(1, 1)
-        )
-    };
-    let keyed = write(
-        dir.path(),
-        "keyed.toml",
-        &format!(
-            "{}[scaling]\noutputs = [{}, {}]\ninputs = [{}, {}]\n",
-            plant(&|_, _| 1.0),
-            d_o[0],
-            d_o[1],
-            d_i[0],
-            d_i[1]
-        ),
-    );
-    let hand = write(dir.path(), "hand.toml", &plant(&|i, j| d_o[i] * d_i[j]));
+    let (keyed, hand) = crate::common::scaling_plant_pair(d_o, d_i);
+    let keyed = write(dir.path(), "keyed.toml", &keyed);
+    let hand = write(dir.path(), "hand.toml", &hand);
     let synth = |cfg: &Path, out: &str| {
         let o = dir.path().join(out);
         let r = rshape(&[

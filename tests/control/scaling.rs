@@ -318,39 +318,12 @@ fn stability_with_scaling_equals_the_hand_scaled_loop() {
     let dir = tempfile::tempdir().unwrap();
     let (d_o, d_i) = ([0.01, 0.5], [4.0, 0.25]);
     // G = [[100/(s+1), 0], [2/(s+2), 4/(s+0.5)]]; K = [[0.02, 0], [0.1, 0.5]].
-    let g = [
-        [(100.0, "[1, 1]"), (0.0, "[1]")],
-        [(2.0, "[1, 2]"), (4.0, "[1, 0.5]")],
-    ];
     let k = [[0.02, 0.0], [0.1, 0.5]];
-    let plant = |s: &dyn Fn(usize, usize) -> f64| {
-        let e = |i: usize, j: usize| {
-            let (num, den): (f64, &str) = g[i][j];
-            format!("{{ num = [{:e}], den = {den} }}", num * s(i, j))
-        };
-        format!(
-            "[plant]\ntf = [[{}, {}], [{}, {}]]\n[r]\nnum = [0.05, 0.02]\nden = [1, 1]\n",
-            e(0, 0),
-            e(0, 1),
-            e(1, 0),
-            e(1, 1)
-        )
-    };
+    let (keyed_text, hand_text) = crate::common::scaling_plant_pair(d_o, d_i);
     let keyed = dir.path().join("keyed.toml");
-    std::fs::write(
-        &keyed,
-        format!(
-            "{}[scaling]\noutputs = [{}, {}]\ninputs = [{}, {}]\n",
-            plant(&|_, _| 1.0),
-            d_o[0],
-            d_o[1],
-            d_i[0],
-            d_i[1]
-        ),
-    )
-    .unwrap();
+    std::fs::write(&keyed, keyed_text).unwrap();
     let hand = dir.path().join("hand.toml");
-    std::fs::write(&hand, plant(&|i, j| d_o[i] * d_i[j])).unwrap();
+    std::fs::write(&hand, hand_text).unwrap();
     let kfile = |name: &str, s: &dyn Fn(usize, usize) -> f64| {
         let p = dir.path().join(name);
         std::fs::write(
