@@ -372,16 +372,12 @@ pub fn write_fit_text(
     Ok((text, outcome.result.r))
 }
 
-/// The subcommands that do not apply `[scaling]` yet refuse it (exit 2) rather than mix
-/// units: `diagnose` revises the model in the data's own units.
-pub fn refuse_scaling(config: &Config, command: &str) -> Result<()> {
+/// `diagnose` does not apply `[scaling]` yet and refuses it (exit 2) rather than mix units:
+/// it revises the model in the data's own units.
+pub fn refuse_scaling_for_diagnose(config: &Config) -> Result<()> {
     match &config.scaling {
-        Some(_) if command == "diagnose" => Err(anyhow!(
-            "{}: diagnose adds effects to a [physical] model in the data's own units, and this model cannot be converted ([scaling] is not applied by diagnose yet); remove [scaling], or use a copy of the config without it, to diagnose",
-            config.path.display()
-        )),
         Some(_) => Err(anyhow!(
-            "{}: rshape {command} does not apply [scaling] yet (its answer would be in the scaled units); remove [scaling], or use a copy of the config without it, for {command}",
+            "{}: diagnose adds effects to a [physical] model in the data's own units, and this model cannot be converted ([scaling] is not applied by diagnose yet); remove [scaling], or use a copy of the config without it, to diagnose",
             config.path.display()
         )),
         None => Ok(()),

@@ -140,12 +140,6 @@ pub fn run(a: &SynthesizeArgs) -> Result<i32> {
     if let Some(fit) = fit {
         fit_text = super::common::write_fit_text(fit, &a.out, config.scaling.as_ref())?.0;
     }
-    // With [scaling] the controller was designed for G_s = D_o·G·D_i; the files hold
-    // K = D_i·K_s·D_o for G itself (what `stability --controller` reads with the same config).
-    let mut outcome = outcome;
-    if let Some(s) = &config.scaling {
-        outcome.gm.k = s.unscale_controller(&outcome.gm.k);
-    }
     let written = synthesize::write_outputs(&a.out, &outcome)?;
     let code = if outcome.robust { 0 } else { 1 };
     if a.json {

@@ -266,11 +266,6 @@ impl Scaling {
             .then(|| self.outputs[0] * self.inputs[0])
     }
 
-    /// True when both diagonals are all ones.
-    pub fn is_identity(&self) -> bool {
-        self.outputs.iter().chain(&self.inputs).all(|x| *x == 1.0)
-    }
-
     /// `D_o = diag(..), D_i = diag(..)` for messages, each number as written in a config.
     pub fn describe(&self) -> String {
         let list = |v: &[f64]| v.iter().map(|x| short(*x)).collect::<Vec<_>>().join(", ");

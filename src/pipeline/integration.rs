@@ -213,13 +213,7 @@ pub fn write_fit_exports(
     dir: &std::path::Path,
     scaling: Option<&crate::model::Scaling>,
 ) -> Result<Vec<std::path::PathBuf>> {
-    let note = crate::report::ScalingNote::of_opt(scaling);
-    crate::report::write_fit_exports(
-        &outcome.result,
-        outcome.table.as_deref(),
-        dir,
-        note.as_ref(),
-    )
+    exports(&outcome.result, outcome.table.as_deref(), dir, scaling)
 }
 
 /// Writes `r.json`, `r.m`, `r.py`, `r.jl` into `dir` (noting the config's `[scaling]` as
@@ -229,6 +223,16 @@ pub fn export_r(
     dir: &std::path::Path,
     scaling: Option<&crate::model::Scaling>,
 ) -> Result<Vec<std::path::PathBuf>> {
+    exports(&fit.result, fit.table.as_deref(), dir, scaling)
+}
+
+/// The exports of a fit with the config's scaling noted ([`write_fit_exports`], [`export_r`]).
+fn exports(
+    result: &crate::fit::FitResult,
+    table: Option<&[crate::fit::OrderRow]>,
+    dir: &std::path::Path,
+    scaling: Option<&crate::model::Scaling>,
+) -> Result<Vec<std::path::PathBuf>> {
     let note = crate::report::ScalingNote::of_opt(scaling);
-    crate::report::write_fit_exports(&fit.result, fit.table.as_deref(), dir, note.as_ref())
+    crate::report::write_fit_exports(result, table, dir, note.as_ref())
 }

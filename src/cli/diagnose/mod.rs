@@ -138,7 +138,7 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         super::common::check_out_file("--write", w, &a.input.files())?;
     }
     let loaded = a.input.load()?;
-    super::common::refuse_scaling(&loaded.config, "diagnose")?;
+    super::common::refuse_scaling_for_diagnose(&loaded.config)?;
     // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,
     // with the noise radii carried over to it, through the hook `compare` uses too.
     let found = crate::pipeline::closed_loop::discovery_inputs(

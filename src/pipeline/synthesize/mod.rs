@@ -332,6 +332,12 @@ pub fn run_with_stages(
     let controller_poles = eigenvalues(&gm.k.a, "controller poles")?;
     let robust = stability.robust;
     let merit = crate::synthesis::merit::merit(&ncf.plant, &gm.k);
+    // With [scaling] the controller was designed and proved for G_s = D_o·G·D_i; the outcome
+    // holds K = D_i·K_s·D_o, the controller of G itself (what `stability --controller` reads
+    // with the same config), for the CLI and the Python package alike.
+    if let Some(s) = &config.scaling {
+        gm.k = s.unscale_controller(&gm.k);
+    }
     Ok(SynthesisOutcome {
         merit,
         gm,
