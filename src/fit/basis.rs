@@ -137,7 +137,15 @@ pub struct GridSpec<'a> {
     pub extend_decades: f64,
     /// Enforce `|r| ≥ min(neighbouring data bounds)` between data (no dips).
     pub no_dip: bool,
+    /// Scaled frequencies where A1 may notch between grid points (the lightly damped zeros
+    /// of `M̃`, [`crate::model::Factorization::a1_dips`]); empty: the grid alone.
+    pub a1_dips: &'a [f64],
 }
+
+/// A dip gets its own constraint point when A1 there is below this share of A1 at the dense
+/// grid's spacing on either side: the grid would let `|r|` through the notch, and the
+/// certificate, which evaluates A1 at the dips, would then refuse every candidate.
+const DIP_DEPTH: f64 = 0.95;
 
 /// Builds the constraint points: every datum, a dense grid over the data band (no-dip lower
 /// bound, local upper envelope), the two extensions (floor only, upper envelope from the
@@ -186,8 +194,23 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             datum: Some(i),
         });
     }
+    let mut ws = dense_grid(w_lo / ext, w_hi * ext, spec.per_decade);
+    if let (Some(a1), Some(&first), Some(&last)) = (spec.a1, ws.first(), ws.last()) {
+        // A notch of A1 narrower than the grid's spacing (a mode of ζ = 0.01 is ~1 % wide,
+        // the spacing at 50 points per decade 4.7 %): its bottom becomes a constraint point.
+        let g = 10f64.powf(1.0 / spec.per_decade as f64);
+        let deep = |d: f64| a1(d) < DIP_DEPTH * a1(d / g).min(a1(d * g));
+        ws.extend(
+            spec.a1_dips
+                .iter()
+                .copied()
+                .filter(|d| d.is_finite() && *d > first && *d < last && deep(*d)),
+        );
+        ws.sort_by(f64::total_cmp);
+        ws.dedup();
+    }
     let mut j = 0; // index of the datum at or below w
-    for w in dense_grid(w_lo / ext, w_hi * ext, spec.per_decade) {
+    for w in ws {
         let (lower, upper, kind) = if w < w_lo {
             (spec.floor, up_lo, PointKind::Outside)
         } else if w > w_hi {
@@ -288,6 +311,7 @@ mod tests {
             per_decade: 50,
             extend_decades: 2.0,
             no_dip: true,
+            a1_dips: &[],
         });
         assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
         assert!(g.iter().any(|p| p.kind == PointKind::Infinity));

@@ -126,6 +126,7 @@ pub(crate) fn prepare<'a>(
         .a1_limit
         .as_ref()
         .map(|a| a.iter().map(|v| (v * back / rho).powi(2)).collect());
+    let dips: Vec<f64> = set.a1_dips.iter().map(|d| d / o0).collect();
     let grid = build_grid(&GridSpec {
         w: &w,
         lower: &lower,
@@ -135,6 +136,7 @@ pub(crate) fn prepare<'a>(
         per_decade: set.grid_per_decade,
         extend_decades: set.extend_decades,
         no_dip: set.no_dip,
+        a1_dips: &dips,
     });
     let band = (w[0], w[n - 1]);
     Ok(Context {
