@@ -195,17 +195,20 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
         });
     }
     let mut ws = dense_grid(w_lo / ext, w_hi * ext, spec.per_decade);
+    let mut dips: Vec<f64> = Vec::new();
     if let (Some(a1), Some(&first), Some(&last)) = (spec.a1, ws.first(), ws.last()) {
         // A notch of A1 narrower than the grid's spacing (a mode of ζ = 0.01 is ~1 % wide,
         // the spacing at 50 points per decade 4.7 %): its bottom becomes a constraint point.
         let g = 10f64.powf(1.0 / spec.per_decade as f64);
         let deep = |d: f64| a1(d) < DIP_DEPTH * a1(d / g).min(a1(d * g));
-        ws.extend(
+        dips.extend(
             spec.a1_dips
                 .iter()
                 .copied()
                 .filter(|d| d.is_finite() && *d > first && *d < last && deep(*d)),
         );
+        dips.sort_by(f64::total_cmp);
+        ws.extend(&dips);
         ws.sort_by(f64::total_cmp);
         ws.dedup();
     }
@@ -230,12 +233,19 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
             let upper = a.max(b);
             (lower.max(spec.floor), upper, PointKind::Band)
         };
+        // A notch below the bound no r may dip under between these data: no r meets both,
+        // at any level. Left to the certificate, which names it, rather than to a search
+        // of every level up to its cap.
+        let a1 = a1_at(w);
+        if dips.binary_search_by(|d| d.total_cmp(&w)).is_ok() && a1.is_some_and(|v| v <= lower) {
+            continue;
+        }
         pts.push(GridPoint {
             w,
             x: w * w,
             lower,
             upper: (upper > 0.0).then_some(upper),
-            a1: a1_at(w),
+            a1,
             kind,
             datum: None,
         });
