@@ -431,6 +431,64 @@ fn pyfrf_accelerance_whole_band() {
     }
 }
 
+/// Issue 33 (disc33z): the whole band walked at the default settings from the mass line
+/// (as measured before under `pyfrf_accelerance_whole_band`: nine steps, and at step 4 the
+/// re-check refused the mode at 2640.2 Hz as mains, 44 × 60 Hz, step 5 added it back).  The
+/// data show its skirts (|H| 160, 319, 229, 123 at 2639–2642 Hz, radii 1.7–2.8; three lines
+/// below, at 2637 Hz, still 68 against about 25 away from the peak): no mains refusal within 1 Hz of 2640 Hz at
+/// any step, and once the walk has the mode it keeps it.
+#[test]
+#[ignore = "the whole band at the default settings, up to nine steps: minutes in release"]
+fn pyfrf_whole_band_keeps_2640_hz_once_found() {
+    let data = pyfrf(20.0, 5000.0);
+    let mut m = accelerance_mass_line();
+    let mut first = None;
+    for step in 1..=9 {
+        let t = std::time::Instant::now();
+        let d =
+            diagnose_channels(&m, &data, &SearchSettings::default(), &Default::default()).unwrap();
+        let has = has_mode(&d.final_model, 2640.2, 1.0);
+        println!(
+            "step {step} ({:.1} s): {}\n  2640 Hz in the model: {has}; refused: {:?}",
+            t.elapsed().as_secs_f64(),
+            d.message,
+            d.refused
+                .iter()
+                .map(|r| (
+                    r.step,
+                    r.refusal.rule,
+                    r.refusal.frequency_hz,
+                    r.in_kept_set
+                ))
+                .collect::<Vec<_>>()
+        );
+        let mains: Vec<_> = d
+            .refused
+            .iter()
+            .filter(|r| {
+                r.refusal.rule == rshape::diagnose::admissible::Rule::Mains
+                    && r.refusal
+                        .frequency_hz
+                        .is_some_and(|f| (f - 2640.2).abs() < 1.0)
+            })
+            .collect();
+        assert!(mains.is_empty(), "step {step}: {mains:?}");
+        if has {
+            first.get_or_insert(step);
+        } else {
+            assert!(
+                first.is_none(),
+                "2640 Hz found at step {first:?}, lost at {step}"
+            );
+        }
+        if d.chosen.is_empty() {
+            break;
+        }
+        m = d.final_model.clone();
+    }
+    assert!(first.is_some(), "no mode at 2640.2 Hz");
+}
+
 /// The shipped config `configs/pyfrf_rigid.toml` (`[noise] coherence`, `averages = 5`,
 /// `coverage = 3` on the 20–1200 Hz copy of the data) gives the radii this file computes by
 /// hand from ../shared's full-band files: the same frequencies, the same `3ε|H|`.
