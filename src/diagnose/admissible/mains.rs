@@ -10,7 +10,7 @@
 //!   mains tolerance — `ΔBIC_out = 2ΔV_out − p·ln(2N_out)` with
 //!   `ΔV_out = 2 Σ_ch Σ_i [(|g − g_rest|/r)² − (|g − g_model|/r)²]` over those lines, `g_rest`
 //!   the refit model without the mode, `p` its parameters (the search's BIC,
-//!   `search::beam`) — is at most the acceptance threshold `MIN_DELTA_BIC` (10): the
+//!   `search::beam`) — is at most the acceptance threshold [`MIN_DELTA_BIC`] (10): the
 //!   lines beside it do not support it;
 //! * **a stable harmonic** (low `h`): the mains fundamental wanders from its nominal value by
 //!   up to [`MAINS_DRIFT_HZ`] during a measurement, its `h`-th harmonic by `h` times that.
@@ -29,7 +29,6 @@
 use super::{spacing_at, MAINS_HZ};
 use crate::diagnose::effects::candidates::{sig, Cand};
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::search::rank::MIN_DELTA_BIC;
 use crate::model::physical::PhysicalModel;
 use std::f64::consts::TAU;
 
@@ -37,6 +36,11 @@ use std::f64::consts::TAU;
 /// (Hz): interconnected grids hold it within ±0.05 Hz in normal operation (ENTSO-E's
 /// standard frequency range ±50 mHz; North American grids, ±36 mHz at 1σ).
 pub const MAINS_DRIFT_HZ: f64 = 0.05;
+
+/// The evidence (ΔBIC) the lines outside the mains tolerance must give a mode: the search's
+/// acceptance threshold (`search::rank::MIN_DELTA_BIC`, which checks at compile time that the
+/// two agree; named here because the search layer sits above this one).
+pub const MIN_DELTA_BIC: f64 = 10.0;
 
 /// A mains harmonic a mode sits on.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -37,7 +37,7 @@
 //! the size rules in `size`, the covariance rules in `identified`.
 
 mod identified;
-mod mains;
+pub(crate) mod mains;
 mod modes;
 mod size;
 
