@@ -4,6 +4,11 @@
 //! narrower than a line, its skirts over many lines) or a spectral line (the same resonance's
 //! value at the 2640 Hz line only).  The search fits its own mode to each: the resonance is
 //! added, the line is not (refused as mains whenever a mode there is refit).
+//!
+//! Measured (release, disc33z): the resonance is added at step 1 (misfit_rms 32.98 → 0.300,
+//! consistent); the line's mode is refit at 2640.0004 Hz and refused as mains (ΔBIC −23.8 on
+//! the lines beside it).  With the coincidence rule before, the resonance is refused (no mode
+//! at 2640 Hz); with the stable-harmonic clause alone, the line's mode is written.
 
 use num_complex::Complex64;
 use rshape::diagnose::admissible::Rule;
