@@ -4,12 +4,12 @@
 //!
 //! * **mains** — a mode narrower than one line within the frequency resolution (half the
 //!   local line spacing, or its own half-power half-width) of 50 or 60 Hz or a harmonic is
-//!   probable electrical interference, applied only when asked (`allow_mains`), when the
+//!   probable electrical interference (applied only when asked, `allow_mains`) when the
 //!   lines outside that resolution do not support it (its ΔBIC there ≤ 10: a spectral line,
 //!   no resonance skirts), or when the harmonic is low enough to stay on its line while the
 //!   fundamental wanders by 0.05 Hz (`h·0.05 Hz` ≤ the resolution: there a tone off a line's
-//!   centre leaks like a resonance's skirts).  A mode with skirts at a high harmonic
-//!   (2640 Hz = 44 × 60 Hz on 1 Hz lines) is judged like any other (`mains`);
+//!   centre leaks like a resonance's skirts).  A mode with skirts at a higher harmonic
+//!   (2640 Hz = 44 × 60 Hz on 1 Hz lines) is judged by the other rules (`mains`);
 //! * **broad** — a "resonance" with `ζ > 0.2` is a broad term (a residual, a compromise
 //!   between bands), not a mode;
 //! * **unresolved** — fewer than 3 data lines in the half-power band `ω_n(1 ± ζ)`: `ζ` and
