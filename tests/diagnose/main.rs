@@ -22,6 +22,7 @@ mod diagnose_hidden_accelerance;
 mod diagnose_hidden_robot;
 mod diagnose_holdout;
 mod diagnose_honest_report;
+mod diagnose_mains;
 mod diagnose_mimo;
 mod diagnose_output_effects;
 mod diagnose_path_after_elimination;

@@ -2,9 +2,14 @@
 //! (issue 33): a term the likelihood wants but no structure has is refused, and the
 //! refusal names its rule.  The rules (shared/design/physical-modes.md):
 //!
-//! * **mains** — a mode within the frequency resolution (half the local line spacing, or its
-//!   own half-power half-width) of 50 or 60 Hz or a harmonic, narrower than one line: probable
-//!   electrical interference, applied only when asked (`allow_mains`);
+//! * **mains** — a mode narrower than one line within the frequency resolution (half the
+//!   local line spacing, or its own half-power half-width) of 50 or 60 Hz or a harmonic is
+//!   probable electrical interference (applied only when asked, `allow_mains`) when the
+//!   lines outside that resolution do not support it (its ΔBIC there ≤ 10: a spectral line,
+//!   no resonance skirts), or when the harmonic is low enough to stay on its line while the
+//!   fundamental wanders by 0.05 Hz (`h·0.05 Hz` ≤ the resolution: there a tone off a line's
+//!   centre leaks like a resonance's skirts).  A mode with skirts at a higher harmonic
+//!   (2640 Hz = 44 × 60 Hz on 1 Hz lines) is judged by the other rules (`mains`);
 //! * **broad** — a "resonance" with `ζ > 0.2` is a broad term (a residual, a compromise
 //!   between bands), not a mode;
 //! * **unresolved** — fewer than 3 data lines in the half-power band `ω_n(1 ± ζ)`: `ζ` and
@@ -32,6 +37,7 @@
 //! the size rules in `size`, the covariance rules in `identified`.
 
 mod identified;
+pub(crate) mod mains;
 mod modes;
 mod size;
 
@@ -156,25 +162,11 @@ pub fn check(c: &Child<'_>, data: &Channels) -> Option<Refusal> {
         let (w, z) = (md.omega_n, md.zeta);
         let f = w / std::f64::consts::TAU;
         let fo = Some(f);
-        // Mains: a line-narrow resonance at 50/60 Hz or a harmonic.
-        let df = spacing_at(om, w) / std::f64::consts::TAU;
-        if !c.allow_mains && z * f < df {
-            let tol = (0.5 * df).max(z * f);
-            for f0 in MAINS_HZ {
-                let h = (f / f0).round().max(1.0);
-                if (f - h * f0).abs() <= tol {
-                    return refuse(
-                        fo,
-                        Rule::Mains,
-                        format!(
-                            "at {} Hz, within the resolution ({} Hz) of {} Hz ({}× {f0} Hz mains) and narrower than a line: probable electrical interference, not a mode of the structure (--allow-mains writes it)",
-                            sig(f),
-                            sig(tol),
-                            sig(h * f0),
-                            h
-                        ),
-                    );
-                }
+        // Mains: a line-narrow mode at 50/60 Hz or a harmonic that the lines beside it do
+        // not support, or at a harmonic stable enough for a tone to mimic its skirts.
+        if !c.allow_mains {
+            if let Some(r) = mains::refusal(c.model, k, data) {
+                return refuse(fo, Rule::Mains, r);
             }
         }
         if z > BROAD_ZETA {

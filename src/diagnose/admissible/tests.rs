@@ -252,3 +252,144 @@ fn a_friction_pole_far_below_the_band_is_negligible() {
         None
     );
 }
+
+/// 1 Hz lines from 2500 to 2800 Hz (exact multiples of 1 Hz).
+fn hz_lines() -> Vec<f64> {
+    (2500..=2800)
+        .map(|k| std::f64::consts::TAU * k as f64)
+        .collect()
+}
+
+/// The smooth part at high frequency: one mode at 2000 Hz (ζ 0.02).
+fn smooth() -> PhysicalModel {
+    PhysicalModel {
+        mode: vec![mode(std::f64::consts::TAU * 2000.0, 0.02, 1.0)],
+        ..Default::default()
+    }
+}
+
+/// The smooth part and a mode at `f` Hz with damping `z` whose peak is `peak`× the smooth
+/// part's magnitude there.
+fn smooth_and(f: f64, z: f64, peak: f64) -> PhysicalModel {
+    let w = std::f64::consts::TAU * f;
+    let mut m = smooth();
+    let rho = peak * m.eval(w)[(0, 0)].norm() * 2.0 * z * w * w;
+    m.mode.push(mode(w, z, rho));
+    m
+}
+
+/// The smooth part measured on `omega`, plus at the one line nearest `f` Hz the contribution
+/// `with` makes there beyond the smooth part: a spectral line, no skirts.
+fn spike(with: &PhysicalModel, omega: Vec<f64>, f: f64) -> Channels {
+    let mut d = data_of(&smooth(), omega);
+    let i = d
+        .omega
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            (a.1 - std::f64::consts::TAU * f)
+                .abs()
+                .total_cmp(&(b.1 - std::f64::consts::TAU * f).abs())
+        })
+        .unwrap()
+        .0;
+    let w = d.omega[i];
+    d.g[0][i] += with.eval(w)[(0, 0)] - smooth().eval(w)[(0, 0)];
+    d.radius[0][i] = 0.01 * d.g[0][i].norm() + 1e-9;
+    d
+}
+
+/// Issue 33: at 2640.2 Hz (44 × 60 Hz, 0.2 Hz from the harmonic), ζ 2.65e-4 (half-power
+/// half-width 0.70 Hz, narrower than the 1 Hz lines).  The same refit mode is a resonance
+/// where the data show its skirts on the lines beside the harmonic (admitted: no rule
+/// refuses it; the coincidence rule before refused it), and a spectral line where the data
+/// hold the same value at the 2640 Hz line only (refused as mains: its ΔBIC off that line
+/// is negative).  A mode fitted to the spike alone (ζ 1e-7, no skirts to speak of) too.
+#[test]
+fn a_mode_with_skirts_at_44_x_60_hz_is_admitted_and_a_one_line_spike_there_is_mains() {
+    let tau = std::f64::consts::TAU;
+    let (f, z) = (2640.2, 2.65e-4);
+    let m = smooth_and(f, z, 5.0);
+    // The premise: the mode is line-narrow and within the resolution of 44 × 60 Hz.
+    let hm = mains::harmonics_at(f, z, 1.0);
+    assert_eq!(hm.len(), 1, "{hm:?}");
+    assert_eq!((hm[0].f0, hm[0].h), (60.0, 44.0));
+    assert!(!hm[0].stable(), "{hm:?}");
+    // Skirts: the mode's contribution 10 lines away is still 0.35× the smooth part there.
+    let skirt = (m.eval(tau * 2650.0)[(0, 0)] - smooth().eval(tau * 2650.0)[(0, 0)]).norm()
+        / smooth().eval(tau * 2650.0)[(0, 0)].norm();
+    assert!(skirt > 0.3, "{skirt}");
+    let resonance = data_of(&m, hz_lines());
+    assert_eq!(refused(Cand::Mode, &m, &resonance, &AFTER, false), None);
+    let line = spike(&m, hz_lines(), 2640.0);
+    let r = refused(Cand::Mode, &m, &line, &AFTER, false).unwrap();
+    assert_eq!(r.rule, Rule::Mains, "{}", r.reason);
+    assert!(
+        r.reason.contains("do not show a resonance's skirts"),
+        "{}",
+        r.reason
+    );
+    assert!((r.frequency_hz.unwrap() - f).abs() < 1e-9);
+    // The independent check: the lines beside 2640 Hz hold the smooth part exactly.
+    let off = mains::off_line_support(&m, 1, &line, 2640.0, 0.7);
+    assert_eq!(off.n_out, 1);
+    assert!(off.delta_bic < 0.0, "{off:?}");
+    // A mode fitted to the spike alone: at the line, its value there.
+    let narrow = smooth_and(2640.0, 1e-7, 5.0);
+    let line = spike(&narrow, hz_lines(), 2640.0);
+    assert_eq!(
+        rule_of(Cand::Mode, &narrow, &line, &AFTER, false),
+        Some(Rule::Mains)
+    );
+    // --allow-mains writes the spike's mode anyway (as far as the mains rule goes).
+    assert_ne!(
+        rule_of(Cand::Mode, &narrow, &line, &AFTER, true),
+        Some(Rule::Mains)
+    );
+}
+
+/// A one-line spike at 50 Hz is refused as a spectral line; a resonance with skirts at
+/// 50 Hz (h = 1: the harmonic stays within 0.05 Hz of its line, where an off-centre tone
+/// leaks like a resonance's skirts) is refused as mains too, by the stable-harmonic test.
+#[test]
+fn at_50_hz_a_spike_and_a_line_narrow_resonance_are_both_mains() {
+    let tau = std::f64::consts::TAU;
+    let omega: Vec<f64> = (10..=100).map(|k| tau * k as f64).collect();
+    let base = truth();
+    let mut m = truth();
+    let w = tau * 50.0;
+    let rho = base.eval(w)[(0, 0)].norm() * 2.0 * 2e-3 * w * w;
+    m.mode.push(mode(w, 2e-3, rho));
+    // The resonance: its skirts are in the data (0.1× |G| one line away: 10 radii).
+    let d = data_of(&m, omega.clone());
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
+    assert_eq!(r.rule, Rule::Mains, "{}", r.reason);
+    assert!(r.reason.contains("wander"), "{}", r.reason);
+    assert!(!r.reason.contains("spectral line"), "{}", r.reason);
+    assert!(mains::off_line_support(&m, 1, &d, 50.0, 0.5).delta_bic > 100.0);
+    // The spike: the same value at the 50 Hz line only.
+    let mut d = data_of(&base, omega);
+    let i = d.omega.iter().position(|x| *x == w).unwrap();
+    d.g[0][i] = m.eval(w)[(0, 0)];
+    d.radius[0][i] = 0.01 * d.g[0][i].norm() + 1e-9;
+    let r = refused(Cand::Mode, &m, &d, &AFTER, false).unwrap();
+    assert_eq!(r.rule, Rule::Mains, "{}", r.reason);
+    assert!(
+        r.reason.contains("do not show a resonance's skirts"),
+        "{}",
+        r.reason
+    );
+}
+
+/// Where the coincidence alone decides: `h·0.05 Hz` within the tolerance (1 Hz lines: up to
+/// the 10th harmonic; 0.25 Hz lines: the 2nd).
+#[test]
+fn the_stable_harmonics_follow_the_line_spacing() {
+    let stable = |f: f64, df: f64| mains::harmonics_at(f, 1e-6, df).iter().any(|h| h.stable());
+    assert!(stable(500.0, 1.0) && stable(600.0, 1.0));
+    assert!(!stable(550.0, 1.0) && !stable(660.0, 1.0));
+    assert!(stable(120.0, 0.25) && !stable(150.0, 0.25));
+    // Not narrower than a line, or 1 Hz off the harmonic: no harmonic.
+    assert!(mains::harmonics_at(2640.0, 4e-4, 1.0).is_empty());
+    assert!(mains::harmonics_at(2641.0, 1e-6, 1.0).is_empty());
+}
