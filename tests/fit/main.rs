@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod certificate_arm_notch;
 mod certificate_exact;
 mod fit_defects;
 mod fit_lower_bound;
