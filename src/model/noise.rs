@@ -244,8 +244,9 @@ pub fn resolve_noise_for_channel(
             radii: r.radii.iter().map(|x| x * k).collect(),
             source: r.source,
             description: format!(
-                "{} (data file's units; × {k} = d_o·d_i of [scaling])",
-                r.description
+                "{} (data file's units; × {} = d_o·d_i of [scaling])",
+                r.description,
+                crate::report::fmt::fmt_g(k)
             ),
         }),
     )

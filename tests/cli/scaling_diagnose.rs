@@ -153,6 +153,48 @@ fn diagnose_with_scaling_finds_what_the_unscaled_config_finds() {
     }
     std::fs::write(&other, off).unwrap();
     let other = other.to_str().unwrap();
+    // compare on the [physical] revisions (data 5 % off, a radius in the data's units): the scaled one evaluates D_o·G·D_i against the
+    // scaled data and radii, and its Theorem 4 envelope is on the factors scaled in C and J,
+    // so every line's misfit, verdict and r_min are the unscaled revision's.
+    let cmp = |rev: &Path| -> Value {
+        let out = rshape(&[
+            "compare",
+            rev.to_str().unwrap(),
+            "--data",
+            other,
+            "--noise-radius",
+            "0.05",
+            "--json",
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let (ca, cb) = (cmp(&rev_a), cmp(&rev_b));
+    assert_eq!(ca["verdict"], cb["verdict"]);
+    let (ra, rb) = (
+        ca["rows"].as_array().unwrap(),
+        cb["rows"].as_array().unwrap(),
+    );
+    assert_eq!(ra.len(), rb.len());
+    for (x, y) in ra.iter().zip(rb) {
+        assert_eq!(x["invalid"], y["invalid"]);
+        for key in ["misfit", "r_min"] {
+            let (p, q) = (x[key].as_f64().unwrap(), y[key].as_f64().unwrap());
+            assert!(
+                (p - q).abs() <= 1e-9 * p.abs().max(q.abs()),
+                "{key}: {p} vs {q}"
+            );
+        }
+        let (p, q) = (
+            x["model"][0].as_f64().unwrap(),
+            y["model"][0].as_f64().unwrap(),
+        );
+        assert!(
+            (q - 7e-3 * p).abs() <= 1e-12 * p.abs(),
+            "model {q} vs 0.007·{p}"
+        );
+    }
+
     let out_b = dir.path().join("out_b");
     let (b, a) = (rev_b.to_str().unwrap(), rev_a.to_str().unwrap());
     let run = rshape(&[
