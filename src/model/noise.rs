@@ -212,7 +212,7 @@ pub fn resolve_noise_for_channel(
         return resolve_in_file_units(cli_radius, config, data, channel);
     };
     let (p, m) = (data.outputs(), data.inputs());
-    if (p, m) != (s.outputs.len(), s.inputs.len()) {
+    if !data.is_empty() && (p, m) != (s.outputs.len(), s.inputs.len()) {
         return Err(Error::Input {
             path: data.path.to_path_buf(),
             msg: format!(
@@ -228,7 +228,7 @@ pub fn resolve_noise_for_channel(
     } else {
         (channel.0.max(1) - 1, channel.1.max(1) - 1)
     };
-    if at.0 >= p || at.1 >= m {
+    if !data.is_empty() && (at.0 >= p || at.1 >= m) {
         return Err(Error::Input {
             path: data.path.to_path_buf(),
             msg: format!(

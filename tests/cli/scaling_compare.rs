@@ -157,3 +157,82 @@ fn compare_with_scaling_gives_the_unscaled_verdict_for_every_noise_source() {
         assert!(src.contains("d_o·d_i of [scaling]"), "{what}: {src}");
     }
 }
+
+/// A 2×2 plant (`[[100/(s+1), 0], [2/(s+2), 4/(s+0.5)]]`) and data 10 % off with a phase
+/// wiggle: the radius of channel `(k, l)` (a `--noise-radius`, a std file with one column
+/// per channel) is scaled by that channel's `d_o,k·d_i,l`, and the per-line verdicts are the
+/// unscaled ones.
+#[test]
+fn compare_scales_each_channel_of_mimo_data_by_its_own_factor() {
+    let dir = tempfile::tempdir().unwrap();
+    let g = |i: usize, j: usize, w: f64| -> num_complex::Complex64 {
+        let s = num_complex::Complex64::new(0.0, w);
+        match (i, j) {
+            (0, 0) => 100.0 / (s + 1.0),
+            (0, 1) => 0.0 * s,
+            (1, 0) => 2.0 / (s + 2.0),
+            _ => 4.0 / (s + 0.5),
+        }
+    };
+    let (mut data, mut std) = (
+        "omega_rad_s,re_1_1,im_1_1,re_1_2,im_1_2,re_2_1,im_2_1,re_2_2,im_2_2\n".to_string(),
+        "omega_rad_s,std_1_1,std_1_2,std_2_1,std_2_2\n".to_string(),
+    );
+    for k in 0..40 {
+        let w = 0.01 * 10f64.powf(k as f64 / 10.0);
+        let off = num_complex::Complex64::new(1.1, 0.1 * (k as f64).sin());
+        data.push_str(&format!("{w:e}"));
+        std.push_str(&format!("{w:e}"));
+        for (i, j) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            let v = g(i, j, w) * off + 1e-3 * (i + j) as f64;
+            data.push_str(&format!(",{:e},{:e}", v.re, v.im));
+            let wiggle = 1.0 + 0.8 * ((k + 3 * i + j) as f64 * 0.9).sin();
+            std.push_str(&format!(
+                ",{:e}",
+                0.03 * g(i, j, w).norm().max(1e-3) * wiggle
+            ));
+        }
+        data.push('\n');
+        std.push('\n');
+    }
+    std::fs::write(dir.path().join("frf.csv"), data).unwrap();
+    std::fs::write(dir.path().join("frf_std.csv"), std).unwrap();
+    let (d_o, d_i) = ([0.01, 3.0], [2.0, 0.5]);
+    let plant = crate::common::scaling_plant_toml(&|_, _| 1.0);
+    for (noise, args, chan) in [
+        ("", &["--noise-radius", "0.02"][..], (2usize, 1usize)),
+        ("[noise]\nstd_file = \"frf_std.csv\"\n", &[][..], (2, 2)),
+        ("[noise]\nstd_file = \"frf_std.csv\"\n", &[][..], (1, 1)),
+    ] {
+        let base = format!("data = \"frf.csv\"\n{noise}{plant}");
+        let scaled = format!(
+            "{base}[scaling]\noutputs = [{}, {}]\ninputs = [{}, {}]\n",
+            d_o[0], d_o[1], d_i[0], d_i[1]
+        );
+        let c = format!("{},{}", chan.0, chan.1);
+        let mut all = args.to_vec();
+        all.extend(["--channel", c.as_str()]);
+        let a = compare(dir.path(), "plain.toml", &base, &all);
+        let b = compare(dir.path(), "scaled.toml", &scaled, &all);
+        let k = d_o[chan.0 - 1] * d_i[chan.1 - 1];
+        let (ra, rb) = (a["rows"].as_array().unwrap(), b["rows"].as_array().unwrap());
+        let mut invalid = 0;
+        for (x, y) in ra.iter().zip(rb) {
+            let (lx, ly) = (
+                x["noise_radius"].as_f64().unwrap(),
+                y["noise_radius"].as_f64().unwrap(),
+            );
+            assert!(close(ly, k * lx, 1e-12), "{c}: radius {ly} vs {k}·{lx}");
+            let (cx, cy) = (x["misfit"].as_f64().unwrap(), y["misfit"].as_f64().unwrap());
+            assert!(close(cx, cy, 1e-9), "{c}: misfit {cx} vs {cy}");
+            assert_eq!(x["invalid"], y["invalid"], "{c}");
+            invalid += usize::from(x["invalid"] == true);
+        }
+        assert!(
+            0 < invalid && invalid < ra.len(),
+            "{c}: {invalid} invalid of {}",
+            ra.len()
+        );
+        assert_eq!(a["verdict"], b["verdict"], "{c}");
+    }
+}
