@@ -227,8 +227,9 @@ impl Scaling {
     }
 
     /// `Φ_s = D_o·Φ·D_i` for every datum.  The data's `noise_radius` column stays in the
-    /// file's units: the pipeline resolves the noise on the file's units and scales the radii
-    /// ([`Scaling::radius_factor`]).  The sizes must be the plant's.
+    /// file's units: the noise is resolved on the file's units and its radii scaled by
+    /// [`Scaling::entry_factor`] ([`crate::model::resolve_noise_for_channel`]).  The sizes
+    /// must be the plant's.
     pub fn frf(&self, mut data: FrfData) -> Result<FrfData, String> {
         let (p, m) = (data.outputs(), data.inputs());
         if (p, m) != (self.outputs.len(), self.inputs.len()) && !data.is_empty() {
