@@ -86,7 +86,7 @@ def test_scaled_diagnose_is_the_unscaled_one_and_apply_keeps_scaling(tmp_path, c
             assert np.isclose(v, y["params"][k], rtol=1e-9, atol=0)
     # The revision keeps [scaling] and is what the CLI writes.
     text = b.apply("chosen", write=tmp_path / "rev_py.toml")
-    assert "[scaling]" in text and "[physical]" in text
+    assert "[scaling]" in text and "[[physical." in text
     cli("diagnose", scaled, "--apply", "chosen", "--write", tmp_path / "rev_cli.toml")
     body = lambda t: [l for l in t.splitlines() if not l.startswith("#")]
     assert body(text) == body((tmp_path / "rev_cli.toml").read_text())
