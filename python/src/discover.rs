@@ -152,10 +152,19 @@ pub fn _diagnose(
         }
         noise_arg(noise_radius)?;
         let chan = channel_arg(channel)?;
+        // In the data file's units, as the CLI's diagnose: the config without [scaling] (the
+        // misfit is the same in either units), whose [scaling] the revision carries.
+        let scaling = cfg.scaling.clone();
+        let cfg = match scaling {
+            Some(_) => std::sync::Arc::new(cfg.without_scaling().py()?),
+            None => cfg,
+        };
         let data = config_data(&cfg, frf)?;
         let found = discovery_inputs((*cfg).clone(), data, noise_radius).py()?;
         let noise = found.noise_radius;
         let config = found.config;
+        let mut raw = found.raw;
+        raw.scaling = scaling.as_ref().map(rshape::model::Scaling::spec);
         let (base, converted) = match &config.physical {
             Some(p) => (p.clone(), None),
             None => {
@@ -191,7 +200,7 @@ pub fn _diagnose(
         let json = serde_json::to_string(&diagnosis).map_err(|e| input(e.to_string()))?;
         Ok(DiagnosisHandle {
             config,
-            raw: found.raw,
+            raw,
             data: channels,
             diagnosis,
             base,

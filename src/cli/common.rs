@@ -50,6 +50,22 @@ impl InputArgs {
         Ok(Inputs { config, data })
     }
 
+    /// As [`InputArgs::load`], in the data file's own units: a config with `[scaling]` is
+    /// loaded without it ([`Config::without_scaling`]), its scaling returned beside (for
+    /// `diagnose`, which revises a `[physical]` model written in the data's units).
+    pub fn load_in_file_units(&self) -> Result<(Inputs, Option<crate::model::Scaling>)> {
+        let config = load_config(&self.config)?;
+        let scaling = config.scaling.clone();
+        let config = match scaling {
+            Some(_) => config.without_scaling()?,
+            None => config,
+        };
+        let path = self.data_path(&config)?;
+        let data = crate::pipeline::envelope::load_data(&config, &path)?;
+        self.check_noise_radius()?;
+        Ok((Inputs { config, data }, scaling))
+    }
+
     /// The data file: `--data`, else the config's `data`.
     fn data_path(&self, config: &Config) -> Result<PathBuf> {
         self.data
@@ -370,34 +386,4 @@ pub fn write_fit_text(
     }
     text.push_str(&crate::fit::work_line(&outcome.result, outcome.seconds));
     Ok((text, outcome.result.r))
-}
-
-/// `diagnose` does not apply `[scaling]` yet and refuses it (exit 2) rather than mix units:
-/// it revises the model in the data's own units.
-pub fn refuse_scaling_for_diagnose(config: &Config) -> Result<()> {
-    match &config.scaling {
-        Some(_) => Err(anyhow!(
-            "{}: diagnose adds effects to a [physical] model in the data's own units, and this model cannot be converted ([scaling] is not applied by diagnose yet); remove [scaling], or use a copy of the config without it, to diagnose",
-            config.path.display()
-        )),
-        None => Ok(()),
-    }
-}
-
-/// `compare` with `[scaling]`: the scaled data against the scaled model, which is exact when
-/// there is no noise or the noise comes from a coherence (`ε·|H|` scales with `H`); a noise
-/// given in the data file's units (a radius, `--noise-radius`, a std file, an output bound,
-/// a `noise_radius` column) is refused (exit 2) rather than compared in mixed units.
-pub fn refuse_scaled_noise(config: &Config, data: &FrfData, cli: Option<f64>) -> Result<()> {
-    use crate::model::NoiseSource;
-    if config.scaling.is_none() {
-        return Ok(());
-    }
-    match crate::model::noise_source(cli, Some(config), data.noise_radius.is_some()) {
-        None | Some(NoiseSource::ConfigCoherence) => Ok(()),
-        Some(src) => Err(anyhow!(
-            "{}: rshape compare does not scale a noise given in the data's units ({src:?}) by [scaling] yet; use a config without [scaling] for compare (its verdict does not depend on units)",
-            config.path.display()
-        )),
-    }
 }

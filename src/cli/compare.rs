@@ -51,7 +51,6 @@ pub fn run_compare(
     band: Option<(f64, f64)>,
 ) -> Result<(CompareReport, crate::diagnose::Siso, PlantModel)> {
     let inputs = input.load()?;
-    super::common::refuse_scaled_noise(&inputs.config, &inputs.data, input.noise_radius)?;
     // Closed-loop data: compare the plant recovered from Φ and C̄, with the radii
     // propagated to it (they replace --noise-radius and [noise], which are radii on Φ).
     let inputs = crate::pipeline::closed_loop::discovery_inputs(

@@ -194,7 +194,66 @@ pub fn resolve_noise(
 /// [`resolve_noise`] for the SISO channel `(output, input)` (1-based) of the data: the
 /// channel selects the `std_<out>_<in>` column of a `[noise] std_file`.  Used by `compare`
 /// and `diagnose`, which may select the channel with `--channel`.
+///
+/// With a config's `[scaling]` the data are in the model's units (`Φ_s = D_o·Φ·D_i`, as
+/// the pipeline prepares them) while every noise source (a radius, `--noise-radius`, an
+/// output bound, a std or coherence file, the data column) is in the data file's: the
+/// noise is resolved on the unscaled data `D_o⁻¹·Φ_s·D_i⁻¹` and the radii scaled like the
+/// entry they bound, by `d_o,k·d_i,l` of the channel (the only place this is done: `run`,
+/// `compare` and the Python package all come here).  A misfit `|G_d − G_m|/L` is then the
+/// same in either units.
 pub fn resolve_noise_for_channel(
+    cli_radius: Option<f64>,
+    config: Option<&Config>,
+    data: &FrfData,
+    channel: (usize, usize),
+) -> Result<Option<ResolvedNoise>> {
+    let Some(s) = config.and_then(|c| c.scaling.as_ref()) else {
+        return resolve_in_file_units(cli_radius, config, data, channel);
+    };
+    let (p, m) = (data.outputs(), data.inputs());
+    if !data.is_empty() && (p, m) != (s.outputs.len(), s.inputs.len()) {
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "the data are {p}×{m} and [scaling] is for a {}×{} plant: the noise cannot be put in the model's units",
+                s.outputs.len(),
+                s.inputs.len()
+            ),
+        });
+    }
+    // SISO data are the channel already; MIMO data hold it at (out, inp).
+    let at = if (p, m) == (1, 1) {
+        (0, 0)
+    } else {
+        (channel.0.max(1) - 1, channel.1.max(1) - 1)
+    };
+    if !data.is_empty() && (at.0 >= p || at.1 >= m) {
+        return Err(Error::Input {
+            path: data.path.to_path_buf(),
+            msg: format!(
+                "channel ({}, {}) is not in the {p}×{m} data",
+                channel.0, channel.1
+            ),
+        });
+    }
+    let k = s.entry_factor(at);
+    let file_units = s.unscale_frf(data.clone());
+    Ok(
+        resolve_in_file_units(cli_radius, config, &file_units, channel)?.map(|r| ResolvedNoise {
+            radii: r.radii.iter().map(|x| x * k).collect(),
+            source: r.source,
+            description: format!(
+                "{} (data file's units; × {} = d_o·d_i of [scaling])",
+                r.description,
+                crate::report::fmt::fmt_g(k)
+            ),
+        }),
+    )
+}
+
+/// [`resolve_noise_for_channel`] on data in the data file's units.
+fn resolve_in_file_units(
     cli_radius: Option<f64>,
     config: Option<&Config>,
     data: &FrfData,

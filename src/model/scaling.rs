@@ -13,9 +13,11 @@
 //! * a `[model]` with the standard factorization `G = M̃⁻¹Ñ`: `M̃_s = D_o·M̃·D_o⁻¹`,
 //!   `Ñ_s = D_o·Ñ·D_i` (the equations `M̃y = Ñu` in the new units, each row scaled as its
 //!   output), so `G_s = M̃_s⁻¹Ñ_s`;
-//! * a `[model]` with the special factorization `G = C·M̃⁻¹·Ñ·J`: `C_s = D_o·C`,
-//!   `J_s = J·D_i`; the modal factors `M̃`, `Ñ` and every perturbation of them are unchanged,
-//!   so the Theorem 3 envelope (and the noisy one of Theorem 4) does not depend on the units;
+//! * a `[model]` with the special factorization `G = C·M̃⁻¹·Ñ·J`, or the factorization of a
+//!   `[physical]` model: `C_s = D_o·C`, `J_s = J·D_i`; the modal factors `M̃`, `Ñ` and every
+//!   perturbation of them are unchanged, so the Theorem 3 envelope (and the noisy one of
+//!   Theorem 4) does not depend on the units; a `[physical]` model itself stays in the data
+//!   file's units (`compare` evaluates `D_o·G·D_i`, `diagnose` works unscaled);
 //! * a controller `K` of the loop `u = −K·y` for `G` is `K_s = D_i⁻¹·K·D_o⁻¹` for `G_s`
 //!   (the loop gain `G_s·K_s = D_o·G·K·D_o⁻¹` is similar to `G·K`, the loop is the same).
 //!
@@ -225,8 +227,9 @@ impl Scaling {
     }
 
     /// `Φ_s = D_o·Φ·D_i` for every datum.  The data's `noise_radius` column stays in the
-    /// file's units: the pipeline resolves the noise on the file's units and scales the radii
-    /// ([`Scaling::radius_factor`]).  The sizes must be the plant's.
+    /// file's units: the noise is resolved on the file's units and its radii scaled by
+    /// [`Scaling::entry_factor`] ([`crate::model::resolve_noise_for_channel`]).  The sizes
+    /// must be the plant's.
     pub fn frf(&self, mut data: FrfData) -> Result<FrfData, String> {
         let (p, m) = (data.outputs(), data.inputs());
         if (p, m) != (self.outputs.len(), self.inputs.len()) && !data.is_empty() {
@@ -259,11 +262,19 @@ impl Scaling {
         })
     }
 
-    /// The factor of a SISO noise radius (or standard deviation), `d_o·d_i`; `None` for a
-    /// MIMO plant (the noisy test, Theorem 4, is SISO).
-    pub fn radius_factor(&self) -> Option<f64> {
-        (self.outputs.len() == 1 && self.inputs.len() == 1)
-            .then(|| self.outputs[0] * self.inputs[0])
+    /// The factor `d_o,k·d_i,l` of entry `(k, l)` (0-based): that of its noise radius or
+    /// standard deviation too, which scale like the entry they bound.
+    pub fn entry_factor(&self, (k, l): (usize, usize)) -> f64 {
+        self.outputs[k] * self.inputs[l]
+    }
+
+    /// The `[scaling]` table of these diagonals (what a written config carries: a revision
+    /// of `scaling = "auto"` gets the values it resolved to).
+    pub fn spec(&self) -> ScalingSpec {
+        ScalingSpec::Diagonal(ScalingSection {
+            outputs: Some(self.outputs.clone()),
+            inputs: Some(self.inputs.clone()),
+        })
     }
 
     /// `D_o = diag(..), D_i = diag(..)` for messages, each number as written in a config.

@@ -29,19 +29,9 @@ pub(super) fn noise_radii(
     data: &FrfData,
     cli: Option<f64>,
 ) -> Result<Option<Vec<f64>>> {
-    let radii = match &config.scaling {
-        // Every noise source (a radius, `--noise-radius`, a std or coherence file, the
-        // output bound, the data column) is in the data file's units: resolved on the
-        // unscaled data, the radii then scale like the entries (`d_o·d_i`, SISO).
-        Some(s) => {
-            let raw = s.unscale_frf(data.clone());
-            crate::model::noise::noise_radii(cli, Some(config), &raw)?.map(|r| {
-                let k = s.radius_factor().unwrap_or(1.0);
-                r.into_iter().map(|x| x * k).collect::<Vec<_>>()
-            })
-        }
-        None => crate::model::noise::noise_radii(cli, Some(config), data)?,
-    };
+    // With [scaling] the data are scaled and the radii come back scaled like them
+    // (resolve_noise_for_channel, the one place noise meets the units).
+    let radii = crate::model::noise::noise_radii(cli, Some(config), data)?;
     Ok(radii.filter(|r| r.iter().any(|x| *x > 0.0)))
 }
 

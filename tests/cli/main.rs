@@ -41,4 +41,6 @@ mod run_cli;
 mod sample_time;
 mod scaling_batch;
 mod scaling_cli;
+mod scaling_compare;
+mod scaling_diagnose;
 mod settings_validate;

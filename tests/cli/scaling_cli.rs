@@ -73,7 +73,7 @@ fn bad_scalings_exit_2_naming_the_key() {
         assert!(err.contains(want), "{what}: {err}");
         assert!(err.contains("bad.toml"), "{what}: {err}");
     }
-    // "auto" needs a [plant]; a [physical] model refuses [scaling] altogether.
+    // "auto" needs a [plant].
     let model = "scaling = \"auto\"\n[model]\nfactorization = \"standard\"\nm = [[{ num = [1, 2], den = [1, 1] }]]\nn = [[{ num = [1], den = [1, 1] }]]\n";
     let cfg = write(dir.path(), "auto_model.toml", model);
     let out = rshape(&[
@@ -84,25 +84,41 @@ fn bad_scalings_exit_2_naming_the_key() {
     ]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("scaling = \"auto\" needs the model as a [plant]"));
+    // A [physical] model takes [scaling] (session 13; it was refused): its factorization
+    // takes it in C and J, so its envelope (Theorem 3) is the unscaled one.
     let physical = std::fs::read_to_string(repo("configs/robot_physical.toml")).unwrap();
-    let cfg = write(
+    let scaled = write(
         dir.path(),
         "phys.toml",
-        &format!("{physical}\n[scaling]\noutputs = [2]\n"),
+        &format!("{physical}\n[scaling]\noutputs = [2]\ninputs = [0.3]\n"),
     );
-    let out = rshape(&[
-        "check",
-        cfg.to_str().unwrap(),
-        "--data",
-        repo("configs/robot.csv").to_str().unwrap(),
-    ]);
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(2), "{err}");
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(
-        err.contains("[scaling] is for a [plant] or a [model], not a [physical] model"),
-        "{err}"
-    );
+    let plain = write(dir.path(), "phys_plain.toml", &physical);
+    let mut envelopes = Vec::new();
+    for (cfg, name) in [(&plain, "e_plain"), (&scaled, "e_scaled")] {
+        let out_dir = dir.path().join(name);
+        let out = rshape(&[
+            "envelope",
+            cfg.to_str().unwrap(),
+            "--data",
+            repo("configs/robot.csv").to_str().unwrap(),
+            "--noise-radius",
+            "0",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let text = std::fs::read_to_string(out_dir.join("envelope.csv")).unwrap();
+        let r: Vec<f64> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+            .collect();
+        envelopes.push(r);
+    }
+    assert!(envelopes[0].iter().any(|x| *x > 0.0));
+    for (a, b) in envelopes[0].iter().zip(&envelopes[1]) {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(b.abs()), "{a} vs {b}");
+    }
     let cl = std::fs::read_to_string(repo("configs/closed_loop_retuned_noisy.toml")).unwrap();
     let cl = cl.replace(
         "data = \"",

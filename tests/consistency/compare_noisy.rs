@@ -17,6 +17,7 @@ fn check(config: &str, radius: Option<f64>) {
     // Independent computation.
     let f = match &model {
         PlantModel::Physical(p) => p.to_factorization().unwrap(),
+        PlantModel::ScaledPhysical(..) => panic!("these configs have no [scaling]"),
         PlantModel::Factored(f) => f.clone(),
     };
     let rad = s.radius.clone().unwrap();

@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod certificate_arm_notch;
 mod certificate_exact;
 mod fit_a1_notch;
 mod fit_defects;

@@ -137,8 +137,10 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     if let Some(w) = &a.write {
         super::common::check_out_file("--write", w, &a.input.files())?;
     }
-    let loaded = a.input.load()?;
-    super::common::refuse_scaling_for_diagnose(&loaded.config)?;
+    // In the data file's units: the misfit |G_d − G_m|/L of every channel is the same in
+    // the units of [scaling] (data, model and noise radius scale alike), and the [physical]
+    // model a revision writes is in the data's units; [scaling] goes into it unchanged.
+    let (loaded, scaling) = a.input.load_in_file_units()?;
     // Closed-loop data (issue 9, item 6): diagnose the plant P₀ recovered from Φ and C̄,
     // with the noise radii carried over to it, through the hook `compare` uses too.
     let found = crate::pipeline::closed_loop::discovery_inputs(
@@ -147,7 +149,8 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
         a.input.noise_radius,
     )?;
     let noise = found.noise_radius;
-    let raw = found.raw;
+    let mut raw = found.raw;
+    raw.scaling = scaling.as_ref().map(crate::model::Scaling::spec);
     let inputs = super::common::Inputs {
         config: found.config,
         data: found.data,
@@ -171,6 +174,13 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
             p
         }
     };
+    if let (Some(s), false) = (&scaling, a.json) {
+        println!(
+            "{}: [scaling] {}: diagnosed in the data file's units (the noise-normalized misfit is the same in the scaled ones); --write keeps [scaling]",
+            config.path.display(),
+            s.describe()
+        );
+    }
     let mut data = channels(a, &inputs, noise)?;
     if let Some((lo, hi)) = a.band {
         data = data.band(lo, hi)?;

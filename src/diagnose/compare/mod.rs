@@ -29,7 +29,7 @@ use crate::data::FrfData;
 use crate::error::{Error, Result};
 use crate::model::noise::resolve_noise_for_channel;
 use crate::model::physical::PhysicalModel;
-use crate::model::{Config, Factorization};
+use crate::model::{Config, Factorization, Scaling};
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use std::path::PathBuf;
@@ -43,16 +43,21 @@ pub use report::{bands, Band, CompareReport, CompareRow, CompareVerdict};
 pub enum PlantModel {
     /// Physical description, evaluated exactly.
     Physical(PhysicalModel),
+    /// A physical description (in the data file's units) seen in the units of its config's
+    /// `[scaling]`: `D_o·G·D_i`, evaluated exactly.
+    ScaledPhysical(PhysicalModel, Scaling),
     /// Coprime factors.
     Factored(Factorization),
 }
 
 impl PlantModel {
-    /// From a config: the physical description when there is one.
+    /// From a config: the physical description when there is one, in the units of the
+    /// config's data (scaled by its `[scaling]`, as the pipeline scales the data).
     pub fn from_config(c: &Config) -> Self {
-        match &c.physical {
-            Some(p) => PlantModel::Physical(p.clone()),
-            None => PlantModel::Factored(c.factorization.clone()),
+        match (&c.physical, &c.scaling) {
+            (Some(p), None) => PlantModel::Physical(p.clone()),
+            (Some(p), Some(s)) => PlantModel::ScaledPhysical(p.clone(), s.clone()),
+            (None, _) => PlantModel::Factored(c.factorization.clone()),
         }
     }
 
@@ -60,6 +65,12 @@ impl PlantModel {
     pub fn eval(&self, omega: f64) -> Option<DMatrix<Complex64>> {
         match self {
             PlantModel::Physical(p) => Some(p.eval(omega)),
+            PlantModel::ScaledPhysical(p, s) => {
+                let g = p.eval(omega);
+                Some(DMatrix::from_fn(g.nrows(), g.ncols(), |i, j| {
+                    g[(i, j)] * s.entry_factor((i, j))
+                }))
+            }
             PlantModel::Factored(f) => f.plant(omega),
         }
     }
@@ -67,8 +78,21 @@ impl PlantModel {
     /// `(outputs, inputs)`.
     pub fn size(&self) -> (usize, usize) {
         match self {
-            PlantModel::Physical(p) => (p.n_outputs(), p.n_inputs()),
+            PlantModel::Physical(p) | PlantModel::ScaledPhysical(p, _) => {
+                (p.n_outputs(), p.n_inputs())
+            }
             PlantModel::Factored(f) => (f.outputs(), f.inputs()),
+        }
+    }
+
+    /// The rational factorization the envelope is computed on: a physical model's Padé
+    /// export (scaled in `C` and `J` for [`PlantModel::ScaledPhysical`], as the config's own
+    /// factorization), or the factors.
+    pub fn factorization(&self) -> std::result::Result<Factorization, String> {
+        match self {
+            PlantModel::Physical(p) => p.to_factorization(),
+            PlantModel::ScaledPhysical(p, s) => s.factorization(&p.to_factorization()?),
+            PlantModel::Factored(f) => Ok(f.clone()),
         }
     }
 }
@@ -250,14 +274,13 @@ pub fn compare(config: &Config, model: &PlantModel, siso: &Siso) -> Result<Compa
     // noise radius is known, else (or when the μ test cannot run) noise-free.
     let mut exact = false;
     let (r_min, r_env_method) = if model.size() == (1, 1) {
-        let f = match model {
-            PlantModel::Physical(p) => p.to_factorization().map_err(Error::Invalid),
-            PlantModel::Factored(f) => Ok(f.clone()),
-        };
-        let source = if matches!(model, PlantModel::Physical(_)) {
-            "Padé export of the physical model"
-        } else {
-            "configured factors"
+        let f = model.factorization().map_err(Error::Invalid);
+        let source = match model {
+            PlantModel::Physical(_) => "Padé export of the physical model",
+            PlantModel::ScaledPhysical(..) => {
+                "Padé export of the physical model, [scaling] in C and J"
+            }
+            PlantModel::Factored(_) => "configured factors",
         };
         match f {
             Err(e) => (None, format!("not computed: {e}")),

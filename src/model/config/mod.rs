@@ -269,17 +269,30 @@ impl Config {
                 None => err(msg),
             }
         })?;
+        Self::from_raw(raw, path)
+    }
+
+    /// The same config without its `[scaling]`: the model, the data and the noise in the
+    /// data file's own units (what `diagnose` works in: the `[physical]` model it revises is
+    /// written in them).  Built again from what was written, so a `[plant]`'s normalized
+    /// factors are those of `G`, not of `D_o·G·D_i`.
+    pub fn without_scaling(&self) -> Result<Self> {
+        let mut raw = self.raw.clone();
+        raw.scaling = None;
+        Self::from_raw(raw, &self.path)
+    }
+
+    /// [`Config::parse`] after the TOML: checks and builds the model of what was written.
+    fn from_raw(raw: RawConfig, path: &Path) -> Result<Self> {
+        let err = |msg: String| Error::Config {
+            path: path.to_path_buf(),
+            msg,
+        };
         let closed_loop = super::closed_loop::from_raw(&raw).map_err(err)?;
-        if raw.scaling.is_some() && (raw.physical.is_some() || closed_loop.is_some()) {
-            let what = if closed_loop.is_some() {
-                "[closed_loop]"
-            } else {
-                "[physical]"
-            };
-            return Err(err(format!(
-                "[scaling] is for a [plant] or a [model], not a {what} model: remove [scaling] (a {what} model is in the units of its data{})",
-                if raw.physical.is_some() { "; its modal envelope (Theorem 3) does not depend on them" } else { "" }
-            )));
+        if raw.scaling.is_some() && closed_loop.is_some() {
+            return Err(err(
+                "[scaling] is for a [plant], a [model] or a [physical] model, not a [closed_loop] model: remove [scaling] (a [closed_loop] model is in the units of its data)".into(),
+            ));
         }
         let mut scaling = None;
         let plant_factorization = match &raw.plant {
@@ -324,7 +337,20 @@ impl Config {
             }
             (None, Some(ph)) => {
                 ph.validate().map_err(err)?;
-                (ph.to_factorization().map_err(err)?, Some(ph.clone()))
+                let f = ph.to_factorization().map_err(err)?;
+                // The model stays in the data's units (diagnose and compare evaluate it
+                // there); its special factorization takes the scaling in C and J, which
+                // leaves the modal factors, hence the Theorem 3/4 envelope, unchanged.
+                let f = match &raw.scaling {
+                    Some(spec) => {
+                        let s = spec.resolve(f.outputs(), f.inputs(), None).map_err(err)?;
+                        let scaled = s.factorization(&f).map_err(err)?;
+                        scaling = Some(s);
+                        scaled
+                    }
+                    None => f,
+                };
+                (f, Some(ph.clone()))
             }
             (Some(_), Some(_)) => {
                 return Err(err(
