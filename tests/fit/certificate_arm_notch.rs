@@ -1,5 +1,5 @@
 //! The DaISy robot arm with ζ = 0.01 on its second mode (docs/guide/outside-data.md, "Where a
-//! user gets stuck"): the fit fails at every order, its hint naming two notches of the A1
+//! user gets stuck"): the fit failed at every order, its hint naming two notches of the A1
 //! limit `σ_min(M̃)`. Is it the nominal model or the fit?  For a SISO plant `σ_min(M̃) = |M̃|`,
 //! and `M̃` of a stable plant is itself a unit (stable, its zeros the plant's stable poles,
 //! biproper).  So `r = α·M̃` meets A1 with the margin `1/α` at every frequency, and it lies
@@ -8,7 +8,7 @@
 //! `α* < 1` means the nominal leaves room for a biproper `r` (of the plant's order); the
 //! certificate of the fit, applied to `α·M̃`, must then pass.
 
-use rshape::fit::{certify, CertInput, FitSettings, Zpk};
+use rshape::fit::{certify, fit_unit, CertInput, FitSettings, Zpk};
 use rshape::pipeline::envelope::load_data;
 use rshape::{Config, RunOptions};
 use std::path::Path;
@@ -113,4 +113,50 @@ fn the_z001_arm_admits_alpha_times_m_tilde() {
     );
     assert!(cert.passed, "{:?}", cert.failures);
     assert_eq!(cert.a1_checked_on, "proved");
+}
+
+// The arm's transfer function (ARM_Z001's), for an A1 check that does not go through the
+// factorization.
+const NUM: [f64; 5] = [-1.93391, -0.103041, -2.55255, -0.0234311, -0.1];
+const DEN: [f64; 5] = [12.032, 0.3659, 9.2346, 0.13578, 1.0];
+
+/// `|G(jω)|` from the transfer function's coefficients (highest power first), by Horner.
+fn plant_mag(w: f64) -> f64 {
+    let s = num_complex::Complex64::new(0.0, w);
+    let horner = |c: &[f64]| {
+        c.iter()
+            .fold(num_complex::Complex64::new(0.0, 0.0), |a, k| a * s + k)
+    };
+    (horner(&NUM) / horner(&DEN)).norm()
+}
+
+/// The fit on the same arm (stop 48): A1 notches narrower than the fit's grid are constraint
+/// points of the fit. Before, every candidate of every order rose through the notch at
+/// 0.7977 rad/s and the certificate refused them all.
+#[test]
+fn a1_notch_between_grid_points_is_kept_by_the_fit() {
+    let cfg = Config::parse(ARM_Z001, Path::new("arm_z001.toml")).unwrap();
+    let data = load_data(&cfg, cfg.data.as_ref().unwrap()).unwrap();
+    let env = rshape::envelope(&cfg, &data, &RunOptions::default())
+        .unwrap()
+        .envelope;
+    let f = &cfg.factorization;
+    let set = FitSettings {
+        order: 6,
+        ..FitSettings::default().with_a1_model(f)
+    };
+    let a1 = |w: f64| f.a1_limit(w);
+    let fit = fit_unit(&env, Some(&a1), &set, &Default::default()).unwrap();
+    assert!(fit.certificate.passed, "{:?}", fit.certificate.failures);
+    // Independently of the factorization's code: for normalized coprime factors of a SISO
+    // plant σ_min(M̃) = |M̃| = 1/√(1 + |G|²), so A1 is |r|·√(1 + |G|²) < 1. Checked densely
+    // across the notch (±3 % around 0.7977 rad/s) and over the band.
+    let r = |w: f64| fit.r.freq(w).norm();
+    let mut worst: f64 = 0.0;
+    let notch = (0..=3000).map(|k| 0.7977 * (0.97 + 0.06 * k as f64 / 3000.0));
+    let band = (0..=2000).map(|k| 10f64.powf(-2.0 + 3.0 * k as f64 / 2000.0));
+    for w in notch.chain(band) {
+        worst = worst.max(r(w) * (1.0 + plant_mag(w).powi(2)).sqrt());
+    }
+    assert!(worst < 1.0, "|r|/σ_min(M̃) reaches {worst}");
 }

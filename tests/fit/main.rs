@@ -8,7 +8,6 @@ mod common;
 
 mod certificate_arm_notch;
 mod certificate_exact;
-mod fit_a1_notch;
 mod fit_defects;
 mod fit_lower_bound;
 mod fit_paper;
