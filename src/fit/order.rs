@@ -1,11 +1,15 @@
 //! Order selection: fit orders `0..=n_max` in one chained sweep (each order starts from the
-//! previous one, so conservatism never increases), tabulate order against conservatism
-//! (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest order whose
-//! mean and max are both within `auto_tolerance` of the best in the table.
+//! previous one, so the objective's promise holds: the max never rises, nor, with
+//! [`Objective::Area`], the mean; see [`super::engine::admits`]), tabulate order against
+//! conservatism (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest
+//! order whose mean and max are both within `auto_tolerance` of the best in the table.
 
 use super::context::prepare;
-use super::engine::{fit_order, Scored};
-use super::{A1Fn, EventKind, FitError, FitOptions, FitProgress, FitResult, FitSettings};
+use super::engine::{admits, fit_order, max_tolerance, rank, Scored};
+use super::provenance::Origin;
+use super::{
+    A1Fn, EventKind, FitError, FitOptions, FitProgress, FitResult, FitSettings, Objective,
+};
 use crate::consistency::Envelope;
 use serde::Serialize;
 
@@ -95,8 +99,24 @@ fn recheck_stall(
     }
 }
 
+/// The second chain of a minimax sweep: the `r` each order would have with the
+/// mean-and-max promise ([`Objective::Area`]'s), and the working sets of its searches.
+struct MeanChain {
+    prev: Scored,
+    masks: (Vec<bool>, Vec<bool>),
+}
+
 /// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table;
 /// `options.progress` hears of each order before it is fitted.
+///
+/// With [`Objective::Minimax`] an order may lower the max at a higher mean ([`admits`]);
+/// from the first order that does, a second chain is carried beside the first: the `r` the
+/// mean-and-max promise would have chosen at each order (the sweep before issue 38's tenth
+/// step), with its own search from its own previous `r`.  The candidates of both searches
+/// compete for the row, so no order's max ends above that chain's by more than the
+/// bisection tolerance (a lower max at order `n` changes where order `n + 1` starts, and a
+/// search from another start may end elsewhere: envelope 15 of the sweep at order 8,
+/// 0.0987 → 0.1020 without it).  The chains merge again where they choose the same `r`.
 pub fn fit_auto(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
@@ -107,6 +127,7 @@ pub fn fit_auto(
     let progress = options.progress;
     let ctx = prepare(env, a1, settings)?;
     let mut prev: Option<Scored> = None;
+    let mut second: Option<MeanChain> = None;
     let mut masks = (Vec::new(), Vec::new());
     let mut rows = Vec::new();
     let mut fits: Vec<Option<FitResult>> = Vec::new();
@@ -122,11 +143,37 @@ pub fn fit_auto(
             });
         }
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
-        let of = recheck_stall(&ctx.prep, n, prev.as_ref(), settings, of);
+        let mut of = recheck_stall(&ctx.prep, n, prev.as_ref(), settings, of);
+        let own = of.ranked.clone();
+        // The second chain's search of this order; its candidates (but its carried-over r,
+        // which is the first chain's business) compete for the row too.
+        let ranked_second = second.as_mut().map(|c| {
+            let o = fit_order(&ctx.prep, n, Some(&c.prev), settings, &mut c.masks);
+            let mut o = recheck_stall(&ctx.prep, n, Some(&c.prev), settings, o);
+            of.lp_solves += o.lp_solves;
+            of.events.append(&mut o.events);
+            let mut all = std::mem::take(&mut of.ranked);
+            all.extend(
+                o.ranked
+                    .iter()
+                    .filter(|c| !matches!(c.origin, Origin::CarriedOver { .. }))
+                    .cloned(),
+            );
+            of.ranked = rank(all, prev.as_ref(), settings, n, settings.objective);
+            rank(o.ranked, Some(&c.prev), settings, n, Objective::Area)
+        });
         let (ne, nl) = (of.events.len(), of.lp_solves);
         events.extend(of.events);
         solves += of.lp_solves;
-        match ctx.certify_ranked(n, &of.ranked, events.clone(), solves, settings) {
+        match ctx.certify_ranked(
+            n,
+            &of.ranked,
+            prev.as_ref(),
+            settings.objective,
+            events.clone(),
+            solves,
+            settings,
+        ) {
             Ok((res, sc)) => {
                 rows.push(OrderRow {
                     order: n,
@@ -136,6 +183,17 @@ pub fn fit_auto(
                     solver_events: ne,
                     lp_solves: nl,
                 });
+                second = next_second(
+                    &ctx,
+                    n,
+                    settings,
+                    prev.as_ref(),
+                    &sc,
+                    second,
+                    ranked_second,
+                    own,
+                    &mut masks,
+                );
                 prev = Some(sc);
                 fits.push(Some(res));
             }
@@ -172,6 +230,63 @@ pub fn fit_auto(
         }
         None => Err(last_err.unwrap_or_else(|| FitError::Invalid("no order fitted".into()))),
     }
+}
+
+/// The second chain after order `n` ([`fit_auto`]): its certified `r` of this order under
+/// the mean-and-max promise, or `None` where it is the first chain's `r` `chosen` (or could
+/// not be certified).  It starts at the first order whose `chosen` that promise would not
+/// admit after `prev`, from this order's own candidates `own` and working sets `masks`.
+/// Where the chains merge, the first takes the second's working sets, so from there on the
+/// sweep follows the mean-and-max sweep's path (the same `r` to `10⁻¹²` in its figures).
+#[allow(clippy::too_many_arguments)]
+fn next_second(
+    ctx: &super::context::Context<'_>,
+    n: usize,
+    settings: &FitSettings,
+    prev: Option<&Scored>,
+    chosen: &Scored,
+    second: Option<MeanChain>,
+    ranked_second: Option<Vec<Scored>>,
+    own: Vec<Scored>,
+    masks: &mut (Vec<bool>, Vec<bool>),
+) -> Option<MeanChain> {
+    if settings.objective != Objective::Minimax {
+        return None;
+    }
+    let (base, ranked, second_masks, started) = match (second, ranked_second) {
+        (Some(c), Some(r)) => (c.prev, r, c.masks, false),
+        _ => {
+            let p = prev?;
+            if admits(Objective::Area, max_tolerance(settings), p, chosen) {
+                return None;
+            }
+            let r = rank(own, Some(p), settings, n, Objective::Area);
+            (p.clone(), r, masks.clone(), true)
+        }
+    };
+    let (_, sc) = ctx
+        .certify_ranked(
+            n,
+            &ranked,
+            Some(&base),
+            Objective::Area,
+            Vec::new(),
+            0,
+            settings,
+        )
+        .ok()?;
+    let same = (sc.max_log - chosen.max_log).abs() <= 1e-12
+        && (sc.mean_log - chosen.mean_log).abs() <= 1e-12;
+    if same {
+        if !started {
+            *masks = second_masks;
+        }
+        return None;
+    }
+    Some(MeanChain {
+        prev: sc,
+        masks: second_masks,
+    })
 }
 
 /// The order table as aligned text, with the chosen order marked.
