@@ -4,7 +4,7 @@
 //! ([`super::certificate`]) on the ranked candidates.
 
 use super::basis::{build_grid, GridSpec, Scaling};
-use super::engine::{Prepared, Scored};
+use super::engine::{admits, max_tolerance, Prepared, Scored};
 use super::provenance::Origin;
 use super::{certificate, A1Fn, FitError, FitResult, FitSettings, Objective, SolverEvent};
 use crate::consistency::Envelope;
@@ -173,11 +173,17 @@ impl Context<'_> {
     }
 
     /// Certifies the ranked candidates of one order, best first; returns the first that
-    /// passes (possibly repaired), or the reasons they all failed.
+    /// passes (possibly repaired), or the reasons they all failed.  `prev` is the previous
+    /// order's certified `r` of a chained sweep: a certified candidate that the promise of
+    /// `guard` does not admit after it ([`admits`], judged on the certified, possibly
+    /// repaired figures) is kept only when no admitted one passes.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn certify_ranked(
         &self,
         order: usize,
         ranked: &[Scored],
+        prev: Option<&Scored>,
+        guard: Objective,
         events: Vec<SolverEvent>,
         lp_solves: usize,
         set: &FitSettings,
@@ -222,11 +228,17 @@ impl Context<'_> {
             .position(|c| matches!(c.origin, Origin::CarriedOver { .. }));
         let order_of_trial: Vec<usize> = (0..ranked.len().min(4)).chain(carried).collect();
         let mut best: Option<(FitResult, Scored)> = None;
-        let better = |a: &FitResult, b: &FitResult| {
+        let max_tol = max_tolerance(set);
+        let admitted = |sc: &Scored| prev.is_none_or(|p| admits(guard, max_tol, p, sc));
+        // Admitted first (the carried-over r always is), then the objective, then the mean.
+        let better = |(a, sa): (&FitResult, &Scored), (b, sb): (&FitResult, &Scored)| {
             let (x, y) = (a.objective_value, b.objective_value);
-            x < y - 1e-12
-                || (x <= y + 1e-12
-                    && a.certificate.mean_log10_ratio < b.certificate.mean_log10_ratio)
+            let (ka, kb) = (admitted(sa), admitted(sb));
+            (ka && !kb)
+                || (ka == kb
+                    && (x < y - 1e-12
+                        || (x <= y + 1e-12
+                            && a.certificate.mean_log10_ratio < b.certificate.mean_log10_ratio)))
         };
         let mut seen = Vec::new();
         for i in order_of_trial {
@@ -245,7 +257,10 @@ impl Context<'_> {
                 continue;
             }
             let repaired = cert.repair_factor > 1.0 + 1e-12;
-            if best.as_ref().is_none_or(|(b, _)| better(&res, b)) {
+            if best
+                .as_ref()
+                .is_none_or(|(b, sb)| better((&res, &sc), (b, sb)))
+            {
                 best = Some((res, sc));
             }
             if !repaired && carried.is_none_or(|c| seen.contains(&c)) {

@@ -6,7 +6,8 @@
 //! 2. the area polish of each pole set: the minimax poles, the previous order's poles plus
 //!    one real pole, and the reference poles;
 //! 3. the previous order's `r` itself (an order-`N−1` unit is an order-`N` unit with a
-//!    cancelling pole-zero pair), so conservatism can never increase with the order.
+//!    cancelling pole-zero pair), so every order has a candidate that keeps the objective's
+//!    promise about the orders ([`admits`]).
 //!
 //! A candidate that fails (solver status, root on the axis) is recorded and skipped; the
 //! run goes on with the others.
@@ -116,6 +117,30 @@ fn kappa(grid: &[GridPoint], q: &[f64], poles: &[Complex64]) -> Vec<f64> {
         .collect()
 }
 
+/// The bisection tolerance as decades of `max |r|/r_min`: `log10(1 + bisection_tol)`
+/// (0.00087 by default).  Two maxima closer than this are the same level to the search.
+pub(crate) fn max_tolerance(set: &FitSettings) -> f64 {
+    (1.0 + set.bisection_tol).log10()
+}
+
+/// Whether candidate `c` may follow the previous order's `p` — the promise of the objective
+/// ([`Objective`]) about order `n` against order `n − 1`:
+/// - minimax: the max never rises (`c.max ≤ p.max`), and the mean rises only where the max
+///   falls by more than the bisection tolerance `max_tol` (then the max is the better fit
+///   and the mean, the tie-break, gives way);
+/// - area: neither the max nor the mean rises.
+///
+/// Both within `10⁻¹²` (rounding of the figures).  The previous order's `r` itself (carried
+/// over) is always admitted, so every order has an admitted candidate.
+pub(crate) fn admits(objective: Objective, max_tol: f64, p: &Scored, c: &Scored) -> bool {
+    let max_ok = c.max_log <= p.max_log + 1e-12;
+    let mean_ok = c.mean_log <= p.mean_log + 1e-12;
+    match objective {
+        Objective::Minimax => max_ok && (mean_ok || c.max_log < p.max_log - max_tol),
+        Objective::Area => max_ok && mean_ok,
+    }
+}
+
 /// Result of one order: the candidates (best first) and the solver events.
 pub(crate) struct OrderFit {
     pub ranked: Vec<Scored>,
@@ -140,7 +165,7 @@ pub(crate) fn fit_order(
     o.fallbacks();
     o.global_minimax();
     OrderFit {
-        ranked: o.rank(),
+        ranked: rank(o.cands, prev, set, n, set.objective),
         events: o.events,
         lp_solves: o.lp_solves,
     }
@@ -388,47 +413,48 @@ impl<'a> OrderSearch<'a> {
             self.cands.push(c);
         }
     }
+}
 
-    /// Step 5: rank the candidates, feasible first and never worse than the previous
-    /// order; among those within the bisection tolerance of the best maximum, the smallest
-    /// mean (minimax) or area.  Every candidate is padded to order `n` with cancelling
-    /// pole-zero pairs.
-    fn rank(&mut self) -> Vec<Scored> {
-        let (prev, set, n) = (self.prev, self.set, self.n);
-        let guard = |c: &Scored| match prev {
-            Some(p) => c.mean_log <= p.mean_log + 1e-12 && c.max_log <= p.max_log + 1e-12,
-            None => true,
+/// Step 5: ranks candidates, feasible first and admitted after the previous order `prev`
+/// under the promise of `guard` ([`admits`]); among those within the bisection tolerance of
+/// the best maximum, the smallest mean (minimax) or area (`set.objective`).  Every candidate
+/// is padded to order `n` with cancelling pole-zero pairs.
+pub(crate) fn rank(
+    mut cands: Vec<Scored>,
+    prev: Option<&Scored>,
+    set: &FitSettings,
+    n: usize,
+    guard: Objective,
+) -> Vec<Scored> {
+    let max_tol = max_tolerance(set);
+    let guard = |c: &Scored| prev.is_none_or(|p| admits(guard, max_tol, p, c));
+    let best_max = cands
+        .iter()
+        .filter(|c| feasible(c) && guard(c))
+        .map(|c| c.max_log)
+        .fold(f64::INFINITY, f64::min);
+    let key = |c: &Scored| -> (u8, f64) {
+        let class = match (feasible(c), guard(c)) {
+            (true, true) => 0,
+            (true, false) => 1,
+            _ => 2,
         };
-        let max_tol = (1.0 + set.bisection_tol).log10();
-        let mut cands = std::mem::take(&mut self.cands);
-        let best_max = cands
-            .iter()
-            .filter(|c| feasible(c) && guard(c))
-            .map(|c| c.max_log)
-            .fold(f64::INFINITY, f64::min);
-        let key = |c: &Scored| -> (u8, f64) {
-            let class = match (feasible(c), guard(c)) {
-                (true, true) => 0,
-                (true, false) => 1,
-                _ => 2,
-            };
-            let v = match set.objective {
-                Objective::Minimax if c.max_log <= best_max + max_tol => c.mean_log,
-                Objective::Minimax => 1e6 + c.max_log,
-                Objective::Area => c.area,
-            };
-            (class, v)
+        let v = match set.objective {
+            Objective::Minimax if c.max_log <= best_max + max_tol => c.mean_log,
+            Objective::Minimax => 1e6 + c.max_log,
+            Objective::Area => c.area,
         };
-        cands.sort_by(|a, b| {
-            let (ka, kb) = (key(a), key(b));
-            ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
-        });
-        for c in cands.iter_mut() {
-            while c.zpk.poles.len() < n {
-                c.zpk.poles.push(Complex64::new(-1.0, 0.0));
-                c.zpk.zeros.push(Complex64::new(-1.0, 0.0));
-            }
+        (class, v)
+    };
+    cands.sort_by(|a, b| {
+        let (ka, kb) = (key(a), key(b));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1))
+    });
+    for c in cands.iter_mut() {
+        while c.zpk.poles.len() < n {
+            c.zpk.poles.push(Complex64::new(-1.0, 0.0));
+            c.zpk.zeros.push(Complex64::new(-1.0, 0.0));
         }
-        cands
     }
+    cands
 }

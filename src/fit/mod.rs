@@ -71,12 +71,17 @@ use serde::Serialize;
 #[serde(rename_all = "snake_case")]
 pub enum Objective {
     /// Log-Chebyshev: the largest `|r|/r_min` over the data (bisection over LPs, free poles
-    /// and zeros), then, at that level, the smallest log-frequency-weighted area.
+    /// and zeros; then the log-frequency-weighted area polished at that level with the poles
+    /// fixed); among the candidates within the bisection tolerance `log10(1 + bisection_tol)`
+    /// of the best max, the smallest mean `log10 |r|/r_min`.  Orders chained (`--order
+    /// auto`, [`FitSettings::chain`]) promise: the max never rises with the order; the mean
+    /// is the tie-break and may rise only where the max falls by more than that tolerance.
     #[default]
     Minimax,
     /// The log-frequency-weighted `Σ w_i |r(jω_i)|²/r_min,i²` (LP with fixed poles; the pole
     /// sets tried are the minimax poles, the previous order's and the reference poles), with
-    /// `max |r|/r_min` allowed up to `area_slack` times the minimax optimum.
+    /// `max |r|/r_min` allowed up to `area_slack` times the minimax optimum.  Orders chained
+    /// promise: neither the max nor the mean rises with the order.
     Area,
 }
 
@@ -114,8 +119,8 @@ pub struct FitSettings {
     pub root_iter_cap: usize,
     /// Certificate grid density (points per decade).  Default 100.
     pub cert_per_decade: usize,
-    /// Fit orders `0..order` first and carry each into the next, so conservatism provably
-    /// never increases with the order (2–5× slower).  Default false; [`fit_auto`] always
+    /// Fit orders `0..order` first and carry each into the next, so the objective's promise
+    /// about the orders ([`Objective`]) holds by construction (2–5× slower).  Default false; [`fit_auto`] always
     /// chains.
     pub chain: bool,
     /// `--order auto`: pick the smallest order whose mean and max `log10(|r|/r_min)` are
@@ -384,7 +389,15 @@ fn fit_with(
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         all_events.extend(of.events);
         solves += of.lp_solves;
-        match ctx.certify_ranked(n, &of.ranked, all_events.clone(), solves, settings) {
+        match ctx.certify_ranked(
+            n,
+            &of.ranked,
+            prev.as_ref(),
+            settings.objective,
+            all_events.clone(),
+            solves,
+            settings,
+        ) {
             Ok((res, sc)) => {
                 prev = Some(sc);
                 last = Some(Ok(res));

@@ -1,11 +1,15 @@
 //! Order selection: fit orders `0..=n_max` in one chained sweep (each order starts from the
-//! previous one, so conservatism never increases), tabulate order against conservatism
-//! (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest order whose
-//! mean and max are both within `auto_tolerance` of the best in the table.
+//! previous one, so the objective's promise holds: the max never rises, nor, with
+//! [`Objective::Area`], the mean; see [`super::engine::admits`]), tabulate order against
+//! conservatism (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest
+//! order whose mean and max are both within `auto_tolerance` of the best in the table.
 
 use super::context::prepare;
-use super::engine::{fit_order, Scored};
-use super::{A1Fn, EventKind, FitError, FitOptions, FitProgress, FitResult, FitSettings};
+use super::engine::{admits, fit_order, max_tolerance, rank, Scored};
+use super::provenance::Origin;
+use super::{
+    A1Fn, EventKind, FitError, FitOptions, FitProgress, FitResult, FitSettings, Objective,
+};
 use crate::consistency::Envelope;
 use serde::Serialize;
 
@@ -95,8 +99,24 @@ fn recheck_stall(
     }
 }
 
+/// The second chain of a minimax sweep: the `r` each order would have with the
+/// mean-and-max promise ([`Objective::Area`]'s), and the working sets of its searches.
+struct MeanChain {
+    prev: Scored,
+    masks: (Vec<bool>, Vec<bool>),
+}
+
 /// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table;
 /// `options.progress` hears of each order before it is fitted.
+///
+/// With [`Objective::Minimax`] an order may lower the max at a higher mean ([`admits`]);
+/// from the first order that does, a second chain is carried beside the first: the `r` the
+/// mean-and-max promise would have chosen at each order (the sweep before issue 38's tenth
+/// step), with its own search from its own previous `r`.  The candidates of both searches
+/// compete for the row, so no order's max ends above that chain's by more than the
+/// bisection tolerance (a lower max at order `n` changes where order `n + 1` starts, and a
+/// search from another start may end elsewhere: envelope 15 of the sweep at order 8,
+/// 0.0987 → 0.1020 without it).  The chains merge again where they choose the same `r`.
 pub fn fit_auto(
     env: &Envelope,
     a1: Option<A1Fn<'_>>,
@@ -107,6 +127,7 @@ pub fn fit_auto(
     let progress = options.progress;
     let ctx = prepare(env, a1, settings)?;
     let mut prev: Option<Scored> = None;
+    let mut second: Option<MeanChain> = None;
     let mut masks = (Vec::new(), Vec::new());
     let mut rows = Vec::new();
     let mut fits: Vec<Option<FitResult>> = Vec::new();
@@ -122,11 +143,37 @@ pub fn fit_auto(
             });
         }
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
-        let of = recheck_stall(&ctx.prep, n, prev.as_ref(), settings, of);
+        let mut of = recheck_stall(&ctx.prep, n, prev.as_ref(), settings, of);
+        let own = of.ranked.clone();
+        // The second chain's search of this order; its candidates (but its carried-over r,
+        // which is the first chain's business) compete for the row too.
+        let ranked_second = second.as_mut().map(|c| {
+            let o = fit_order(&ctx.prep, n, Some(&c.prev), settings, &mut c.masks);
+            let mut o = recheck_stall(&ctx.prep, n, Some(&c.prev), settings, o);
+            of.lp_solves += o.lp_solves;
+            of.events.append(&mut o.events);
+            let mut all = std::mem::take(&mut of.ranked);
+            all.extend(
+                o.ranked
+                    .iter()
+                    .filter(|c| !matches!(c.origin, Origin::CarriedOver { .. }))
+                    .cloned(),
+            );
+            of.ranked = rank(all, prev.as_ref(), settings, n, settings.objective);
+            rank(o.ranked, Some(&c.prev), settings, n, Objective::Area)
+        });
         let (ne, nl) = (of.events.len(), of.lp_solves);
         events.extend(of.events);
         solves += of.lp_solves;
-        match ctx.certify_ranked(n, &of.ranked, events.clone(), solves, settings) {
+        match ctx.certify_ranked(
+            n,
+            &of.ranked,
+            prev.as_ref(),
+            settings.objective,
+            events.clone(),
+            solves,
+            settings,
+        ) {
             Ok((res, sc)) => {
                 rows.push(OrderRow {
                     order: n,
@@ -136,6 +183,17 @@ pub fn fit_auto(
                     solver_events: ne,
                     lp_solves: nl,
                 });
+                second = next_second(
+                    &ctx,
+                    n,
+                    settings,
+                    prev.as_ref(),
+                    &sc,
+                    second,
+                    ranked_second,
+                    own,
+                    &mut masks,
+                );
                 prev = Some(sc);
                 fits.push(Some(res));
             }
@@ -153,16 +211,8 @@ pub fn fit_auto(
             }
         }
     }
-    let ok = rows.iter().filter(|r| r.status == "ok");
-    let best_mean = ok
-        .clone()
-        .map(|r| r.mean_log10)
-        .fold(f64::INFINITY, f64::min);
-    let best_max = ok.map(|r| r.max_log10).fold(f64::INFINITY, f64::min);
     let tol = settings.auto_tolerance;
-    let chosen = rows.iter().position(|r| {
-        r.status == "ok" && r.mean_log10 <= best_mean + tol && r.max_log10 <= best_max + tol
-    });
+    let chosen = choose(&rows, tol);
     match chosen {
         Some(i) => {
             let mut res = fits[i].take().expect("row ok has a fit");
@@ -172,6 +222,81 @@ pub fn fit_auto(
         }
         None => Err(last_err.unwrap_or_else(|| FitError::Invalid("no order fitted".into()))),
     }
+}
+
+/// The second chain after order `n` ([`fit_auto`]): its certified `r` of this order under
+/// the mean-and-max promise, or `None` where it is the first chain's `r` `chosen` (or could
+/// not be certified).  It starts at the first order whose `chosen` that promise would not
+/// admit after `prev`, from this order's own candidates `own` and working sets `masks`.
+/// Where the chains merge, the first takes the second's working sets, so from there on the
+/// sweep follows the mean-and-max sweep's path (the same `r` to `10⁻¹²` in its figures).
+#[allow(clippy::too_many_arguments)]
+fn next_second(
+    ctx: &super::context::Context<'_>,
+    n: usize,
+    settings: &FitSettings,
+    prev: Option<&Scored>,
+    chosen: &Scored,
+    second: Option<MeanChain>,
+    ranked_second: Option<Vec<Scored>>,
+    own: Vec<Scored>,
+    masks: &mut (Vec<bool>, Vec<bool>),
+) -> Option<MeanChain> {
+    if settings.objective != Objective::Minimax {
+        return None;
+    }
+    let (base, ranked, second_masks, started) = match (second, ranked_second) {
+        (Some(c), Some(r)) => (c.prev, r, c.masks, false),
+        _ => {
+            let p = prev?;
+            if admits(Objective::Area, max_tolerance(settings), p, chosen) {
+                return None;
+            }
+            let r = rank(own, Some(p), settings, n, Objective::Area);
+            (p.clone(), r, masks.clone(), true)
+        }
+    };
+    let (_, sc) = ctx
+        .certify_ranked(
+            n,
+            &ranked,
+            Some(&base),
+            Objective::Area,
+            Vec::new(),
+            0,
+            settings,
+        )
+        .ok()?;
+    let same = (sc.max_log - chosen.max_log).abs() <= 1e-12
+        && (sc.mean_log - chosen.mean_log).abs() <= 1e-12;
+    if same {
+        if !started {
+            *masks = second_masks;
+        }
+        return None;
+    }
+    Some(MeanChain {
+        prev: sc,
+        masks: second_masks,
+    })
+}
+
+/// The order `--order auto` reports: the smallest order whose max is within `tol` of the best
+/// max in the table and whose mean is within `tol` of the best mean among those orders.  The
+/// best mean is taken among the orders near the best max because with
+/// [`Objective::Minimax`] the mean may rise where the max falls ([`admits`]): the order with
+/// the smallest mean may have a max far above the best, and no order is then near both
+/// (a closed-loop envelope of the guide ended "no order fitted" that way).  Where both
+/// columns fall with the order (always with [`Objective::Area`]) this is the smallest order
+/// within `tol` of the best of both.
+fn choose(rows: &[OrderRow], tol: f64) -> Option<usize> {
+    let ok = || rows.iter().filter(|r| r.status == "ok");
+    let best_max = ok().map(|r| r.max_log10).fold(f64::INFINITY, f64::min);
+    let near = || ok().filter(|r| r.max_log10 <= best_max + tol);
+    let best_mean = near().map(|r| r.mean_log10).fold(f64::INFINITY, f64::min);
+    rows.iter().position(|r| {
+        r.status == "ok" && r.max_log10 <= best_max + tol && r.mean_log10 <= best_mean + tol
+    })
 }
 
 /// The order table as aligned text, with the chosen order marked.
@@ -210,6 +335,48 @@ mod tests {
             kind,
             action: String::new(),
         }
+    }
+
+    fn row(order: usize, max: f64, mean: f64) -> OrderRow {
+        OrderRow {
+            order,
+            mean_log10: mean,
+            max_log10: max,
+            status: "ok".into(),
+            solver_events: 0,
+            lp_solves: 0,
+        }
+    }
+
+    /// The chosen order: near the best max, and near the best mean among the orders near the
+    /// best max.  A minimax table whose mean rose where the max fell (order 2 below: max −0.28,
+    /// mean +0.05) has no order within 0.01 of both column minima, and still a choice; a table
+    /// falling in both columns gives the smallest order near both minima, as before.
+    #[test]
+    fn auto_chooses_near_the_best_max_then_the_best_mean() {
+        let rising_mean = [
+            row(0, 2.0, 1.0),
+            row(1, 1.0, 0.50),
+            row(2, 0.72, 0.55),
+            row(3, 0.695, 0.545),
+            row(4, 0.69, 0.56),
+        ];
+        assert_eq!(choose(&rising_mean, 0.01), Some(3));
+        let falling = [
+            row(0, 2.0, 1.0),
+            row(1, 1.0, 0.5),
+            row(2, 0.505, 0.3),
+            row(3, 0.5, 0.295),
+        ];
+        assert_eq!(choose(&falling, 0.01), Some(2));
+        let mut failed = falling.clone();
+        failed[3].status = "failed".into();
+        failed[3].max_log10 = f64::NAN;
+        failed[3].mean_log10 = f64::NAN;
+        assert_eq!(choose(&failed, 0.01), Some(2));
+        assert_eq!(choose(&failed[..1], 0.01), Some(0));
+        let none: Vec<OrderRow> = failed[3..].to_vec();
+        assert_eq!(choose(&none, 0.01), None);
     }
 
     /// The thorough refit runs exactly for a stall with a level left undecided, above the

@@ -139,10 +139,13 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
         );
         for w in rows[1..].windows(2) {
             assert!(w[1].status == "ok" && w[0].status == "ok", "{:?}", w);
+            let (p, c) = (
+                (w[0].max_log10, w[0].mean_log10),
+                (w[1].max_log10, w[1].mean_log10),
+            );
             assert!(
-                w[1].mean_log10 <= w[0].mean_log10 + 1e-9
-                    && w[1].max_log10 <= w[0].max_log10 + 1e-9,
-                "{name}: conservatism increased from order {} to {}: {:?}",
+                promise_kept(objective, set.bisection_tol, p, c),
+                "{name} {objective:?}: conservatism increased from order {} to {}: {:?}",
                 w[0].order,
                 w[1].order,
                 w
@@ -150,10 +153,10 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
         }
         assert!(fit.certificate.passed);
     }
-    // Independent fixed-order fits with `chain` (orders 0..N carried forward) are monotone
-    // too.  (Without `chain`, the default, a fixed-order fit is 2–5× faster but its mean can
-    // exceed a lower order's by a little: robot order 4 vs 3, 0.1713 vs 0.1697.)
-    let mut prev = f64::INFINITY;
+    // Independent fixed-order fits with `chain` (orders 0..N carried forward) keep the
+    // promise too.  (Without `chain`, the default, a fixed-order fit is 2–5× faster but its
+    // mean can exceed a lower order's by a little: robot order 4 vs 3, 0.1713 vs 0.1697.)
+    let mut prev = (f64::INFINITY, f64::INFINITY);
     for n in 1..=6 {
         let set = FitSettings {
             order: n,
@@ -161,9 +164,35 @@ fn assert_monotone(name: &str, env: &Envelope, a1: Option<&dyn Fn(f64) -> f64>) 
             ..Default::default()
         };
         let fit = fit_unit(env, a1, &set, &Default::default()).unwrap();
-        let m = fit.certificate.mean_log10_ratio;
-        assert!(m <= prev + 1e-9, "{name}: order {n} mean {m} > {prev}");
-        prev = m;
+        let c = (
+            fit.certificate.max_log10_ratio,
+            fit.certificate.mean_log10_ratio,
+        );
+        assert!(
+            promise_kept(set.objective, set.bisection_tol, prev, c),
+            "{name}: order {n} (max, mean) {c:?} after {prev:?}"
+        );
+        prev = c;
+    }
+}
+
+/// The promise of each objective about order `n` (`c`, as (max, mean) of `log10 |r|/r_min`)
+/// against order `n − 1` (`p`), as the docs state it: the max never rises; with `--objective
+/// area` nor does the mean; with minimax the mean may rise only where the max fell by more
+/// than the bisection tolerance (`log10(1 + bisection_tol)` decade).  (Until session 13
+/// both objectives promised both; the minimax promise changed with issue 38's tenth step.)
+pub(crate) fn promise_kept(
+    objective: Objective,
+    bisection_tol: f64,
+    p: (f64, f64),
+    c: (f64, f64),
+) -> bool {
+    let max_tol = (1.0 + bisection_tol).log10();
+    let max_ok = c.0 <= p.0 + 1e-9;
+    let mean_ok = c.1 <= p.1 + 1e-9;
+    match objective {
+        Objective::Minimax => max_ok && (mean_ok || c.0 < p.0 - max_tol + 1e-9),
+        Objective::Area => max_ok && mean_ok,
     }
 }
 
