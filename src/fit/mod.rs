@@ -123,8 +123,9 @@ pub struct FitSettings {
     /// about the orders ([`Objective`]) holds by construction (2–5× slower).  Default false; [`fit_auto`] always
     /// chains.
     pub chain: bool,
-    /// `--order auto`: pick the smallest order whose mean and max `log10(|r|/r_min)` are
-    /// within this of the best over the sweep.  Default 0.01 (2.3 %).
+    /// `--order auto`: pick the smallest order whose max `log10(|r|/r_min)` is within this of
+    /// the best over the sweep and whose mean is within this of the best mean of those orders.
+    /// Default 0.01 (2.3 %).
     pub auto_tolerance: f64,
     /// The slow reference route, for cross-checks: Clarabel's iterative refinement in every
     /// LP (by default only in the second try of a solve short of `Solved`) and a plain

@@ -317,7 +317,7 @@ pub fn format_table(rows: &[OrderRow], chosen: usize, tol: f64) -> String {
         ));
     }
     s.push_str(&format!(
-        "chosen: the smallest order whose mean and max are within {tol} (log10) of the best\n"
+        "chosen: the smallest order whose max is within {tol} (log10) of the best max and whose mean is within {tol} of the best mean of those orders\n"
     ));
     s
 }
