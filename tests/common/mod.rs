@@ -74,3 +74,17 @@ pub fn scaling_plant_pair(d_o: [f64; 2], d_i: [f64; 2]) -> (String, String) {
     );
     (keyed, scaling_plant_toml(&|i, j| d_o[i] * d_i[j]))
 }
+
+/// A unit-mass mode at `f_hz` with damping `zeta`, input gain 1 and output gain `rho` (its
+/// residue `rho` in receptance form).
+pub fn mode_hz(f_hz: f64, zeta: f64, rho: f64) -> rshape::model::physical::ModeSpec {
+    use rshape::model::physical::{Gains, ModeSpec};
+    ModeSpec {
+        name: None,
+        omega_n: std::f64::consts::TAU * f_hz,
+        zeta,
+        mass: 1.0,
+        input_gain: Gains::Scalar(1.0),
+        output_gain: Gains::Scalar(rho),
+    }
+}

@@ -9,20 +9,11 @@ use rshape::diagnose::Channels;
 use rshape::diagnose::ErrorMeasures as Measures;
 use rshape::diagnose::Node;
 use rshape::diagnose::{model_of, same_set};
-use rshape::model::physical::{Feedthrough, Gains, ModeSpec, PhysicalModel};
+use rshape::model::physical::{Feedthrough, PhysicalModel};
 
 const TAU: f64 = std::f64::consts::TAU;
 
-fn mode(f_hz: f64, zeta: f64, rho: f64) -> ModeSpec {
-    ModeSpec {
-        name: None,
-        omega_n: TAU * f_hz,
-        zeta,
-        mass: 1.0,
-        input_gain: Gains::Scalar(1.0),
-        output_gain: Gains::Scalar(rho),
-    }
-}
+use crate::common::mode_hz as mode;
 
 fn model(modes: &[(f64, f64)]) -> PhysicalModel {
     PhysicalModel {

@@ -13,20 +13,11 @@
 use num_complex::Complex64;
 use rshape::diagnose::admissible::Rule;
 use rshape::diagnose::{diagnose_channels, Channels, Diagnosis, SearchSettings};
-use rshape::model::physical::{Gains, ModeSpec, PhysicalModel};
+use rshape::model::physical::PhysicalModel;
 
 const TAU: f64 = std::f64::consts::TAU;
 
-fn mode(f: f64, zeta: f64, rho: f64) -> ModeSpec {
-    ModeSpec {
-        name: None,
-        omega_n: TAU * f,
-        zeta,
-        mass: 1.0,
-        input_gain: Gains::Scalar(1.0),
-        output_gain: Gains::Scalar(rho),
-    }
-}
+use crate::common::mode_hz as mode;
 
 fn smooth() -> PhysicalModel {
     PhysicalModel {

@@ -9,9 +9,7 @@ use num_complex::Complex64;
 use rshape::diagnose::cost;
 use rshape::diagnose::{diagnose_channels, retune_within, Channels, SearchSettings};
 use rshape::diagnose::{Diagnosis, PeakFate};
-use rshape::model::physical::{
-    Feedthrough, Gains, ModeSpec, PhysicalModel, PoleAtZeroSpec, Quantity,
-};
+use rshape::model::physical::{Feedthrough, Gains, PhysicalModel, PoleAtZeroSpec, Quantity};
 use std::path::Path;
 
 const TAU: f64 = std::f64::consts::TAU;
@@ -69,16 +67,7 @@ fn mass_line() -> PhysicalModel {
     }
 }
 
-fn mode(f_hz: f64, zeta: f64, rho: f64) -> ModeSpec {
-    ModeSpec {
-        name: None,
-        omega_n: TAU * f_hz,
-        zeta,
-        mass: 1.0,
-        input_gain: Gains::Scalar(1.0),
-        output_gain: Gains::Scalar(rho),
-    }
-}
+use crate::common::mode_hz as mode;
 
 /// The hand check, independent of the holdout code: with the 900 Hz mode in the
 /// model, the 810 Hz mode lowers the held-out cost in every one of the four interleaved

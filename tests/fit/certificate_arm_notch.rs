@@ -15,15 +15,21 @@ use std::path::Path;
 
 const ARM_Z001: &str = "data = \"configs/data/daisy_robot_arm/frf_etfe_normfreq.csv\"\nsample_time = 1.0\n[plant]\ntf = [[{ num = [-1.93391, -0.103041, -2.55255, -0.0234311, -0.1], den = [12.032, 0.3659, 9.2346, 0.13578, 1.0] }]]\n";
 
-/// `α*` (by brute force: data, and a dense grid between consecutive data), and the
-/// certificate of `α·M̃` with `α` between `α*` and 1: it passes, A1 proved.
-#[test]
-fn the_z001_arm_admits_alpha_times_m_tilde() {
+/// The config and its Theorem 2 envelope.
+fn arm_z001() -> (Config, rshape::Envelope) {
     let cfg = Config::parse(ARM_Z001, Path::new("arm_z001.toml")).unwrap();
     let data = load_data(&cfg, cfg.data.as_ref().unwrap()).unwrap();
     let env = rshape::envelope(&cfg, &data, &RunOptions::default())
         .unwrap()
         .envelope;
+    (cfg, env)
+}
+
+/// `α*` (by brute force: data, and a dense grid between consecutive data), and the
+/// certificate of `α·M̃` with `α` between `α*` and 1: it passes, A1 proved.
+#[test]
+fn the_z001_arm_admits_alpha_times_m_tilde() {
+    let (cfg, env) = arm_z001();
     let f = &cfg.factorization;
     // M̃ of the normalized factors in zero-pole form: its zeros are the plant's poles, its
     // poles those of the factors' realization [Ñ M̃], its value at infinity R̃^(-1/2).
@@ -135,11 +141,7 @@ fn plant_mag(w: f64) -> f64 {
 /// 0.7977 rad/s and the certificate refused them all.
 #[test]
 fn a1_notch_between_grid_points_is_kept_by_the_fit() {
-    let cfg = Config::parse(ARM_Z001, Path::new("arm_z001.toml")).unwrap();
-    let data = load_data(&cfg, cfg.data.as_ref().unwrap()).unwrap();
-    let env = rshape::envelope(&cfg, &data, &RunOptions::default())
-        .unwrap()
-        .envelope;
+    let (cfg, env) = arm_z001();
     let f = &cfg.factorization;
     let set = FitSettings {
         order: 6,
