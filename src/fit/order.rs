@@ -109,7 +109,7 @@ struct MeanChain {
 /// Sweeps orders `0..=n_max`, returns the chosen certified fit and the table;
 /// `options.progress` hears of each order before it is fitted.
 ///
-/// With [`Objective::Minimax`] an order may lower the max at a higher mean ([`admits`]);
+/// With [`Objective::Minimax`] (see its promise) an order may lower the max at a higher mean;
 /// from the first order that does, a second chain is carried beside the first: the `r` the
 /// mean-and-max promise would have chosen at each order (the sweep before issue 38's tenth
 /// step), with its own search from its own previous `r`.  The candidates of both searches
