@@ -102,6 +102,7 @@ impl<'a> Fits<'a, '_> {
             nodes: self.nodes,
             data: self.data,
             allow_mains: self.allow_mains,
+            min_delta_bic: self.min_delta_bic,
         }
     }
 }

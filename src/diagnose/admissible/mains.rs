@@ -10,8 +10,9 @@
 //!   mains tolerance — `ΔBIC_out = 2ΔV_out − p·ln(2N_out)` with
 //!   `ΔV_out = 2 Σ_ch Σ_i [(|g − g_rest|/r)² − (|g − g_model|/r)²]` over those lines, `g_rest`
 //!   the refit model without the mode, `p` its parameters (the search's BIC,
-//!   `search::beam`) — is at most the acceptance threshold [`MIN_DELTA_BIC`] (10): the
-//!   lines beside it do not support it;
+//!   [`delta_bic`]) — is at most the search's acceptance threshold
+//!   ([`crate::diagnose::SearchSettings::min_delta_bic`], 10 by default): the lines beside it
+//!   do not support it;
 //! * **a stable harmonic** (low `h`): the mains fundamental wanders from its nominal value by
 //!   up to [`MAINS_DRIFT_HZ`] during a measurement, its `h`-th harmonic by `h` times that.
 //!   While `h·δf0` is within the tolerance the harmonic stays on its line, and a tone there,
@@ -29,6 +30,7 @@
 use super::{spacing_at, MAINS_HZ};
 use crate::diagnose::effects::candidates::{sig, Cand};
 use crate::diagnose::lsq::channels::Channels;
+use crate::diagnose::lsq::measures::delta_bic;
 use crate::model::physical::PhysicalModel;
 use std::f64::consts::TAU;
 
@@ -36,11 +38,6 @@ use std::f64::consts::TAU;
 /// (Hz): interconnected grids hold it within ±0.05 Hz in normal operation (ENTSO-E's
 /// standard frequency range ±50 mHz; North American grids, ±36 mHz at 1σ).
 pub const MAINS_DRIFT_HZ: f64 = 0.05;
-
-/// The evidence (ΔBIC) the lines outside the mains tolerance must give a mode: the search's
-/// acceptance threshold (`search::rank::MIN_DELTA_BIC`, which checks at compile time that the
-/// two agree; named here because the search layer sits above this one).
-pub const MIN_DELTA_BIC: f64 = 10.0;
 
 /// A mains harmonic a mode sits on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -112,20 +109,25 @@ pub fn off_line_support(
         let (ga, gr) = (m.eval(*w), rest.eval(*w));
         for (ch, e) in data.entries.iter().enumerate() {
             let (g, r) = (data.g[ch][i], data.radius[ch][i]);
-            // Measures::v is 2Σ(|e|/r)²; the search's BIC is 2v + p·ln(2N).
+            // Measures::v is 2Σ(|e|/r)².
             dv += 2.0 * (((g - gr[*e]).norm() / r).powi(2) - ((g - ga[*e]).norm() / r).powi(2));
             n += 1;
         }
     }
-    let p = Cand::Mode.n_params(data.entries.len()) as f64;
     OffLine {
-        delta_bic: 2.0 * dv - p * (2.0 * n.max(1) as f64).ln(),
+        delta_bic: delta_bic(dv, Cand::Mode.n_params(data.entries.len()), n.max(1)),
         n_out,
     }
 }
 
-/// The mains refusal of mode `k` of `m`, if any (module docs).
-pub(super) fn refusal(m: &PhysicalModel, k: usize, data: &Channels) -> Option<String> {
+/// The mains refusal of mode `k` of `m`, if any (module docs); `min_delta_bic` is the
+/// search's acceptance threshold.
+pub(super) fn refusal(
+    m: &PhysicalModel,
+    k: usize,
+    data: &Channels,
+    min_delta_bic: f64,
+) -> Option<String> {
     let md = &m.mode[k];
     let f = md.omega_n / TAU;
     let df = spacing_at(&data.omega, md.omega_n) / TAU;
@@ -139,14 +141,15 @@ pub(super) fn refusal(m: &PhysicalModel, k: usize, data: &Channels) -> Option<St
             hm.f0
         );
         let off = off_line_support(m, k, data, hm.hz(), hm.tol);
-        if off.delta_bic <= MIN_DELTA_BIC {
+        if off.delta_bic <= min_delta_bic {
             return Some(format!(
-                "{at}; the lines beside it do not show a resonance's skirts (its ΔBIC without the {} line{} within {} Hz of {} Hz: {} ≤ {MIN_DELTA_BIC}): a spectral line, probable electrical interference, not a mode of the structure (--allow-mains writes it)",
+                "{at}; the lines beside it do not show a resonance's skirts (its ΔBIC without the {} line{} within {} Hz of {} Hz: {} ≤ {}): a spectral line, probable electrical interference, not a mode of the structure (--allow-mains writes it)",
                 off.n_out,
                 if off.n_out == 1 { "" } else { "s" },
                 sig(hm.tol),
                 sig(hm.hz()),
-                sig(off.delta_bic)
+                sig(off.delta_bic),
+                sig(min_delta_bic)
             ));
         }
         if hm.stable() {

@@ -123,6 +123,10 @@ pub struct Child<'a> {
     pub reference: &'a Measures,
     /// Write modes at mains frequencies anyway.
     pub allow_mains: bool,
+    /// The ΔBIC the search requires of an effect
+    /// ([`crate::diagnose::SearchSettings::min_delta_bic`]); the mains rule requires the same of
+    /// a mode's evidence on the lines beside a harmonic.
+    pub min_delta_bic: f64,
 }
 
 /// Median of a non-empty list (NaN for an empty one).
@@ -165,7 +169,7 @@ pub fn check(c: &Child<'_>, data: &Channels) -> Option<Refusal> {
         // Mains: a line-narrow mode at 50/60 Hz or a harmonic that the lines beside it do
         // not support, or at a harmonic stable enough for a tone to mimic its skirts.
         if !c.allow_mains {
-            if let Some(r) = mains::refusal(c.model, k, data) {
+            if let Some(r) = mains::refusal(c.model, k, data, c.min_delta_bic) {
                 return refuse(fo, Rule::Mains, r);
             }
         }

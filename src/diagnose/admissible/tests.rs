@@ -3,6 +3,7 @@
 #![cfg(test)]
 
 use super::*;
+use crate::diagnose::search::rank::MIN_DELTA_BIC;
 use crate::model::physical::{EffectKind, EffectSpec, Gains, ModeSpec};
 
 fn mode(w: f64, z: f64, rho: f64) -> ModeSpec {
@@ -72,6 +73,7 @@ fn refused(
             measures: after,
             reference: &BEFORE,
             allow_mains: mains,
+            min_delta_bic: MIN_DELTA_BIC,
         },
         d,
     )
@@ -392,4 +394,38 @@ fn the_stable_harmonics_follow_the_line_spacing() {
     // Not narrower than a line, or 1 Hz off the harmonic: no harmonic.
     assert!(mains::harmonics_at(2640.0, 4e-4, 1.0).is_empty());
     assert!(mains::harmonics_at(2641.0, 1e-6, 1.0).is_empty());
+}
+
+/// The spectral-line test asks of the lines beside a harmonic the evidence the search asks of
+/// any effect: the run's `min_delta_bic`, not a constant of its own.  The 2640.2 Hz resonance
+/// (skirts on every line beside it) has off-line evidence `X`; with the threshold just above
+/// `X` it is refused as a spectral line, just below it admitted.
+#[test]
+fn the_spectral_line_test_reads_the_searchs_threshold() {
+    let m = smooth_and(2640.2, 2.65e-4, 5.0);
+    let d = data_of(&m, hz_lines());
+    let hm = mains::harmonics_at(2640.2, 2.65e-4, 1.0);
+    let x = mains::off_line_support(&m, 1, &d, hm[0].hz(), hm[0].tol).delta_bic;
+    assert!(x > MIN_DELTA_BIC, "{x}");
+    let at = |min_delta_bic: f64| {
+        check(
+            &Child {
+                cand: Cand::Mode,
+                model: &m,
+                measures: &AFTER,
+                reference: &BEFORE,
+                allow_mains: false,
+                min_delta_bic,
+            },
+            &d,
+        )
+    };
+    let r = at(1.01 * x).expect("refused above its evidence");
+    assert_eq!(r.rule, Rule::Mains, "{}", r.reason);
+    assert!(
+        r.reason.contains("do not show a resonance's skirts"),
+        "{}",
+        r.reason
+    );
+    assert_eq!(at(0.99 * x), None);
 }

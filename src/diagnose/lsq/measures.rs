@@ -41,3 +41,17 @@ pub fn measures_of(c: &[Vec<f64>]) -> Measures {
         invalid_fraction: bad as f64 / n,
     }
 }
+
+/// The Bayesian information criterion of a fit with cost `v` ([`Measures::v`]) and `n_params`
+/// real parameters on `n_data` complex data (`2·n_data` real ones): `2v + p·ln(2N)`
+/// (Schwarz 1978; docs/design/effects.md).
+pub fn bic(v: f64, n_params: usize, n_data: usize) -> f64 {
+    2.0 * v + n_params as f64 * (2.0 * n_data as f64).ln()
+}
+
+/// The evidence for `n_params` added real parameters that lower the cost by `dv`
+/// ([`Measures::v`] before minus after) on `n_data` complex data: the fall of [`bic`],
+/// `2Δv − p·ln(2N)`.
+pub fn delta_bic(dv: f64, n_params: usize, n_data: usize) -> f64 {
+    2.0 * dv - n_params as f64 * (2.0 * n_data as f64).ln()
+}

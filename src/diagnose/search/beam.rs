@@ -116,7 +116,7 @@ impl SearchResult {
 }
 
 fn bic(v: f64, n: usize, data: &Channels) -> f64 {
-    2.0 * v + n as f64 * (2.0 * data.n_data() as f64).ln()
+    crate::diagnose::lsq::measures::bic(v, n, data.n_data())
 }
 
 /// The two roots: the configured model as it is, and retuned from a rough start (its

@@ -10,7 +10,7 @@ use super::node::Node;
 use super::rank::{improves, modes_at_band_edge, si_map, Screened};
 use crate::diagnose::admissible::{check, Child, Refusal};
 use crate::diagnose::lsq::channels::Channels;
-use crate::diagnose::lsq::measures::Measures;
+use crate::diagnose::lsq::measures::{delta_bic, Measures};
 use crate::diagnose::report::Step;
 use crate::diagnose::search::final_effects::final_effects;
 use crate::model::physical::PhysicalModel;
@@ -48,9 +48,8 @@ pub(super) fn judge(
 ) -> (Option<Node>, Option<Refusal>) {
     let data = j.data;
     let (model, m, v_fit, n_refit) = refit;
-    let ln2f = (2.0 * data.n_data() as f64).ln();
     let n_new: usize = added.iter().map(|sc| sc.cand.n_params(data.n_ch())).sum();
-    let d_bic = 2.0 * (j.ref_v - v_fit) - n_new as f64 * ln2f;
+    let d_bic = delta_bic(j.ref_v - v_fit, n_new, data.n_data());
     // A mode the joint refit pushed to a band edge is not a resonance of the data (it would
     // be written at exactly the band top).
     let (w_lo, w_hi) = (data.omega[0], *data.omega.last().expect("data"));
@@ -75,10 +74,18 @@ pub(super) fn judge(
                 measures: &m,
                 reference: j.reference,
                 allow_mains: j.allow_mains,
+                min_delta_bic: j.min_delta_bic,
             },
             data,
         ),
-        _ => check_each(&model, added.len(), &m, j.allow_mains, data),
+        _ => check_each(
+            &model,
+            added.len(),
+            &m,
+            j.allow_mains,
+            j.min_delta_bic,
+            data,
+        ),
     };
     if refusal.is_some() {
         return (None, refusal);
@@ -118,7 +125,7 @@ pub(super) fn judge(
     }
     let child = Node {
         effects,
-        bic: 2.0 * v_fit + n_refit as f64 * ln2f,
+        bic: crate::diagnose::lsq::measures::bic(v_fit, n_refit, data.n_data()),
         model,
         measures: m,
         v_fit,

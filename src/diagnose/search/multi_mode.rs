@@ -80,6 +80,7 @@ pub(super) fn check_each(
     k: usize,
     measures: &Measures,
     allow_mains: bool,
+    min_delta_bic: f64,
     data: &Channels,
 ) -> Option<Refusal> {
     let n = model.mode.len();
@@ -100,6 +101,7 @@ pub(super) fn check_each(
                 measures,
                 reference: &reference,
                 allow_mains,
+                min_delta_bic,
             },
             data,
         );
@@ -128,6 +130,7 @@ mod tests {
     use super::*;
     use crate::diagnose::admissible::Rule;
     use crate::diagnose::lsq::problem::Mods;
+    use crate::diagnose::search::rank::MIN_DELTA_BIC;
     use crate::model::physical::{Gains, ModeSpec};
 
     const TAU: f64 = std::f64::consts::TAU;
@@ -165,7 +168,10 @@ mod tests {
         let d = data();
         // The two missing modes: admissible (each is most of the misfit where it stands).
         let good = with_modes(&[(100.0, 0.01, 1e5), (137.3, 0.005, 5e4), (263.7, 0.005, 1e5)]);
-        assert_eq!(check_each(&good, 2, &measures(&good, &d), false, &d), None);
+        assert_eq!(
+            check_each(&good, 2, &measures(&good, &d), false, MIN_DELTA_BIC, &d),
+            None
+        );
         // One real mode and a cancelling pair at 203 Hz (bands overlap, residues ±): the
         // pair's mode is refused as an artefact, and the reason names the group.
         let bad = with_modes(&[
@@ -174,7 +180,8 @@ mod tests {
             (203.0, 0.01, 4e4),
             (203.5, 0.01, -4e4),
         ]);
-        let r = check_each(&bad, 3, &measures(&bad, &d), false, &d).expect("refused");
+        let r =
+            check_each(&bad, 3, &measures(&bad, &d), false, MIN_DELTA_BIC, &d).expect("refused");
         assert_eq!(r.rule, Rule::Artefact, "{r:?}");
         assert!((r.frequency_hz.unwrap() - 203.0).abs() < 1.0, "{r:?}");
         assert!(r.reason.contains("proposed with 2 other modes"), "{r:?}");
@@ -186,6 +193,7 @@ mod tests {
                 measures: &measures(&bad, &d),
                 reference: &measures(&with_modes(&[(100.0, 0.01, 1e5)]), &d),
                 allow_mains: false,
+                min_delta_bic: MIN_DELTA_BIC,
             },
             &d,
         )

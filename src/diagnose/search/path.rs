@@ -44,7 +44,7 @@ pub(crate) fn restate_path(
     }
     let (lin, nl) = slots(&node.model, data);
     node.n_params = lin.len() + nl.len();
-    node.bic = 2.0 * node.v_fit + node.n_params as f64 * (2.0 * data.n_data() as f64).ln();
+    node.bic = crate::diagnose::lsq::measures::bic(node.v_fit, node.n_params, data.n_data());
     let (mut last, mut k) = (None, 0);
     for s in node.steps.iter_mut() {
         if last != Some(s.step) {
@@ -124,7 +124,7 @@ fn restate_step(
         .iter()
         .map(|e| e.0.n_params(data.n_ch()))
         .sum();
-    let d_bic = 2.0 * (v_prev - v) - n_new as f64 * (2.0 * data.n_data() as f64).ln();
+    let d_bic = crate::diagnose::lsq::measures::delta_bic(v_prev - v, n_new, data.n_data());
     let cands: Vec<_> = node.effects[..end].iter().map(|e| e.0).collect();
     let finals = final_effects(&model, base, &cands, data, false);
     for (s, fe) in node.steps[first..end].iter_mut().zip(&finals[first..]) {

@@ -13,8 +13,6 @@ use std::collections::BTreeMap;
 
 /// ΔBIC a candidate needs to be accepted.
 pub const MIN_DELTA_BIC: f64 = 10.0;
-// The mains rule reads the same threshold from below the search layer.
-const _: () = assert!(MIN_DELTA_BIC == crate::diagnose::admissible::mains::MIN_DELTA_BIC);
 
 /// BIC gap under which two candidates (or two effect sets) are a tie.
 pub const TIE_BIC: f64 = 6.0;

@@ -79,6 +79,8 @@ pub(crate) struct Recheck<'a> {
     pub data: &'a Channels,
     /// Write modes at mains frequencies anyway.
     pub allow_mains: bool,
+    /// The search's acceptance threshold ([`crate::diagnose::SearchSettings::min_delta_bic`]).
+    pub min_delta_bic: f64,
 }
 
 impl Recheck<'_> {
@@ -123,6 +125,7 @@ impl Recheck<'_> {
                         measures: &node.measures,
                         reference: &reference,
                         allow_mains: self.allow_mains,
+                        min_delta_bic: self.min_delta_bic,
                     },
                     data,
                 ))
