@@ -2,7 +2,8 @@
 //! previous one, so the objective's promise holds: the max never rises, nor, with
 //! [`Objective::Area`], the mean; see [`super::engine::admits`]), tabulate order against
 //! conservatism (mean and max of `log10(|r|/r_min)` over the data), and pick the smallest
-//! order whose mean and max are both within `auto_tolerance` of the best in the table.
+//! order whose max is within `auto_tolerance` of the best max and whose mean is within it of
+//! the best mean among those orders (`choose`).
 
 use super::context::prepare;
 use super::engine::{admits, fit_order, max_tolerance, rank, Scored};
