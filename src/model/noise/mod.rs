@@ -1,10 +1,15 @@
 //! Noise models of the measurements (Boulet & Francis 1998, Sec. III, eqs. (4)–(5)); the
 //! three sources and their precedence are in [`resolve_noise`]'s documentation.
 
+mod files;
+mod output_bound;
+
+pub use output_bound::{linf_disk_radius, phase_bound, radii_from_output_bound};
+
 use super::Config;
-use crate::data::std_file::{h1_random_error, read_coherence_csv, read_std_csv};
 use crate::data::FrfData;
 use crate::error::{Error, Result};
+use files::{coherence_noise, std_file_noise};
 
 /// Where the radii came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -33,80 +38,6 @@ pub struct ResolvedNoise {
     pub source: NoiseSource,
     /// The source in words, with its numbers (for reports).
     pub description: String,
-}
-
-/// The phase-noise bound of Sec. III, `L_θ = M/(A_m − M)` (radians), for an output-noise
-/// bound `M` and a measured output amplitude `A_m`.  `None` when `A_m ≤ M` (the noise can
-/// hide the whole sinusoid: no phase information).
-pub fn phase_bound(output_bound: f64, measured_amplitude: f64) -> Option<f64> {
-    (measured_amplitude > output_bound).then(|| output_bound / (measured_amplitude - output_bound))
-}
-
-/// Radius `L_a` of the largest disk inside the set (Sec. III)
-/// `U = {(A_m + w_A)·e^{j(θ_m + w_θ)} : |w_A| ≤ M, |w_θ| ≤ L_θ}`, `L_θ = M/(A_m − M)`.
-///
-/// `U` is an annular sector: radii `[A_m − M, A_m + M]`, half-angle `L_θ`.  A disk centred on
-/// the bisecting ray at distance `c` from the origin has radius at most `M − |c − A_m|`
-/// (the two arcs) and `c·sin(min(L_θ, π/2))` (the two edges).  Maximizing over `c`:
-///
-/// * if `A_m·sin(min(L_θ, π/2)) ≥ M`: `L_a = M` (centre `c = A_m`);
-/// * otherwise: `L_a = (A_m + M)·s/(1 + s)`, `s = sin(min(L_θ, π/2))`.
-///
-/// With `L_θ = M/(A_m − M)` the first case always holds when `A_m > M`: writing
-/// `x = L_θ`, `A_m = M(1 + x)/x`, the condition is `(1 + x)·sin x ≥ x`, true for
-/// `0 < x ≤ π/2` (since `sin x ≥ x − x³/6` and `x + x² ≤ 6`), and for `x > π/2` it reads
-/// `A_m ≥ M`.  So `L_a = M`, as the paper anticipates ("close to M"); the general formula is
-/// kept for clarity.  `W₀` is an *inner* approximation of `U`: it is the paper's model.
-///
-/// `None` when `A_m ≤ M` (see [`phase_bound`]).  `M = 0` gives 0.
-pub fn linf_disk_radius(output_bound: f64, measured_amplitude: f64) -> Option<f64> {
-    let (m, am) = (output_bound, measured_amplitude);
-    if m == 0.0 {
-        return Some(0.0);
-    }
-    let lt = phase_bound(m, am)?;
-    let s = lt.min(std::f64::consts::FRAC_PI_2).sin();
-    Some(if am * s >= m {
-        m
-    } else {
-        (am + m) * s / (1.0 + s)
-    })
-}
-
-/// Per-datum radii from the `L∞` output bound `M` (Sec. III): `L_a,i = R(M, U·|φ_i|)/U`, with
-/// `R` = [`linf_disk_radius`] and `U` the input amplitude (the measured output amplitude is
-/// `A_m = U·|φ_i|`; dividing by `U` brings the disk back to the units of `φ`).  SISO only.
-pub fn radii_from_output_bound(
-    output_bound: f64,
-    input_amplitude: f64,
-    data: &FrfData,
-) -> Result<Vec<f64>> {
-    if data.outputs() != 1 || data.inputs() != 1 {
-        return Err(Error::Input {
-            path: data.path.to_path_buf(),
-            msg: format!(
-                "[noise] output_bound (Sec. III) is defined for SISO data; these are {}×{}",
-                data.outputs(),
-                data.inputs(),
-            ),
-        });
-    }
-    data.omega
-        .iter()
-        .zip(&data.response)
-        .map(|(&omega, phi)| {
-            let am = input_amplitude * phi[(0, 0)].norm();
-            linf_disk_radius(output_bound, am)
-                .map(|r| r / input_amplitude)
-                .ok_or_else(|| Error::Assumption {
-                    omega,
-                    msg: format!(
-                        "the measured amplitude A_m = {am:.4e} is not above the output-noise bound M = {output_bound:.4e} ({}): the phase is unknown (Sec. III); lower output_bound or remove the datum",
-                        data.path.display()
-                    ),
-                })
-        })
-        .collect()
 }
 
 /// The source of the noise radii under the precedence CLI flag > config > data column (see
@@ -317,129 +248,6 @@ fn resolve_in_file_units(
         }
     };
     Ok(Some(resolved))
-}
-
-/// A std or coherence file on the config's frequency axis (its `sample_time`).
-fn on_axis(
-    cfg: &Config,
-    f: crate::data::StdData,
-    path: &std::path::Path,
-) -> Result<crate::data::StdData> {
-    match cfg.sample_time() {
-        Some(ts) => crate::data::denormalize_std(f, ts, path),
-        None => Ok(f),
-    }
-}
-
-/// The radii of a config's `[noise] std_file` for the data: the file belongs to the config's
-/// own data; for other data (`--data`) `<data stem>_std.csv` beside them is used.
-fn std_file_noise(
-    cfg: &Config,
-    data: &FrfData,
-    (out, inp): (usize, usize),
-) -> Result<ResolvedNoise> {
-    let Some((file, k)) = &cfg.noise_std else {
-        return Err(Error::Invalid("no [noise] std_file in the config".into()));
-    };
-    let file = file_for_data(cfg, data, file, "std", "std_file")?;
-    let std = on_axis(cfg, read_std_csv(&file)?, &file)?;
-    let radii = std.radius_at(&file, &data.omega, out, inp, *k)?;
-    Ok(ResolvedNoise {
-        description: format!("{k} × std_{out}_{inp} of {}", file.display()),
-        radii,
-        source: NoiseSource::ConfigStdFile,
-    })
-}
-
-/// The radii of a config's `[noise] coherence`: `coverage·ε·|H|` per datum, with the H1
-/// random error `ε` of [`h1_random_error`] (Bendat & Piersol, *Random Data*, Table 9.6).
-fn coherence_noise(
-    cfg: &Config,
-    data: &FrfData,
-    (out, inp): (usize, usize),
-) -> Result<ResolvedNoise> {
-    let sec = &cfg.raw.noise;
-    let (Some(file), Some(n)) = (&sec.coherence, sec.averages) else {
-        return Err(Error::Invalid(
-            "[noise] coherence needs averages = n".into(),
-        ));
-    };
-    let n = u32::try_from(n).unwrap_or(1);
-    let k = sec.coverage.unwrap_or(3.0);
-    let base = cfg.path.parent().unwrap_or(std::path::Path::new("."));
-    let file = file_for_data(cfg, data, &base.join(file), "coherence", "coherence")?;
-    let gamma2 = on_axis(cfg, read_coherence_csv(&file)?, &file)?.values_at(
-        &file,
-        "coh",
-        &data.omega,
-        out,
-        inp,
-    )?;
-    // SISO data are the channel already; MIMO data hold it at (out, inp).
-    let at = if data.outputs() == 1 && data.inputs() == 1 {
-        (0, 0)
-    } else if (1..=data.outputs()).contains(&out) && (1..=data.inputs()).contains(&inp) {
-        (out - 1, inp - 1)
-    } else {
-        return Err(Error::Input {
-            path: data.path.to_path_buf(),
-            msg: format!(
-                "channel ({out}, {inp}) of [noise] coherence is not in the {}×{} data",
-                data.outputs(),
-                data.inputs(),
-            ),
-        });
-    };
-    let radii = gamma2
-        .iter()
-        .zip(&data.response)
-        .map(|(&g2, h)| k * h1_random_error(g2, n) * h[at].norm())
-        .collect();
-    Ok(ResolvedNoise {
-        description: format!(
-            "{k} × ε·|H|, ε = √(1 − γ²)/(|γ|√(2·{n})) from coh_{out}_{inp} of {}",
-            file.display()
-        ),
-        radii,
-        source: NoiseSource::ConfigCoherence,
-    })
-}
-
-/// The file of a per-frequency noise source for `data`: the config's own `file` when the
-/// data are the config's data, else `<data stem>_<suffix>.csv` beside the data.
-fn file_for_data(
-    cfg: &Config,
-    data: &FrfData,
-    file: &std::path::Path,
-    suffix: &str,
-    key: &str,
-) -> Result<std::path::PathBuf> {
-    let own = cfg.data.as_ref().is_some_and(|d| {
-        d == &data.path
-            || d.canonicalize()
-                .ok()
-                .is_some_and(|a| Some(a) == data.path.canonicalize().ok())
-    });
-    Ok(if own {
-        file.to_path_buf()
-    } else {
-        let stem = data
-            .path
-            .file_stem()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_default();
-        let sib = data.path.with_file_name(format!("{stem}_{suffix}.csv"));
-        if !sib.exists() {
-            return Err(Error::Input {
-                path: data.path.to_path_buf(),
-                msg: format!(
-                    "the config's [noise] {key} belongs to its own data; put {} beside these data or pass --noise-radius",
-                    sib.display(),
-                ),
-            });
-        }
-        sib
-    })
 }
 
 /// The per-datum radii only (see [`resolve_noise`]): CLI flag > config > data column;
