@@ -236,3 +236,56 @@ fn compare_scales_each_channel_of_mimo_data_by_its_own_factor() {
         assert_eq!(a["verdict"], b["verdict"], "{c}");
     }
 }
+
+/// `compare --against` with `[scaling]`: the second experiment is put in the model's units and
+/// its noise (its own `noise_radius` column, in the data file's units) scaled like the first
+/// one's, so the data-vs-data distance `d = |G_a − G_b|/(r_a + r_b)` is the same in either
+/// units.  Both configs' `against` figures are checked against `d` computed here from the two
+/// files directly.
+#[test]
+fn compare_against_a_second_experiment_is_the_same_with_scaling() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = noisy_data(dir.path());
+    let rows = |p: &Path| -> Vec<[f64; 4]> {
+        std::fs::read_to_string(p)
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("omega"))
+            .map(|l| {
+                let v: Vec<f64> = l.split(',').map(|x| x.trim().parse().unwrap()).collect();
+                [v[0], v[1], v[2], v[3]]
+            })
+            .collect()
+    };
+    let a = rows(&first);
+    // The second experiment: the first one off by up to 30 %, its own radii 5 % of |G|.
+    let mut text = "omega_rad_s,re_1_1,im_1_1,noise_radius\n".to_string();
+    let mut d = Vec::new();
+    for (k, [w, re, im, ra]) in a.iter().enumerate() {
+        let f = 1.0 + 0.3 * (0.9 * k as f64).sin();
+        let (re2, im2, rb) = (f * re, f * im, 0.05 * re.hypot(*im));
+        text.push_str(&format!("{w:e},{re2:e},{im2:e},{rb:e}\n"));
+        d.push((re2 - re).hypot(im2 - im) / (ra + rb));
+    }
+    std::fs::write(dir.path().join("second.csv"), text).unwrap();
+    let rms = (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt();
+    let max = d.iter().cloned().fold(0.0, f64::max);
+    let disagree = d.iter().filter(|x| **x > 1.0).count() as f64 / d.len() as f64;
+    assert!(0.0 < disagree && disagree < 1.0, "{disagree}");
+    let base = "data = \"frf.csv\"\n[plant]\ntf = [[{ num = [1], den = [1, 1, 0] }]]\n";
+    let scaled = format!("{base}[scaling]\noutputs = [{D_O:e}]\ninputs = [{D_I}]\n");
+    let second = dir.path().join("second.csv");
+    let args = ["--against", second.to_str().unwrap()];
+    for (name, text) in [("plain.toml", base.to_string()), ("scaled.toml", scaled)] {
+        let v = compare(dir.path(), name, &text, &args);
+        let ag = &v["against"];
+        assert_eq!(ag["n_common"].as_u64(), Some(a.len() as u64), "{name}");
+        let got = |k: &str| ag[k].as_f64().unwrap();
+        assert!(close(got("distance_rms"), rms, 1e-9), "{name}: {ag}");
+        assert!(close(got("distance_max"), max, 1e-9), "{name}: {ag}");
+        assert!(
+            close(got("disagree_fraction"), disagree, 1e-12),
+            "{name}: {ag}"
+        );
+    }
+}
