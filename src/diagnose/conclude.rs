@@ -239,7 +239,8 @@ pub fn conclude(
         let z = crate::diagnose::lsq::whiteness::normalized_residual(&node.model, data);
         let white =
             crate::diagnose::lsq::whiteness::whiteness(&z, node.n_params, (data.len() / 50).max(5));
-        let hz = |k: usize| data.omega[k] / std::f64::consts::TAU;
+        // Clamped: the explanation reads the lines beside an outlier line.
+        let hz = |k: usize| data.omega[k.min(data.len() - 1)] / std::f64::consts::TAU;
         message += &stop_explanation(&res.refused, &white, hz);
         residual = white
             .level

@@ -388,7 +388,8 @@ pub struct ResidualAccount {
     /// `Q ≤ q_critical`: no structure is left along frequency.
     pub white: bool,
     /// `white_at_noise` (nothing more to find), `scatter_above_noise` (white but above the
-    /// stated σ: a `std_factor`), `structured` (missing dynamics).
+    /// stated σ: a `std_factor`), `structured` (missing dynamics), `outlier_line` (one line
+    /// holds half of `V` or more: a spectral line or a dropout there).
     pub kind: &'static str,
     /// Where a structured residual concentrates, Hz (absent when white or spread).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -400,6 +401,12 @@ pub struct ResidualAccount {
     /// noise radius) would have to grow to cover the scatter.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub std_factor_times: Option<f64>,
+    /// For `outlier_line`: the line's frequency, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outlier_hz: Option<f64>,
+    /// For `outlier_line`: its share of `V`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub outlier_share: Option<f64>,
 }
 
 /// A damping the data do not identify (`lsq::profile`): every `ζ` from

@@ -85,7 +85,24 @@ pub(crate) fn stop_explanation(
     }
     if white.level.is_finite() {
         out += "; ";
-        out += &white.explain(hz);
+        out += &white.explain(&hz);
+        // The refusal at the outlier line, if one was refused there: the two are one story.
+        if let Some((k, _)) = white.outlier {
+            let f = hz(k);
+            let half = 0.5 * (hz(k + 1) - f).max(f - hz(k.saturating_sub(1)));
+            let at = refused
+                .iter()
+                .filter_map(|(_, r)| r.frequency_hz.map(|x| (x, r)))
+                .find(|(x, _)| (x - f).abs() <= half);
+            if let Some((x, r)) = at {
+                out += &format!(
+                    " (the {} at {} Hz refused above sits on that line: {})",
+                    r.effect,
+                    sig(x),
+                    r.rule.word()
+                );
+            }
+        }
     }
     out
 }
@@ -97,13 +114,17 @@ pub(crate) fn residual_account(
     hz: impl Fn(usize) -> f64,
 ) -> crate::diagnose::report::ResidualAccount {
     let high = w.level > crate::diagnose::lsq::whiteness::LEVEL_HIGH;
-    let kind = match (w.white, high) {
-        (true, false) => "white_at_noise",
-        (true, true) => "scatter_above_noise",
-        (false, _) => "structured",
+    let kind = match (w.outlier, w.white, high) {
+        (Some(_), _, _) => "outlier_line",
+        (None, true, false) => "white_at_noise",
+        (None, true, true) => "scatter_above_noise",
+        (None, false, _) => "structured",
     };
-    // The explanation names a concentration only where it stands out (V per datum > 2).
-    let at = w.worst.filter(|(_, _, m)| !w.white && *m > 2.0);
+    // The explanation names a concentration only where it stands out (V per datum > 2), and
+    // not beside an outlier line, which it names instead.
+    let at = w
+        .worst
+        .filter(|(_, _, m)| w.outlier.is_none() && !w.white && *m > 2.0);
     crate::diagnose::report::ResidualAccount {
         level: w.level,
         ljung_box_q: w.q,
@@ -113,7 +134,9 @@ pub(crate) fn residual_account(
         kind,
         concentrated_hz: at.map(|(a, b, _)| [hz(a), hz(b)]),
         concentrated_level: at.map(|(_, _, m)| m),
-        std_factor_times: (w.white && high).then(|| w.level.sqrt()),
+        std_factor_times: (w.outlier.is_none() && w.white && high).then(|| w.level.sqrt()),
+        outlier_hz: w.outlier.map(|(k, _)| hz(k)),
+        outlier_share: w.outlier.map(|(_, s)| s),
     }
 }
 

@@ -123,4 +123,17 @@ fn a_resonance_at_44_x_60_hz_is_added_and_a_spectral_line_there_is_not() {
         there.iter().all(|r| r.refusal.rule == Rule::Mains),
         "{there:?}"
     );
+    // The stop names the spike as what is left (not a std_factor for every line), and ties
+    // it to the refusal.
+    let r = d.residual.as_ref().expect("a stop's residual");
+    assert_eq!(r.kind, "outlier_line", "{r:?}");
+    assert!((r.outlier_hz.unwrap() - 2640.0).abs() < 1e-9, "{r:?}");
+    assert!(r.std_factor_times.is_none(), "{r:?}");
+    assert!(
+        d.message.contains("one line at 2640 Hz")
+            && d.message.contains("refused above sits on that line: mains")
+            && !d.message.contains("std_factor ×"),
+        "{}",
+        d.message
+    );
 }

@@ -149,7 +149,7 @@ pub(super) fn refusal(
                 sig(hm.tol),
                 sig(hm.hz()),
                 sig(off.delta_bic),
-                sig(min_delta_bic)
+                min_delta_bic
             ));
         }
         if hm.stable() {

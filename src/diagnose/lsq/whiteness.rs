@@ -12,10 +12,13 @@
 //!   wrong phase), whatever its level.  The statistic is scale-free: a σ stated too small
 //!   or too large by a constant factor does not change it.
 //!
-//! The four cases the stop explanation tells apart: white at the level (nothing left to
-//! find), white above it (the data scatter more than stated: a `std_factor`), structured
-//! (missing dynamics, with the band where the residual concentrates), structured below the
-//! level (the noise is overstated and still something is missing).
+//! The cases the stop explanation tells apart: white at the level (nothing left to find),
+//! white above it (the data scatter more than stated: a `std_factor`), structured (missing
+//! dynamics, with the band where the residual concentrates), structured below the level (the
+//! noise is overstated and still something is missing) — and, before these, one line holding
+//! at least [`OUTLIER_SHARE`] of `V` above the level: an outlier (a spectral line such as
+//! mains interference, a dropout), which a single spike makes look white (its lagged
+//! products vanish) and a `std_factor` would wrongly spread over every line.
 
 use num_complex::Complex64;
 
@@ -25,6 +28,12 @@ pub const ALPHA: f64 = 1e-3;
 pub const MAX_LAGS: usize = 10;
 /// A level `V/E[V]` above this is beyond the stated noise.
 pub const LEVEL_HIGH: f64 = 1.5;
+/// One line holding this share of `V` or more (above [`LEVEL_HIGH`], on at least
+/// [`OUTLIER_MIN_LINES`] lines) is an outlier.  For noise at any level the largest share of
+/// `n` lines (each `|z|²` exponential) is about `ln n / n`: 0.23 for 10 lines.
+pub const OUTLIER_SHARE: f64 = 0.5;
+/// Fewest lines for the outlier account.
+pub const OUTLIER_MIN_LINES: usize = 10;
 
 /// The verdict on a residual (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -44,6 +53,9 @@ pub struct Whiteness {
     /// The index range (first, last line) of the window of `window` lines where `|z|²`
     /// summed over channels is largest, and its mean per datum there.
     pub worst: Option<(usize, usize, f64)>,
+    /// The line holding at least [`OUTLIER_SHARE`] of `V` (summed over channels) when the
+    /// level is above [`LEVEL_HIGH`], and its share.
+    pub outlier: Option<(usize, f64)>,
 }
 
 /// `P(χ²_{2k} > x) = e^{−x/2} Σ_{j<k} (x/2)^j / j!` (exact for even degrees of freedom,
@@ -116,10 +128,18 @@ pub fn whiteness(z: &[Vec<Complex64>], n_params: usize, window: usize) -> Whiten
         f64::INFINITY
     };
     let window = window.clamp(1, n.max(1));
+    let per_line: Vec<f64> = (0..n)
+        .map(|k| z.iter().map(|c| c[k].norm_sqr()).sum())
+        .collect();
+    let outlier = per_line
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(k, x)| (k, x / v))
+        .filter(|(_, share)| {
+            n >= OUTLIER_MIN_LINES && v / ev > LEVEL_HIGH && *share >= OUTLIER_SHARE
+        });
     let worst = (n >= window && n_ch > 0).then(|| {
-        let per_line: Vec<f64> = (0..n)
-            .map(|k| z.iter().map(|c| c[k].norm_sqr()).sum())
-            .collect();
         let mut s: f64 = per_line[..window].iter().sum();
         let (mut best, mut at) = (s, 0);
         for k in window..n {
@@ -138,6 +158,7 @@ pub fn whiteness(z: &[Vec<Complex64>], n_params: usize, window: usize) -> Whiten
         q_crit,
         white: q <= q_crit,
         worst,
+        outlier,
     }
 }
 
@@ -183,6 +204,14 @@ impl Whiteness {
                 format!("> {}", sig(self.q_crit))
             }
         );
+        if let Some((k, share)) = self.outlier {
+            return format!(
+                "the residual is {}× the stated noise (V/E[V], {lb}), and {} of it is the one line at {} Hz: an outlier there (a spectral line such as mains interference, or a dropout), not scatter — leave that line out (`--band`) or raise its noise radius alone, not std_factor",
+                sig(self.level),
+                crate::report::fmt::fmt_pct(share),
+                sig(hz(k))
+            );
+        }
         match (self.white, self.level > LEVEL_HIGH) {
             (true, false) => format!(
                 "the residual is white at the stated noise (V/E[V] = {}, {lb}): nothing more to find",
@@ -289,5 +318,34 @@ mod tests {
         assert!(a <= 300 && b >= 300, "{w:?}");
         let text = w.explain(|k| 10.0 + k as f64);
         assert!(text.contains("not white") && text.contains("Hz"), "{text}");
+    }
+
+    /// One line far off (a mains line in an FRF) on white noise at the stated level: the
+    /// residual looks white (a single spike has no lagged products), its level is high, and
+    /// the account names the line instead of a `std_factor`; the same noise without the
+    /// spike, or with the excess spread over every line, names no outlier.
+    #[test]
+    fn a_single_line_far_off_is_an_outlier_not_scatter() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(48);
+        let base = disk(&mut rng, 300);
+        let mut z = base.clone();
+        z[140] += Complex64::new(60.0, 0.0);
+        let w = whiteness(std::slice::from_ref(&z), 0, 10);
+        assert!(w.white && w.level > LEVEL_HIGH, "{w:?}");
+        let (k, share) = w.outlier.expect("outlier");
+        assert_eq!(k, 140);
+        // The share computed here: the line's |z|² over the sum.
+        let v: f64 = z.iter().map(|x| x.norm_sqr()).sum();
+        assert!(
+            (share - z[140].norm_sqr() / v).abs() < 1e-12 && share > 0.9,
+            "{share}"
+        );
+        let text = w.explain(|k| 2500.0 + k as f64);
+        assert!(text.contains("one line at 2640 Hz"), "{text}");
+        assert!(!text.contains("std_factor ×"), "{text}");
+        assert_eq!(whiteness(&[base.clone()], 0, 10).outlier, None);
+        let spread: Vec<Complex64> = base.iter().map(|x| 8.0 * x).collect();
+        let w = whiteness(&[spread], 0, 10);
+        assert!(w.level > LEVEL_HIGH && w.outlier.is_none(), "{w:?}");
     }
 }
