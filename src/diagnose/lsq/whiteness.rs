@@ -343,7 +343,7 @@ mod tests {
         let text = w.explain(|k| 2500.0 + k as f64);
         assert!(text.contains("one line at 2640 Hz"), "{text}");
         assert!(!text.contains("std_factor ×"), "{text}");
-        assert_eq!(whiteness(&[base.clone()], 0, 10).outlier, None);
+        assert_eq!(whiteness(std::slice::from_ref(&base), 0, 10).outlier, None);
         let spread: Vec<Complex64> = base.iter().map(|x| 8.0 * x).collect();
         let w = whiteness(&[spread], 0, 10);
         assert!(w.level > LEVEL_HIGH && w.outlier.is_none(), "{w:?}");
