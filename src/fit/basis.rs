@@ -140,6 +140,10 @@ pub struct GridSpec<'a> {
     /// Scaled frequencies where A1 may notch between grid points (the lightly damped zeros
     /// of `M̃`, [`crate::model::Factorization::a1_dips`]); empty: the grid alone.
     pub a1_dips: &'a [f64],
+    /// Scaled frequencies added as constraint points by the cutting-plane round
+    /// ([`super::cutting_plane`]): where a candidate broke a bound between grid points.
+    /// Empty: the grid of the first round.
+    pub cuts: &'a [f64],
 }
 
 /// A dip gets its own constraint point when A1 there is below this share of A1 at the dense
@@ -212,6 +216,20 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
         ws.sort_by(f64::total_cmp);
         ws.dedup();
     }
+    // The cuts of the cutting-plane round, anywhere on the axis (inside the band they get
+    // the no-dip bound of their interval, outside it the floor, as grid points do there).
+    let mut cuts: Vec<f64> = spec
+        .cuts
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .collect();
+    if !cuts.is_empty() {
+        cuts.sort_by(f64::total_cmp);
+        ws.extend(&cuts);
+        ws.sort_by(f64::total_cmp);
+        ws.dedup();
+    }
     let mut j = 0; // index of the datum at or below w
     for w in ws {
         let (lower, upper, kind) = if w < w_lo {
@@ -235,9 +253,10 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
         };
         // A notch below the bound no r may dip under between these data: no r meets both,
         // at any level. Left to the certificate, which names it, rather than to a search
-        // of every level up to its cap.
+        // of every level up to its cap (a cut there likewise).
         let a1 = a1_at(w);
-        if dips.binary_search_by(|d| d.total_cmp(&w)).is_ok() && a1.is_some_and(|v| v <= lower) {
+        let added = |v: &[f64]| v.binary_search_by(|d| d.total_cmp(&w)).is_ok();
+        if (added(&dips) || added(&cuts)) && a1.is_some_and(|v| v <= lower) {
             continue;
         }
         pts.push(GridPoint {
@@ -322,6 +341,7 @@ mod tests {
             extend_decades: 2.0,
             no_dip: true,
             a1_dips: &[],
+            cuts: &[],
         });
         assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
         assert!(g.iter().any(|p| p.kind == PointKind::Infinity));
