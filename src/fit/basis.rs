@@ -354,4 +354,38 @@ mod tests {
         assert!(g.iter().any(|p| p.w == 0.0));
         assert!((lo - 1e-3).abs() < 1e-12);
     }
+
+    /// Cuts add their points, each with the bounds of its place (the no-dip bound of its
+    /// interval in the band, the floor outside it), and leave every other point as it was.
+    #[test]
+    fn cuts_add_points_and_change_nothing_else() {
+        let w = [0.1, 1.0, 10.0];
+        let lower = [4.0, 1.0, 0.25];
+        let a1 = |x: f64| 100.0 + x;
+        let spec = |cuts: &'static [f64]| GridSpec {
+            w: &w,
+            lower: &lower,
+            a1: Some(&a1),
+            a1_data: None,
+            floor: 1e-6,
+            per_decade: 50,
+            extend_decades: 2.0,
+            no_dip: true,
+            a1_dips: &[],
+            cuts,
+        };
+        let base = build_grid(&spec(&[]));
+        let cut = build_grid(&spec(&[0.3333, 500.0]));
+        assert_eq!(cut.len(), base.len() + 2);
+        let key = |p: &GridPoint| (p.w, p.lower, p.upper, p.a1, p.kind);
+        for p in &base {
+            assert!(cut.iter().any(|q| key(q) == key(p)), "{p:?} lost");
+        }
+        let at = |x: f64| cut.iter().find(|p| p.w == x).expect("cut point");
+        assert_eq!(at(0.3333).lower, 1.0);
+        assert_eq!(at(0.3333).kind, PointKind::Band);
+        assert!((at(0.3333).a1.unwrap() - 100.3333).abs() < 1e-12);
+        assert_eq!(at(500.0).lower, 1e-6);
+        assert_eq!(at(500.0).kind, PointKind::Outside);
+    }
 }

@@ -246,3 +246,33 @@ pub(crate) fn search_again(
         other => other,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cluster: the cut, `2·CLUSTER` points within one grid step, closer and closer
+    /// (the innermost `6e-6` relative), and the dips within one step only.
+    #[test]
+    fn cluster_spans_one_grid_step_down_to_6e_6() {
+        let h = 10f64.powf(1.0 / 50.0) - 1.0;
+        let v = cluster(2.0, 50, &[2.05, 3.0]);
+        assert_eq!(v.len(), 2 * CLUSTER as usize + 2);
+        assert!(v.contains(&2.05) && !v.contains(&3.0));
+        let rel: Vec<f64> = v[1..v.len() - 1]
+            .iter()
+            .map(|w| (w / 2.0).ln().abs())
+            .collect();
+        let max = rel.iter().copied().fold(0.0, f64::max);
+        let min = rel.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!((max - (1.0 + h).ln()).abs() < 1e-12, "{max}");
+        assert!(min > 5e-6 && min < 7e-6, "{min}");
+    }
+
+    /// New cuts are sorted, once each, and never one already added.
+    #[test]
+    fn fresh_drops_repeats_and_known_cuts() {
+        let v = fresh(vec![3.0, 1.0, 1.0 + 1e-12, 2.0], &[2.0 * (1.0 + 1e-12)]);
+        assert_eq!(v, vec![1.0, 3.0]);
+    }
+}
