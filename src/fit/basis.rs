@@ -140,6 +140,10 @@ pub struct GridSpec<'a> {
     /// Scaled frequencies where A1 may notch between grid points (the lightly damped zeros
     /// of `M̃`, [`crate::model::Factorization::a1_dips`]); empty: the grid alone.
     pub a1_dips: &'a [f64],
+    /// Scaled frequencies added as constraint points by the cutting-plane round
+    /// ([`super::cutting_plane`]): where a candidate broke a bound between grid points.
+    /// Empty: the grid of the first round.
+    pub cuts: &'a [f64],
 }
 
 /// A dip gets its own constraint point when A1 there is below this share of A1 at the dense
@@ -212,6 +216,20 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
         ws.sort_by(f64::total_cmp);
         ws.dedup();
     }
+    // The cuts of the cutting-plane round, anywhere on the axis (inside the band they get
+    // the no-dip bound of their interval, outside it the floor, as grid points do there).
+    let mut cuts: Vec<f64> = spec
+        .cuts
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .collect();
+    if !cuts.is_empty() {
+        cuts.sort_by(f64::total_cmp);
+        ws.extend(&cuts);
+        ws.sort_by(f64::total_cmp);
+        ws.dedup();
+    }
     let mut j = 0; // index of the datum at or below w
     for w in ws {
         let (lower, upper, kind) = if w < w_lo {
@@ -235,9 +253,10 @@ pub fn build_grid(spec: &GridSpec) -> Vec<GridPoint> {
         };
         // A notch below the bound no r may dip under between these data: no r meets both,
         // at any level. Left to the certificate, which names it, rather than to a search
-        // of every level up to its cap.
+        // of every level up to its cap (a cut there likewise).
         let a1 = a1_at(w);
-        if dips.binary_search_by(|d| d.total_cmp(&w)).is_ok() && a1.is_some_and(|v| v <= lower) {
+        let added = |v: &[f64]| v.binary_search_by(|d| d.total_cmp(&w)).is_ok();
+        if (added(&dips) || added(&cuts)) && a1.is_some_and(|v| v <= lower) {
             continue;
         }
         pts.push(GridPoint {
@@ -322,6 +341,7 @@ mod tests {
             extend_decades: 2.0,
             no_dip: true,
             a1_dips: &[],
+            cuts: &[],
         });
         assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
         assert!(g.iter().any(|p| p.kind == PointKind::Infinity));
@@ -333,5 +353,39 @@ mod tests {
             .fold(f64::INFINITY, f64::min);
         assert!(g.iter().any(|p| p.w == 0.0));
         assert!((lo - 1e-3).abs() < 1e-12);
+    }
+
+    /// Cuts add their points, each with the bounds of its place (the no-dip bound of its
+    /// interval in the band, the floor outside it), and leave every other point as it was.
+    #[test]
+    fn cuts_add_points_and_change_nothing_else() {
+        let w = [0.1, 1.0, 10.0];
+        let lower = [4.0, 1.0, 0.25];
+        let a1 = |x: f64| 100.0 + x;
+        let spec = |cuts: &'static [f64]| GridSpec {
+            w: &w,
+            lower: &lower,
+            a1: Some(&a1),
+            a1_data: None,
+            floor: 1e-6,
+            per_decade: 50,
+            extend_decades: 2.0,
+            no_dip: true,
+            a1_dips: &[],
+            cuts,
+        };
+        let base = build_grid(&spec(&[]));
+        let cut = build_grid(&spec(&[0.3333, 500.0]));
+        assert_eq!(cut.len(), base.len() + 2);
+        let key = |p: &GridPoint| (p.w, p.lower, p.upper, p.a1, p.kind);
+        for p in &base {
+            assert!(cut.iter().any(|q| key(q) == key(p)), "{p:?} lost");
+        }
+        let at = |x: f64| cut.iter().find(|p| p.w == x).expect("cut point");
+        assert_eq!(at(0.3333).lower, 1.0);
+        assert_eq!(at(0.3333).kind, PointKind::Band);
+        assert!((at(0.3333).a1.unwrap() - 100.3333).abs() < 1e-12);
+        assert_eq!(at(500.0).lower, 1e-6);
+        assert_eq!(at(500.0).kind, PointKind::Outside);
     }
 }

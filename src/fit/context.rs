@@ -3,7 +3,7 @@
 //! ([`super::basis`]); [`Context::certify_ranked`] runs the exact certificate
 //! ([`super::certificate`]) on the ranked candidates.
 
-use super::basis::{build_grid, GridSpec, Scaling};
+use super::basis::{build_grid, GridPoint, GridSpec, Scaling};
 use super::engine::{admits, max_tolerance, Prepared, Scored};
 use super::provenance::Origin;
 use super::{certificate, A1Fn, FitError, FitResult, FitSettings, Objective, SolverEvent};
@@ -16,6 +16,8 @@ pub(crate) struct Context<'a> {
     pub a1: Option<A1Fn<'a>>,
     pub scaling: Scaling,
     pub floor: f64,
+    /// Scaled lower bounds `((1 + margin)·r_min/ρ)²` per datum (with a `1e-7` safety).
+    pub lower: Vec<f64>,
     pub prep: Prepared,
 }
 
@@ -120,41 +122,55 @@ pub(crate) fn prepare<'a>(
             0.0
         };
     }
-    let (o0, rho, back) = (scaling.omega0, scaling.rho, 1.0 - set.a1_backoff);
-    let a1_scaled = a1.map(|f| move |wh: f64| (f(wh * o0) * back / rho).powi(2));
-    let a1_data: Option<Vec<f64>> = env
-        .a1_limit
-        .as_ref()
-        .map(|a| a.iter().map(|v| (v * back / rho).powi(2)).collect());
-    let dips: Vec<f64> = set.a1_dips.iter().map(|d| d / o0).collect();
-    let grid = build_grid(&GridSpec {
-        w: &w,
-        lower: &lower,
-        a1: a1_scaled.as_ref().map(|f| f as &dyn Fn(f64) -> f64),
-        a1_data: a1_data.as_deref(),
-        floor: (floor / rho).powi(2),
-        per_decade: set.grid_per_decade,
-        extend_decades: set.extend_decades,
-        no_dip: set.no_dip,
-        a1_dips: &dips,
-    });
     let band = (w[0], w[n - 1]);
-    Ok(Context {
+    let mut ctx = Context {
         env,
         a1,
         scaling,
         floor,
+        lower,
         prep: Prepared {
             w,
             rmin,
             weights,
-            grid,
+            grid: Vec::new(),
             band,
         },
-    })
+    };
+    ctx.prep.grid = ctx.grid_with_cuts(set, &[]);
+    Ok(ctx)
 }
 
 impl Context<'_> {
+    /// The constraint grid of the fit ([`build_grid`]) with the frequencies `cuts` (rad/s)
+    /// added as constraint points (the cutting-plane round, [`super::cutting_plane`]);
+    /// `cuts` empty gives the grid of [`prepare`].
+    pub(crate) fn grid_with_cuts(&self, set: &FitSettings, cuts: &[f64]) -> Vec<GridPoint> {
+        let (o0, rho, back) = (self.scaling.omega0, self.scaling.rho, 1.0 - set.a1_backoff);
+        let a1_scaled = self
+            .a1
+            .map(|f| move |wh: f64| (f(wh * o0) * back / rho).powi(2));
+        let a1_data: Option<Vec<f64>> = self
+            .env
+            .a1_limit
+            .as_ref()
+            .map(|a| a.iter().map(|v| (v * back / rho).powi(2)).collect());
+        let dips: Vec<f64> = set.a1_dips.iter().map(|d| d / o0).collect();
+        let cuts: Vec<f64> = cuts.iter().map(|c| c / o0).collect();
+        build_grid(&GridSpec {
+            w: &self.prep.w,
+            lower: &self.lower,
+            a1: a1_scaled.as_ref().map(|f| f as &dyn Fn(f64) -> f64),
+            a1_data: a1_data.as_deref(),
+            floor: (self.floor / rho).powi(2),
+            per_decade: set.grid_per_decade,
+            extend_decades: set.extend_decades,
+            no_dip: set.no_dip,
+            a1_dips: &dips,
+            cuts: &cuts,
+        })
+    }
+
     pub(crate) fn cert_input<'s>(&'s self, set: &'s FitSettings) -> certificate::CertInput<'s> {
         certificate::CertInput {
             omega: &self.env.omega,
@@ -187,6 +203,43 @@ impl Context<'_> {
         events: Vec<SolverEvent>,
         lp_solves: usize,
         set: &FitSettings,
+    ) -> Result<(FitResult, Scored), FitError> {
+        self.certify_ranked_cuts(order, ranked, prev, guard, events, lp_solves, set)
+            .0
+    }
+
+    /// [`Self::certify_ranked`], and where the candidates that met every bound on the grid
+    /// broke one between its points (rad/s, [`super::cutting_plane::cut_frequencies`]): the
+    /// cuts of a cutting-plane round.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn certify_ranked_cuts(
+        &self,
+        order: usize,
+        ranked: &[Scored],
+        prev: Option<&Scored>,
+        guard: Objective,
+        events: Vec<SolverEvent>,
+        lp_solves: usize,
+        set: &FitSettings,
+    ) -> (Result<(FitResult, Scored), FitError>, Vec<f64>) {
+        let mut cuts = Vec::new();
+        let result = self.certify_ranked_into(
+            order, ranked, prev, guard, events, lp_solves, set, &mut cuts,
+        );
+        (result, cuts)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn certify_ranked_into(
+        &self,
+        order: usize,
+        ranked: &[Scored],
+        prev: Option<&Scored>,
+        guard: Objective,
+        events: Vec<SolverEvent>,
+        lp_solves: usize,
+        set: &FitSettings,
+        cuts: &mut Vec<f64>,
     ) -> Result<(FitResult, Scored), FitError> {
         let inp = self.cert_input(set);
         let mut reasons = Vec::new();
@@ -250,6 +303,11 @@ impl Context<'_> {
             let (res, sc) = one(cand);
             let cert = res.certificate.clone();
             if !cert.passed {
+                // Only a candidate that met every bound on the grid failed between its
+                // points; any other failed where the grid already holds the bound.
+                if super::cutting_plane::met_grid(cand) {
+                    cuts.extend(super::cutting_plane::cut_frequencies(&cert));
+                }
                 reasons.push(format!("{}: {}", cand.origin, cert.failures.join(", ")));
                 if first_failed.is_none() {
                     first_failed = Some(res);

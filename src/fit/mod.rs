@@ -13,6 +13,8 @@
 //! * `context`: input checks, prescaling, and the choice among certified candidates;
 //! * `a1_proof`: assumption A1 proved on the certificate's band (an `L∞` norm of `M̃⁻¹·r`);
 //! * `certificate`: dense re-evaluation of the final `r`, refinement, `ucover`-style repair;
+//! * `cutting_plane`: where no candidate of an order certifies because a bound fails
+//!   between grid points, those frequencies join the order's grid and it is searched again;
 //! * `realization`: a balanced cascade state-space realization of `r` for the exports;
 //! * `order`: the order sweep and the automatic order choice;
 //! * `run`: fit + certificate + exports, for the CLI;
@@ -30,6 +32,7 @@ pub(crate) mod between;
 pub(crate) mod certificate;
 pub(crate) mod chebseries;
 mod context;
+mod cutting_plane;
 pub(crate) mod engine;
 mod levelsearch;
 pub(crate) mod lower_bound;
@@ -133,6 +136,12 @@ pub struct FitSettings {
     /// from the best level known). On the shipped examples 0.7–1.6× the LPs, each dearer.
     /// Default false.
     pub thorough: bool,
+    /// Cutting-plane rounds per order (`fit::cutting_plane`): when no candidate of an order
+    /// certifies and the certificate names frequencies where a bound (A1, or `|r|` above the
+    /// envelope between data) fails between the fit's constraint points, those frequencies
+    /// become constraint points of that order and the order is searched again, at most this
+    /// many times. 0: off. Default 3.
+    pub cut_rounds: usize,
     /// Frequencies (rad/s) where `σ_min(M̃(jω))` may dip sharply: the lightly damped zeros
     /// of `M̃` ([`crate::model::Factorization::a1_dips`]). The certificate evaluates A1
     /// there and refines around each, so that a notch narrower than its grid (a mode with
@@ -166,6 +175,7 @@ impl Default for FitSettings {
             chain: false,
             auto_tolerance: 0.01,
             thorough: false,
+            cut_rounds: 3,
             a1_dips: Vec::new(),
             a1_proof: A1Proof::Sampled,
         }
@@ -390,7 +400,7 @@ fn fit_with(
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         all_events.extend(of.events);
         solves += of.lp_solves;
-        match ctx.certify_ranked(
+        let (first, cuts) = ctx.certify_ranked_cuts(
             n,
             &of.ranked,
             prev.as_ref(),
@@ -398,7 +408,21 @@ fn fit_with(
             all_events.clone(),
             solves,
             settings,
-        ) {
+        );
+        let outcome = match first {
+            Err(e) if settings.cut_rounds > 0 && !cuts.is_empty() => cutting_plane::search_again(
+                ctx,
+                n,
+                prev.as_ref(),
+                settings,
+                cuts,
+                e,
+                &mut all_events,
+                &mut solves,
+            ),
+            other => other,
+        };
+        match outcome {
             Ok((res, sc)) => {
                 prev = Some(sc);
                 last = Some(Ok(res));

@@ -163,10 +163,10 @@ pub fn fit_auto(
             of.ranked = rank(all, prev.as_ref(), settings, n, settings.objective);
             rank(o.ranked, Some(&c.prev), settings, n, Objective::Area)
         });
-        let (ne, nl) = (of.events.len(), of.lp_solves);
+        let (events_before, solves_before) = (events.len(), solves);
         events.extend(of.events);
         solves += of.lp_solves;
-        match ctx.certify_ranked(
+        let (first, cuts) = ctx.certify_ranked_cuts(
             n,
             &of.ranked,
             prev.as_ref(),
@@ -174,7 +174,26 @@ pub fn fit_auto(
             events.clone(),
             solves,
             settings,
-        ) {
+        );
+        let outcome = match first {
+            // No candidate certified, a bound broken between grid points: the order's
+            // cutting-plane rounds (its row counts their LPs and events).
+            Err(e) if settings.cut_rounds > 0 && !cuts.is_empty() => {
+                super::cutting_plane::search_again(
+                    &ctx,
+                    n,
+                    prev.as_ref(),
+                    settings,
+                    cuts,
+                    e,
+                    &mut events,
+                    &mut solves,
+                )
+            }
+            other => other,
+        };
+        let (ne, nl) = (events.len() - events_before, solves - solves_before);
+        match outcome {
             Ok((res, sc)) => {
                 rows.push(OrderRow {
                     order: n,

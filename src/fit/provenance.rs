@@ -83,6 +83,10 @@ pub enum EventKind {
     DoubtBudgetSpent,
     /// The order alone was refitted with the lower orders carried forward.
     RefittedChained,
+    /// No candidate of the order certified, the certificate named frequencies where a bound
+    /// fails between the fit's constraint points; they were added and the order searched
+    /// again (the cutting-plane round, `fit::cutting_plane`).
+    CutsAdded,
 }
 
 #[cfg(test)]

@@ -54,6 +54,12 @@ impl FitSettings {
                 "must be at least 50 points per decade",
             )
             .non_negative("auto_tolerance", self.auto_tolerance)
+            .require(
+                "cut_rounds",
+                self.cut_rounds,
+                self.cut_rounds <= 10,
+                "must be at most 10",
+            )
             .finish()
     }
 }

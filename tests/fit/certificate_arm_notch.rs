@@ -16,7 +16,7 @@ use std::path::Path;
 const ARM_Z001: &str = "data = \"configs/data/daisy_robot_arm/frf_etfe_normfreq.csv\"\nsample_time = 1.0\n[plant]\ntf = [[{ num = [-1.93391, -0.103041, -2.55255, -0.0234311, -0.1], den = [12.032, 0.3659, 9.2346, 0.13578, 1.0] }]]\n";
 
 /// The config and its Theorem 2 envelope.
-fn arm_z001() -> (Config, rshape::Envelope) {
+pub(crate) fn arm_z001() -> (Config, rshape::Envelope) {
     let cfg = Config::parse(ARM_Z001, Path::new("arm_z001.toml")).unwrap();
     let data = load_data(&cfg, cfg.data.as_ref().unwrap()).unwrap();
     let env = rshape::envelope(&cfg, &data, &RunOptions::default())
@@ -127,7 +127,7 @@ const NUM: [f64; 5] = [-1.93391, -0.103041, -2.55255, -0.0234311, -0.1];
 const DEN: [f64; 5] = [12.032, 0.3659, 9.2346, 0.13578, 1.0];
 
 /// `|G(jω)|` from the transfer function's coefficients (highest power first), by Horner.
-fn plant_mag(w: f64) -> f64 {
+pub(crate) fn plant_mag(w: f64) -> f64 {
     let s = num_complex::Complex64::new(0.0, w);
     let horner = |c: &[f64]| {
         c.iter()
