@@ -31,6 +31,8 @@ pub(crate) mod certificate;
 pub(crate) mod chebseries;
 mod context;
 pub(crate) mod engine;
+#[doc(hidden)]
+pub mod experiment;
 mod levelsearch;
 pub(crate) mod lower_bound;
 mod memo;
