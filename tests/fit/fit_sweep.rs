@@ -30,7 +30,7 @@ const MAX_ORDER: usize = 8;
 const RISE: f64 = 0.002;
 
 /// The measurement switches from the environment (see the module doc); prints them.
-fn apply_switches() {
+pub(crate) fn apply_switches() {
     use rshape::fit::experiment::{set_switches, switches, RowOrder, Switches};
     let mut sw = switches();
     if let Ok(fast) = std::env::var("RSHAPE_SWEEP_FAST") {
