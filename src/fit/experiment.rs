@@ -66,11 +66,7 @@ static SWITCHES: RwLock<Option<Switches>> = RwLock::new(None);
 
 /// The switches in force.
 pub fn switches() -> Switches {
-    SWITCHES
-        .read()
-        .ok()
-        .and_then(|s| *s)
-        .unwrap_or_default()
+    SWITCHES.read().ok().and_then(|s| *s).unwrap_or_default()
 }
 
 /// Sets the switches for the whole process (measurements only).
@@ -92,7 +88,12 @@ fn permutation(order: RowOrder, m: usize) -> Option<Vec<usize>> {
         RowOrder::Reversed => Some((0..m).rev().collect()),
         RowOrder::Seeded(seed) => {
             let mut idx: Vec<(u64, usize)> = (0..m)
-                .map(|i| (splitmix(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)), i))
+                .map(|i| {
+                    (
+                        splitmix(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+                        i,
+                    )
+                })
                 .collect();
             idx.sort_unstable();
             Some(idx.into_iter().map(|(_, i)| i).collect())

@@ -231,7 +231,12 @@ impl<'a> LevelLp<'a> {
             );
             self.lp_solves += rounds;
             if sw.keep_working_set {
-                self.mask_keys = r.group.iter().copied().zip(r.point.iter().copied()).collect();
+                self.mask_keys = r
+                    .group
+                    .iter()
+                    .copied()
+                    .zip(r.point.iter().copied())
+                    .collect();
             }
             if esc.spent {
                 self.doubt(

@@ -414,7 +414,10 @@ mod tests {
         for order in [None, Some(vec![2, 1, 0]), Some(vec![1, 2, 0])] {
             let (st, x, _) = lp.solve_in_order(100, false, order.as_deref());
             assert_eq!(st, SolverStatus::Solved, "{order:?}");
-            assert!((x[0] - 1.0).abs() < 1e-6 && (x[1] - 3.0).abs() < 1e-6, "{x:?}");
+            assert!(
+                (x[0] - 1.0).abs() < 1e-6 && (x[1] - 3.0).abs() < 1e-6,
+                "{x:?}"
+            );
             let (st, _, z) = bad.solve_in_order(100, false, order.as_deref());
             assert_eq!(st, SolverStatus::PrimalInfeasible, "{order:?}");
             assert!(z.iter().all(|v| *v >= -1e-9), "{z:?}");
