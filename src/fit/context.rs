@@ -268,7 +268,10 @@ impl Context<'_> {
             };
             let mut sc = cand.clone();
             sc.zpk.gain *= res.certificate.repair_factor;
-            let sc = self.prep.score(sc.zpk, sc.origin);
+            let sc = Scored {
+                attempt: cand.attempt,
+                ..self.prep.score(sc.zpk, sc.origin)
+            };
             (res, sc)
         };
         // The best ranked candidate, unless its certificate had to repair it (a dip between

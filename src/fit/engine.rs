@@ -54,6 +54,8 @@ pub(crate) struct Scored {
     pub coverage: f64,
     /// Smallest `α/|r|²` over the grid (≥ 1 when A1 holds).
     pub a1_ratio: f64,
+    /// The polynomial candidate's attempt (disk-map centre, cut floor) that found it.
+    pub attempt: Option<(f64, f64)>,
 }
 
 impl Prepared {
@@ -91,6 +93,7 @@ impl Prepared {
             origin,
             coverage,
             a1_ratio,
+            attempt: None,
         }
     }
 }
@@ -407,9 +410,13 @@ impl<'a> OrderSearch<'a> {
             .map(|c| c.t)
             .fold(f64::INFINITY, f64::min);
         let (prep, n, set) = (self.prep, self.n, self.set);
-        if let Some(c) =
-            polyfit::minimax(prep, n, t_known, set, &mut self.events, &mut self.lp_solves)
-        {
+        // The attempt that found the previous order's `r` first (a measurement switch).
+        let hint = self
+            .prev
+            .and_then(|p| p.attempt)
+            .filter(|_| super::experiment::switches().previous_centre_first);
+        let (events, lps) = (&mut self.events, &mut self.lp_solves);
+        if let Some(c) = polyfit::minimax(prep, n, t_known, hint, set, events, lps) {
             self.cands.push(c);
         }
     }

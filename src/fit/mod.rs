@@ -34,6 +34,8 @@ pub(crate) mod chebseries;
 mod context;
 mod cutting_plane;
 pub(crate) mod engine;
+#[doc(hidden)]
+pub mod experiment;
 mod levelsearch;
 pub(crate) mod lower_bound;
 mod memo;

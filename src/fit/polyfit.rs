@@ -54,10 +54,12 @@ fn centres(prep: &Prepared) -> Vec<f64> {
 
 /// The global minimax candidate of order `n` on the grid, or `None` when it cannot improve
 /// on `t_known` (the best level already reached) by more than the bisection tolerance.
+/// `hint`: an attempt (disk-map centre, cut floor) to try first.
 pub(crate) fn minimax(
     prep: &Prepared,
     n: usize,
     t_known: f64,
+    hint: Option<(f64, f64)>,
     set: &FitSettings,
     events: &mut Vec<SolverEvent>,
     lp_solves: &mut usize,
@@ -84,6 +86,10 @@ pub(crate) fn minimax(
     // only when the first attempt cut on `B` (order 10 on 1000 data: 2.6 → 2.0 s, the
     // reference sweep unchanged), the other centres.
     let mut pending: std::collections::VecDeque<(f64, f64)> = attempts.iter().copied().collect();
+    if let Some(pos) = hint.and_then(|h| pending.iter().position(|p| *p == h)) {
+        let h = pending.remove(pos).expect("a pending attempt");
+        pending.push_front(h);
+    }
     let mut b_cut_used = None;
     // The band centre runs alone (most orders end there without a doubt); after a doubt the
     // next two attempts run at once on two cores (`rayon`; one after the other on a
@@ -132,7 +138,9 @@ pub(crate) fn minimax(
                 }
             }
         };
-        if b_cut_used.is_none() {
+        // The second cut floor follows from the band centre's first attempt (a hinted
+        // attempt may run before it).
+        if b_cut_used.is_none() && a.attempt == attempts[0] {
             b_cut_used = Some(a.b_cut_used);
             if !a.b_cut_used {
                 pending.retain(|p| *p != attempts[1]);
@@ -218,7 +226,10 @@ fn minimax_at(
         .map(|(lo, hi, feasible)| lp.bisect(lo, hi, tol, feasible, events));
     *lp_solves += lp.lp_solves;
     *b_cut_used |= lp.b_cut_used;
-    factor_lowest(prep, n, x0, found?, set, events)
+    factor_lowest(prep, n, x0, found?, set, events).map(|mut c| {
+        c.attempt = Some((x0, b_cut));
+        c
+    })
 }
 
 /// The candidate of the lowest feasible level whose spectral factors exist and meet the

@@ -6,13 +6,14 @@
 use super::basis::PointKind;
 use super::chebseries::cheb;
 use super::engine::Prepared;
+use super::experiment;
 use super::polyrows::{
     cut_rows, disk, fixed_rows, level_rows, max_violation, reached_level, relative_cuts,
     relative_level_rows, Rows, B_CUT_GROUP,
 };
 use super::problem::{SolverEvent, SolverStatus};
 use super::provenance::EventKind;
-use super::working_set::{active_set_solve, initial_points, Retry};
+use super::working_set::{active_set_solve, initial_points, Escalate, Retry};
 use super::FitSettings;
 
 /// Interior-point iterations of the retry with every row after a working-set solve short
@@ -58,6 +59,9 @@ pub(super) struct LevelLp<'a> {
     data: Vec<(f64, f64)>,
     init: Vec<bool>,
     mask: Vec<bool>,
+    /// `(group, point)` of the rows `mask` belongs to (kept only with
+    /// `Switches::keep_working_set`, to carry the working set across a change of rows).
+    mask_keys: Vec<(u32, usize)>,
     cuts: Rows,
     /// LPs solved so far.
     pub(super) lp_solves: usize,
@@ -99,6 +103,7 @@ impl<'a> LevelLp<'a> {
             data,
             init: initial_points(&prep.grid, 40),
             mask: Vec::new(),
+            mask_keys: Vec::new(),
             cuts: Rows::default(),
             lp_solves: 0,
             b_cut_used: false,
@@ -134,22 +139,51 @@ impl<'a> LevelLp<'a> {
     /// always on, 1.3 s on a doubt only).  A level infeasible only with the cuts on `B`
     /// ([`Level::CutBound`]) is not solved again: refinement does not remove a cut.
     fn level(&mut self, t: f64, events: &mut Vec<SolverEvent>) -> Level {
+        let start = self.lp_solves;
         if self.set.thorough {
-            return self.level_with(t, events, true);
+            return self.level_with(t, events, true, start);
         }
         let before = events.len();
-        match self.level_with(t, events, false) {
-            Level::Doubt => {
+        match self.level_with(t, events, false, start) {
+            // A level whose budget is spent is not solved again.
+            Level::Doubt if !self.budget_spent(start) => {
                 events.truncate(before);
-                self.level_with(t, events, true)
+                self.level_with(t, events, true, start)
             }
             decided => decided,
         }
     }
 
+    /// The LPs this level may still cost ([`Switches::level_budget`], counted from `start`).
+    fn budget_left(&self, start: usize) -> usize {
+        match experiment::switches().level_budget {
+            0 => usize::MAX,
+            k => k.saturating_sub(self.lp_solves - start),
+        }
+    }
+
+    fn budget_spent(&self, start: usize) -> bool {
+        self.budget_left(start) == 0
+    }
+
+    fn carry_mask(&mut self, r: &Rows) {
+        self.mask = carry_mask(&self.mask_keys, &self.mask, &r.group, &r.point);
+    }
+
     /// [`Self::level`] with iterative refinement on or off.
-    fn level_with(&mut self, t: f64, events: &mut Vec<SolverEvent>, refine: bool) -> Level {
+    fn level_with(
+        &mut self,
+        t: f64,
+        events: &mut Vec<SolverEvent>,
+        refine: bool,
+        start: usize,
+    ) -> Level {
         let (n, set) = (self.n, self.set);
+        let sw = experiment::switches();
+        let mut esc = Escalate {
+            sticky: sw.refine_rest_of_level,
+            ..Escalate::off()
+        };
         let nv = 2 * (n + 1);
         let mut eq = vec![0.0; nv];
         eq[n + 1..].copy_from_slice(&cheb(n, 0.0));
@@ -170,8 +204,16 @@ impl<'a> LevelLp<'a> {
                 &level_cuts,
             );
             if self.mask.len() != r.rows.len() {
-                self.mask.clear();
+                if sw.keep_working_set
+                    && !self.mask.is_empty()
+                    && self.mask.len() == self.mask_keys.len()
+                {
+                    self.carry_mask(&r);
+                } else {
+                    self.mask.clear();
+                }
             }
+            esc.budget = self.budget_left(start);
             let (out, rounds) = active_set_solve(
                 nv,
                 &cost,
@@ -185,8 +227,29 @@ impl<'a> LevelLp<'a> {
                 set.max_solver_iter.min(RETRY_ITER),
                 refine,
                 Retry::Decides,
+                &mut esc,
             );
             self.lp_solves += rounds;
+            if sw.keep_working_set {
+                self.mask_keys = r
+                    .group
+                    .iter()
+                    .copied()
+                    .zip(r.point.iter().copied())
+                    .collect();
+            }
+            if esc.spent {
+                self.doubt(
+                    events,
+                    t,
+                    out.status,
+                    format!(
+                        "level budget of {} LPs spent; level treated as not feasible (the other candidates stand)",
+                        sw.level_budget
+                    ),
+                );
+                return Level::Doubt;
+            }
             // Only a full-accuracy certificate of infeasibility decides the level; a
             // reduced-accuracy one is a doubt like any other status below.
             if out.status == SolverStatus::PrimalInfeasible {
@@ -347,5 +410,53 @@ impl<'a> LevelLp<'a> {
             }
         }
         feasible
+    }
+}
+
+/// The working set `mask` of the rows keyed `keys` (group, grid point) carried onto rows
+/// keyed by `group`, `point`: a row keeps its state when the old rows had one of the same
+/// key (the `k`-th of a key to the `k`-th: both are sorted by key, stably, and cuts are
+/// only appended); a row without a counterpart (a new cut) is in.
+fn carry_mask(keys: &[(u32, usize)], mask: &[bool], group: &[u32], point: &[usize]) -> Vec<bool> {
+    use std::collections::HashMap;
+    let mut old: HashMap<(u32, usize), Vec<bool>> = HashMap::new();
+    for (key, on) in keys.iter().zip(mask) {
+        old.entry(*key).or_default().push(*on);
+    }
+    let mut seen: HashMap<(u32, usize), usize> = HashMap::new();
+    group
+        .iter()
+        .zip(point)
+        .map(|(g, p)| {
+            let k = seen.entry((*g, *p)).or_default();
+            let on = old.get(&(*g, *p)).and_then(|v| v.get(*k)).copied();
+            *k += 1;
+            on.unwrap_or(true)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::carry_mask;
+
+    /// Rows keep their state by key and occurrence; new cut rows are in; rows that vanished
+    /// (a level's relative rows) leave nothing behind.
+    #[test]
+    fn working_set_is_carried_by_key() {
+        let m = usize::MAX;
+        // Old rows: lower at points 0, 1; level at 0, 1; two B cuts; one relative level row.
+        let keys = [(0, 0), (0, 1), (1, 0), (1, 1), (4, m), (4, m), (9, 1)];
+        let mask = [true, false, false, true, false, true, true];
+        // New rows: the same fixed rows, a third B cut appended, a new A-floor cut, no
+        // relative row.
+        let group = [0, 0, 1, 1, 4, 4, 4, 5];
+        let point = [0, 1, 0, 1, m, m, m, m];
+        let got = carry_mask(&keys, &mask, &group, &point);
+        assert_eq!(
+            got,
+            vec![true, false, false, true, false, true, true, true],
+            "{got:?}"
+        );
     }
 }

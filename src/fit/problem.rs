@@ -13,7 +13,7 @@
 //!   log-frequency-weighted `Σ w_i |r(jω_i)|²/r_min,i²` over `A` subject to the same bounds.
 
 use super::basis::{basis_row, GridPoint, PointKind};
-use super::working_set::{active_set_solve, Retry};
+use super::working_set::{active_set_solve, Escalate, Retry};
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{
     DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus as ClStatus, SupportedConeT,
@@ -128,7 +128,23 @@ impl Lp {
         max_iter: u32,
         refine: bool,
     ) -> (SolverStatus, Vec<f64>, Vec<f64>) {
+        // The inequality rows in the order of the measurement switch (issue 38, eleventh
+        // step: the noise floor).
+        let order = super::experiment::row_permutation(self.ge.len());
+        self.solve_in_order(max_iter, refine, order.as_deref())
+    }
+
+    /// [`Self::solve_with_dual`] with the inequality rows handed to Clarabel in `order`
+    /// (`order[p]` is the row at position `p`; `None`: as built).  The dual vector is
+    /// returned in the order of the rows as built.
+    pub(crate) fn solve_in_order(
+        &self,
+        max_iter: u32,
+        refine: bool,
+        order: Option<&[usize]>,
+    ) -> (SolverStatus, Vec<f64>, Vec<f64>) {
         let m = self.eq.len() + self.ge.len();
+        let ge_at = |p: usize| order.as_ref().map_or(p, |o| o[p]);
         // Clarabel form: A v + s = b, s ∈ K.  Equalities: E v + s = e, s ∈ {0};
         // inequalities G v ≥ h  ⇔  −G v + s = −h, s ≥ 0.
         let mut colptr = Vec::with_capacity(self.n + 1);
@@ -142,9 +158,10 @@ impl Lp {
                     nzval.push(row[j]);
                 }
             }
-            for (i, (row, _)) in self.ge.iter().enumerate() {
+            for p in 0..self.ge.len() {
+                let row = &self.ge[ge_at(p)].0;
                 if row[j] != 0.0 {
-                    rowval.push(self.eq.len() + i);
+                    rowval.push(self.eq.len() + p);
                     nzval.push(-row[j]);
                 }
             }
@@ -155,7 +172,7 @@ impl Lp {
             .eq
             .iter()
             .map(|(_, e)| *e)
-            .chain(self.ge.iter().map(|(_, h)| -h))
+            .chain((0..self.ge.len()).map(|p| -self.ge[ge_at(p)].1))
             .collect();
         let mut cones = Vec::new();
         if !self.eq.is_empty() {
@@ -188,11 +205,14 @@ impl Lp {
         };
         solver.solve();
         let sol = &solver.solution;
-        (
-            SolverStatus::from_clarabel(sol.status),
-            sol.x.clone(),
-            sol.z.clone(),
-        )
+        let mut z = sol.z.clone();
+        if let (Some(o), true) = (order, z.len() == m) {
+            // Back to the rows as built.
+            for (p, &i) in o.iter().enumerate() {
+                z[self.eq.len() + i] = sol.z[self.eq.len() + p];
+            }
+        }
+        (SolverStatus::from_clarabel(sol.status), sol.x.clone(), z)
     }
 }
 
@@ -283,6 +303,7 @@ pub(crate) fn max_slack(
         max_iter,
         refine,
         Retry::Decides,
+        &mut Escalate::off(),
     );
     if !out.status.has_solution() {
         return (out.status, f64::NEG_INFINITY, vec![], vec![], rounds);
@@ -349,10 +370,63 @@ pub(crate) fn area_fixed_poles(
         max_iter,
         refine,
         Retry::Fails,
+        &mut Escalate::off(),
     );
     if !out.status.has_solution() {
         return (out.status, vec![], f64::INFINITY, rounds);
     }
     let obj: f64 = c.iter().zip(&out.x).map(|(a, b)| a * b).sum();
     (out.status, out.x, obj, rounds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rows' order changes the iterates, not the LP: the same optimum in every order,
+    /// and an infeasible LP's Farkas certificate comes back in the order of the rows as
+    /// built (checked here by hand: `y ≥ 0`, `Gᵀy = 0`, `hᵀy > 0`).
+    #[test]
+    fn row_order_keeps_the_optimum_and_the_certificate() {
+        // min 2x + y  s.t.  x ≥ 1, y ≥ 2, x + y ≥ 4: the unique optimum (1, 3).
+        let lp = Lp {
+            n: 2,
+            c: vec![2.0, 1.0],
+            ge: vec![
+                (vec![1.0, 0.0], 1.0),
+                (vec![0.0, 1.0], 2.0),
+                (vec![1.0, 1.0], 4.0),
+            ],
+            eq: vec![],
+        };
+        // x ≥ 1, y ≥ 1, 2x + y ≤ 2: infeasible; every certificate is a multiple of
+        // y = (2, 1, 1), so a multiplier returned at the wrong row fails `Gᵀy = 0`.
+        let bad = Lp {
+            n: 2,
+            c: vec![0.0, 0.0],
+            ge: vec![
+                (vec![1.0, 0.0], 1.0),
+                (vec![0.0, 1.0], 1.0),
+                (vec![-2.0, -1.0], -2.0),
+            ],
+            eq: vec![],
+        };
+        for order in [None, Some(vec![2, 1, 0]), Some(vec![1, 2, 0])] {
+            let (st, x, _) = lp.solve_in_order(100, false, order.as_deref());
+            assert_eq!(st, SolverStatus::Solved, "{order:?}");
+            assert!(
+                (x[0] - 1.0).abs() < 1e-6 && (x[1] - 3.0).abs() < 1e-6,
+                "{x:?}"
+            );
+            let (st, _, z) = bad.solve_in_order(100, false, order.as_deref());
+            assert_eq!(st, SolverStatus::PrimalInfeasible, "{order:?}");
+            assert!(z.iter().all(|v| *v >= -1e-9), "{z:?}");
+            for j in 0..2 {
+                let g: f64 = bad.ge.iter().zip(&z).map(|((r, _), y)| r[j] * y).sum();
+                assert!(g.abs() < 1e-6 * z.iter().sum::<f64>(), "{order:?}: {z:?}");
+            }
+            let h: f64 = bad.ge.iter().zip(&z).map(|((_, h), y)| h * y).sum();
+            assert!(h > 0.0, "{order:?}: {z:?}");
+        }
+    }
 }

@@ -45,6 +45,33 @@ pub(crate) enum Retry {
     Fails,
 }
 
+/// The escalation of one polynomial level across its working-set solves (issue 38,
+/// eleventh step; [`super::experiment::Switches`]): refinement for the rest of the level
+/// once a refined solve stayed short of `Solved`, and a budget of Clarabel solves.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Escalate {
+    /// Whether a refined solve short of `Solved` turns refinement on for the rest.
+    pub sticky: bool,
+    /// Refinement is on for the rest of the level (set here when `sticky`).
+    pub refined: bool,
+    /// Clarabel solves this call may make (`usize::MAX`: no budget).
+    pub budget: usize,
+    /// Set when the budget ran out before a verdict.
+    pub spent: bool,
+}
+
+impl Escalate {
+    /// No escalation, no budget: the working-set solve as before the eleventh step.
+    pub(crate) fn off() -> Self {
+        Self {
+            sticky: false,
+            refined: false,
+            budget: usize::MAX,
+            spent: false,
+        }
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn active_set_solve(
     n: usize,
@@ -59,6 +86,7 @@ pub(crate) fn active_set_solve(
     retry_iter: u32,
     refine: bool,
     retry: Retry,
+    esc: &mut Escalate,
 ) -> (LpOut, usize) {
     // Whether the retry with every row is solved with refinement straight away: once a
     // working-set solve stayed short of `Solved` with refinement (`Retry::Decides`), its
@@ -82,6 +110,15 @@ pub(crate) fn active_set_solve(
     let mut all = false;
     let on = |mask: &[bool], i: usize| mask[i];
     loop {
+        if solves >= esc.budget {
+            // A budget (the level budget) spent before a verdict: a doubt, never a point.
+            esc.spent = true;
+            let out = LpOut {
+                status: SolverStatus::MaxIterations,
+                x: Vec::new(),
+            };
+            return (out, solves);
+        }
         rounds += 1;
         let ge: Vec<(Vec<f64>, f64)> = (0..rows.len())
             .filter(|i| all || on(mask, *i))
@@ -94,7 +131,7 @@ pub(crate) fn active_set_solve(
             eq: eq.to_vec(),
         };
         let iter = if all { retry_iter } else { max_iter };
-        let refine = refine || (all && refine_all);
+        let refine = refine || esc.refined || (all && refine_all);
         let (mut out, ran) = lp.solve_memo(iter, refine);
         solves += usize::from(ran);
         let settled = match retry {
@@ -125,6 +162,7 @@ pub(crate) fn active_set_solve(
                 )
             {
                 refine_all = true;
+                esc.refined |= esc.sticky;
             }
         }
         if !out.status.has_solution() || rounds > MAX_ROUNDS {

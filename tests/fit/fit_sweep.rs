@@ -9,6 +9,13 @@
 //! the reference table instead of checking it (only on the code the table is meant to record);
 //! `RSHAPE_SWEEP_CSV=DIR` also writes the 24 envelopes as `DIR/envNN.csv`;
 //! `RSHAPE_SWEEP_ONLY=0,4,15` fits only those envelopes (a subset while developing).
+//!
+//! Measurement switches (issue 38, eleventh step; [`rshape::fit::experiment`], hidden, read
+//! here only): `RSHAPE_SWEEP_PERM=reverse` or `=seed:N` hands every LP's rows to Clarabel
+//! reversed or in a fixed seeded permutation (the same LPs: the noise floor of the rule);
+//! `RSHAPE_SWEEP_FAST=none` or a list of `ws,refine,k30,centre` sets the speedups from
+//! today's route (`none`: today's route; unset: the code's default); `RSHAPE_SWEEP_OUT=FILE`
+//! writes this run's table (the reference's format) to `FILE`.
 
 #[path = "../../benches/support/random_envelopes.rs"]
 pub(crate) mod random_envelopes;
@@ -21,6 +28,41 @@ const REFERENCE: &str = "tests/data/fit_sweep_reference.csv";
 const MAX_ORDER: usize = 8;
 /// How far (decades) an order's max may rise over the stored table.
 const RISE: f64 = 0.002;
+
+/// The measurement switches from the environment (see the module doc); prints them.
+pub(crate) fn apply_switches() {
+    use rshape::fit::experiment::{set_switches, switches, RowOrder, Switches};
+    let mut sw = switches();
+    if let Ok(fast) = std::env::var("RSHAPE_SWEEP_FAST") {
+        sw = Switches {
+            row_order: sw.row_order,
+            ..Switches::BASELINE
+        };
+        for f in fast.split(',').map(str::trim).filter(|f| !f.is_empty()) {
+            match f {
+                "none" => {}
+                "ws" => sw.keep_working_set = true,
+                "refine" => sw.refine_rest_of_level = true,
+                "centre" => sw.previous_centre_first = true,
+                k if k.starts_with('k') => sw.level_budget = k[1..].parse().expect("kNN"),
+                other => panic!("RSHAPE_SWEEP_FAST: unknown {other:?}"),
+            }
+        }
+    }
+    if let Ok(p) = std::env::var("RSHAPE_SWEEP_PERM") {
+        sw.row_order = match p.as_str() {
+            "none" | "" => RowOrder::AsBuilt,
+            "reverse" => RowOrder::Reversed,
+            s => RowOrder::Seeded(
+                s.strip_prefix("seed:")
+                    .and_then(|n| n.parse().ok())
+                    .expect("RSHAPE_SWEEP_PERM=reverse or seed:N"),
+            ),
+        };
+    }
+    set_switches(sw);
+    println!("switches: {sw:?}");
+}
 
 /// `(envelope, order) → max log10` from the stored table.
 fn reference() -> Vec<Vec<f64>> {
@@ -78,6 +120,7 @@ fn generator_is_fixed_and_in_range() {
 #[test]
 #[ignore = "heavy: 24 envelopes × orders 0–8 (run with --release)"]
 fn sweep_no_order_rises() {
+    apply_switches();
     let write = std::env::var("RSHAPE_SWEEP_WRITE").is_ok();
     let csv_dir = std::env::var("RSHAPE_SWEEP_CSV").ok();
     let table = if write { None } else { Some(reference()) };
@@ -131,7 +174,9 @@ fn sweep_no_order_rises() {
             lb.add(k, &env, None, &rows, &res.solver_events);
         }
         for r in &rows {
-            assert_eq!(r.status, "ok", "env {k} order {}: {}", r.order, r.status);
+            if r.status != "ok" {
+                failures.push(format!("env {k} order {}: {}", r.order, r.status));
+            }
             out.push_str(&format!(
                 "{k},{},{:.6},{:.6},{}\n",
                 r.order, r.max_log10, r.mean_log10, r.lp_solves
@@ -151,6 +196,9 @@ fn sweep_no_order_rises() {
     println!("total: {lps} LPs, {secs:.1} s; worst rise over the table {worst:+.5} decade");
     if let Some(lb) = &lb {
         lb.report();
+    }
+    if let Ok(file) = std::env::var("RSHAPE_SWEEP_OUT") {
+        std::fs::write(file, &out).unwrap();
     }
     if write && only.is_none() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(REFERENCE);
@@ -280,6 +328,7 @@ impl LbTally {
 #[test]
 #[ignore = "timing figures (run with --release --nocapture)"]
 fn bench_case_figures() {
+    apply_switches();
     let run =
         |name: &str, env: &rshape::consistency::Envelope, a1: Option<rshape::fit::A1Fn<'_>>| {
             let t = Instant::now();
