@@ -8,8 +8,9 @@
 //!   only the interior-point iterates (round-off, the KKT ordering) differ.  It measures
 //!   how far the fit moves with *no* change of method: the noise floor against which the
 //!   sweep's 0.002-decade rule judges a speedup.
-//! * The cheap speedups of the earlier steps (each a flag; [`Switches::default`] is the
-//!   combination the branch recommends, see `docs/internals-fit-speed.md`).
+//! * The cheap speedups of the earlier steps (each a flag, all off in [`Switches::default`],
+//!   today's route; their figures against the noise floor and the rule proposed for them are
+//!   in `docs/internals-fit-speed.md`, eleventh step).
 
 use std::sync::RwLock;
 
