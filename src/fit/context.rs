@@ -223,24 +223,6 @@ impl Context<'_> {
         set: &FitSettings,
     ) -> (Result<(FitResult, Scored), FitError>, Vec<f64>) {
         let mut cuts = Vec::new();
-        let result = self.certify_ranked_into(
-            order, ranked, prev, guard, events, lp_solves, set, &mut cuts,
-        );
-        (result, cuts)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn certify_ranked_into(
-        &self,
-        order: usize,
-        ranked: &[Scored],
-        prev: Option<&Scored>,
-        guard: Objective,
-        events: Vec<SolverEvent>,
-        lp_solves: usize,
-        set: &FitSettings,
-        cuts: &mut Vec<f64>,
-    ) -> Result<(FitResult, Scored), FitError> {
         let inp = self.cert_input(set);
         let mut reasons = Vec::new();
         let mut first_failed: Option<FitResult> = None;
@@ -328,15 +310,13 @@ impl Context<'_> {
                 break;
             }
         }
-        if let Some(b) = best {
-            return Ok(b);
-        }
-        match first_failed {
-            Some(r) => Err(FitError::Uncertified {
+        let result = match (best, first_failed) {
+            (Some(b), _) => Ok(b),
+            (None, Some(r)) => Err(FitError::Uncertified {
                 result: Box::new(r),
                 reasons,
             }),
-            None => Err(FitError::NoFeasibleFit {
+            (None, None) => Err(FitError::NoFeasibleFit {
                 order,
                 reasons: events
                     .iter()
@@ -344,6 +324,7 @@ impl Context<'_> {
                     .collect(),
                 events,
             }),
-        }
+        };
+        (result, cuts)
     }
 }
