@@ -4,7 +4,6 @@ the Python package is compared with), and cached CLI runs."""
 import json
 import os
 import subprocess
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -43,48 +42,20 @@ def cli():
     return run
 
 
-# The configs of the selected tests that take `cli_run` and a `name` parameter, in run order.
-_PREFETCH: list = []
-
-
-def pytest_collection_finish(session):
-    """After selection (`-k`, node ids): what `cli_run` starts ahead."""
-    for item in session.items:
-        params = getattr(getattr(item, "callspec", None), "params", {})
-        if "cli_run" in getattr(item, "fixturenames", ()) and "name" in params and params["name"] not in _PREFETCH:
-            _PREFETCH.append(params["name"])
-
-
 @pytest.fixture(scope="session")
 def cli_run(cli, tmp_path_factory):
-    """`rshape run CONFIG --out DIR` once per config: the DIR.
-
-    The runs the selected tests will ask for (`_PREFETCH`, in the order they run) start in the
-    background at once, on one core fewer than the machine's (at least one thread: the CLI is a
-    separate process), so that they overlap the Python side's own computations; `run(config)`
-    waits for its config's run. The runs and what the tests compare are the same either way."""
-    pool = ThreadPoolExecutor(max_workers=max(1, (os.cpu_count() or 2) - 1))
-    started = {}
-
-    def one(config: str, out: Path):
-        p = cli("run", CONFIGS / config, "--out", out, check=False)
-        return out, p.stderr.strip() if p.returncode == 2 else None
-
-    def start(config: str):
-        if config not in started:
-            started[config] = pool.submit(one, config, tmp_path_factory.mktemp(Path(config).stem))
+    """`rshape run CONFIG --out DIR` once per config: the DIR."""
+    cache = {}
 
     def run(config: str):
         """The output folder, and the error line when the CLI refused the config (exit 2)."""
-        start(config)
-        return started[config].result()
+        if config not in cache:
+            out = tmp_path_factory.mktemp(Path(config).stem)
+            p = cli("run", CONFIGS / config, "--out", out, check=False)
+            cache[config] = (out, p.stderr.strip() if p.returncode == 2 else None)
+        return cache[config]
 
-    for config in _PREFETCH:
-        start(config)
-    yield run
-    for f in started.values():  # nothing left running past the session
-        f.cancel()
-    pool.shutdown(wait=True)
+    return run
 
 
 def read_envelope_csv(path: Path):
