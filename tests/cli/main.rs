@@ -26,6 +26,7 @@ mod configs_every;
 mod figures_extreme;
 mod figures_glance;
 mod fit_a1_gap;
+mod fit_cut_rounds;
 mod fit_proven_bound;
 mod fuzz_inputs;
 mod hardening_iii;
