@@ -327,22 +327,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn grid_has_data_band_outside_and_infinity() {
-        let w = [0.1, 1.0, 10.0];
-        let lower = [4.0, 1.0, 0.25];
-        let g = build_grid(&GridSpec {
-            w: &w,
-            lower: &lower,
-            a1: None,
+    /// Three data a decade apart, 50 band points per decade, two decades outside.
+    fn three_data<'a>(a1: Option<&'a dyn Fn(f64) -> f64>, cuts: &'a [f64]) -> GridSpec<'a> {
+        GridSpec {
+            w: &[0.1, 1.0, 10.0],
+            lower: &[4.0, 1.0, 0.25],
+            a1,
             a1_data: None,
             floor: 1e-6,
             per_decade: 50,
             extend_decades: 2.0,
             no_dip: true,
             a1_dips: &[],
-            cuts: &[],
-        });
+            cuts,
+        }
+    }
+
+    #[test]
+    fn grid_has_data_band_outside_and_infinity() {
+        let g = build_grid(&three_data(None, &[]));
         assert_eq!(g.iter().filter(|p| p.kind == PointKind::Datum).count(), 3);
         assert!(g.iter().any(|p| p.kind == PointKind::Infinity));
         assert!(g.iter().filter(|p| p.kind == PointKind::Band).count() >= 95);
@@ -359,21 +362,8 @@ mod tests {
     /// interval in the band, the floor outside it), and leave every other point as it was.
     #[test]
     fn cuts_add_points_and_change_nothing_else() {
-        let w = [0.1, 1.0, 10.0];
-        let lower = [4.0, 1.0, 0.25];
         let a1 = |x: f64| 100.0 + x;
-        let spec = |cuts: &'static [f64]| GridSpec {
-            w: &w,
-            lower: &lower,
-            a1: Some(&a1),
-            a1_data: None,
-            floor: 1e-6,
-            per_decade: 50,
-            extend_decades: 2.0,
-            no_dip: true,
-            a1_dips: &[],
-            cuts,
-        };
+        let spec = |cuts: &'static [f64]| three_data(Some(&a1), cuts);
         let base = build_grid(&spec(&[]));
         let cut = build_grid(&spec(&[0.3333, 500.0]));
         assert_eq!(cut.len(), base.len() + 2);
