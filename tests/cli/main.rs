@@ -23,6 +23,7 @@ mod batch_vocabulary;
 mod cli_help;
 mod closed_loop_cli;
 mod configs_every;
+mod diagnose_exclude;
 mod figures_extreme;
 mod figures_glance;
 mod fit_a1_gap;

@@ -1,5 +1,5 @@
 //! `rshape diagnose CONFIG [--data FILE] [--noise-radius X] [--channel OUT,IN] [--json]
-//! [--band FMIN:FMAX] [--apply K|chosen [--force] --write NEW.toml]`.
+//! [--band FMIN:FMAX] [--exclude FMIN:FMAX]… [--apply K|chosen [--force] --write NEW.toml]`.
 
 use super::common::InputArgs;
 use super::compare::channel_arg;
@@ -46,6 +46,10 @@ pub struct DiagnoseArgs {
     /// Diagnose only the lines with FMIN ≤ f ≤ FMAX (Hz), e.g. `--band 20:1200`.
     #[arg(long, value_parser = parse_band, value_name = "FMIN:FMAX", allow_hyphen_values = true)]
     pub band: Option<(f64, f64)>,
+    /// Leave out the lines with FMIN ≤ f ≤ FMAX (Hz), e.g. a mains line: `--exclude
+    /// 2639.5:2640.5`; repeat it for several ranges.
+    #[arg(long, value_parser = parse_band, value_name = "FMIN:FMAX", allow_hyphen_values = true)]
+    pub exclude: Vec<(f64, f64)>,
     /// Write modes at 50/60 Hz or a harmonic (refused by default as probable electrical
     /// interference).
     #[arg(long)]
@@ -184,6 +188,9 @@ pub fn run(a: &DiagnoseArgs) -> Result<i32> {
     let mut data = channels(a, &inputs, noise)?;
     if let Some((lo, hi)) = a.band {
         data = data.band(lo, hi)?;
+    }
+    for (lo, hi) in &a.exclude {
+        data = data.exclude(*lo, *hi)?;
     }
     let settings = SearchSettings {
         max_effects: a.max_effects.max(1),

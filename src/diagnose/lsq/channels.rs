@@ -140,19 +140,70 @@ impl Channels {
                 ),
             });
         }
+        Ok(self.keep(&keep))
+    }
+
+    /// Every line but those with `f_lo ≤ f ≤ f_hi` (Hz; `diagnose --exclude`: a spectral
+    /// line or a dropout left out).  A range holding no line, or leaving fewer than two, is an
+    /// error naming the range and the nearest line.
+    pub fn exclude(&self, f_lo: f64, f_hi: f64) -> Result<Self> {
+        let tau = std::f64::consts::TAU;
+        let arg = format!("--exclude {f_lo}:{f_hi}");
+        if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
+            return Err(Error::Argument {
+                arg,
+                msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
+            });
+        }
+        let inside = |k: &usize| {
+            let f = self.omega[*k] / tau;
+            f >= f_lo * (1.0 - 1e-12) && f <= f_hi * (1.0 + 1e-12)
+        };
+        let keep: Vec<usize> = (0..self.len()).filter(|k| !inside(k)).collect();
+        if keep.len() == self.len() {
+            let mid = 0.5 * (f_lo + f_hi);
+            let nearest = self
+                .omega
+                .iter()
+                .map(|w| w / tau)
+                .min_by(|a, b| (a - mid).abs().total_cmp(&(b - mid).abs()))
+                .unwrap_or(f64::NAN);
+            return Err(Error::Argument {
+                arg,
+                msg: format!(
+                    "no line of the data lies in it (the nearest is at {} Hz): widen the range to hold the line to leave out",
+                    crate::report::fmt::sig(nearest)
+                ),
+            });
+        }
+        if keep.len() < 2 {
+            return Err(Error::Argument {
+                arg,
+                msg: format!(
+                    "it leaves {} of the data's {} lines; at least 2 are needed",
+                    keep.len(),
+                    self.len()
+                ),
+            });
+        }
+        Ok(self.keep(&keep))
+    }
+
+    /// The lines `keep` (ascending), every channel with its radii.
+    fn keep(&self, keep: &[usize]) -> Self {
         fn pick<T: Copy>(v: &[Vec<T>], keep: &[usize]) -> Vec<Vec<T>> {
             v.iter()
                 .map(|c| keep.iter().map(|k| c[*k]).collect())
                 .collect()
         }
-        Ok(Self {
+        Self {
             path: self.path.clone(),
             omega: keep.iter().map(|k| self.omega[*k]).collect(),
             entries: self.entries.clone(),
-            g: pick(&self.g, &keep),
-            radius: pick(&self.radius, &keep),
+            g: pick(&self.g, keep),
+            radius: pick(&self.radius, keep),
             radius_source: self.radius_source.clone(),
-        })
+        }
     }
 
     /// Number of channels.

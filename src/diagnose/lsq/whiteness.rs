@@ -205,11 +205,20 @@ impl Whiteness {
             }
         );
         if let Some((k, share)) = self.outlier {
+            // Half the spacing to a neighbour each side: the range holds that line alone.
+            let d = if k > 0 {
+                hz(k) - hz(k - 1)
+            } else {
+                hz(k + 1) - hz(k)
+            };
+            let p = (-(d / 4.0).log10()).ceil().max(0.0) as usize;
             return format!(
-                "the residual is {}× the stated noise (V/E[V], {lb}), and {} of it is the one line at {} Hz: an outlier there (a spectral line such as mains interference, or a dropout), not scatter — leave that line out (`--band`) or raise its noise radius alone, not std_factor",
+                "the residual is {}× the stated noise (V/E[V], {lb}), and {} of it is the one line at {} Hz: an outlier there (a spectral line such as mains interference, or a dropout), not scatter — leave that line out (`--exclude {:.p$}:{:.p$}`) or raise its noise radius alone, not std_factor",
                 sig(self.level),
                 crate::report::fmt::fmt_pct(share),
-                sig(hz(k))
+                sig(hz(k)),
+                hz(k) - d / 2.0,
+                hz(k) + d / 2.0,
             );
         }
         match (self.white, self.level > LEVEL_HIGH) {
@@ -343,6 +352,10 @@ mod tests {
         let text = w.explain(|k| 2500.0 + k as f64);
         assert!(text.contains("one line at 2640 Hz"), "{text}");
         assert!(!text.contains("std_factor ×"), "{text}");
+        // The range offered holds that line alone (half a spacing each side).
+        assert!(text.contains("`--exclude 2639.5:2640.5`"), "{text}");
+        let text = w.explain(|k| 2500.0 + 0.01 * k as f64);
+        assert!(text.contains("`--exclude 2501.395:2501.405`"), "{text}");
         assert_eq!(whiteness(std::slice::from_ref(&base), 0, 10).outlier, None);
         let spread: Vec<Complex64> = base.iter().map(|x| 8.0 * x).collect();
         let w = whiteness(&[spread], 0, 10);
