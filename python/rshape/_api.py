@@ -319,9 +319,12 @@ def diagnose(config: Union[Config, PathLike], frf: Optional[Frf] = None,
              channel: Optional[Tuple[int, int]] = None, noise_radius: Optional[float] = None,
              max_effects: int = 3, beam: int = 3,
              band: Optional[Tuple[float, float]] = None,
-             allow_mains: bool = False) -> Diagnosis:
+             allow_mains: bool = False,
+             exclude: Optional[Sequence[Tuple[float, float]]] = None) -> Diagnosis:
     """Which physical effects the model misses (the search of ``rshape diagnose``);
-    ``band=(fmin, fmax)`` in Hz restricts the data; ``allow_mains=True`` lets a mode at
-    50/60 Hz or a harmonic pass (``--allow-mains``)."""
+    ``band=(fmin, fmax)`` in Hz restricts the data; ``exclude=[(fmin, fmax), ...]`` in Hz
+    leaves ranges out (``--exclude``: a mains line, a dropout); ``allow_mains=True`` lets a
+    mode at 50/60 Hz or a harmonic pass (``--allow-mains``)."""
+    ranges = None if exclude is None else [(float(a), float(b)) for a, b in exclude]
     return Diagnosis(_core._diagnose(_config(config), frf, channel, noise_radius,
-                                     max_effects, beam, band, allow_mains))
+                                     max_effects, beam, band, allow_mains, ranges))

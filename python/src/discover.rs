@@ -128,7 +128,7 @@ impl DiagnosisHandle {
 
 /// `rshape diagnose --json`: candidates, chosen set, changes, peaks.
 #[pyfunction]
-#[pyo3(signature = (config, frf=None, channel=None, noise_radius=None, max_effects=3, beam=3, band=None, allow_mains=false))]
+#[pyo3(signature = (config, frf=None, channel=None, noise_radius=None, max_effects=3, beam=3, band=None, allow_mains=false, exclude=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn _diagnose(
     py: Python<'_>,
@@ -140,6 +140,7 @@ pub fn _diagnose(
     beam: usize,
     band: Option<(f64, f64)>,
     allow_mains: bool,
+    exclude: Option<Vec<(f64, f64)>>,
 ) -> PyResult<DiagnosisHandle> {
     let cfg = config.inner.clone();
     guarded(py, move || {
@@ -189,6 +190,9 @@ pub fn _diagnose(
         };
         if let Some((lo, hi)) = band {
             channels = channels.band(lo, hi).py()?;
+        }
+        for (lo, hi) in exclude.unwrap_or_default() {
+            channels = channels.exclude(lo, hi).py()?;
         }
         let settings = SearchSettings {
             max_effects,

@@ -138,3 +138,17 @@ def test_compare_and_diagnose_equal_the_cli(cli, tmp_path):
     beside = d_py.apply("chosen")
     assert rshape.Config.from_toml(beside, CONFIGS / "revised.toml").data == rshape.Config.load(name).data
     assert not list(CONFIGS.glob(".rshape-revision-*"))
+
+
+def test_diagnose_exclude_equals_the_cli(cli):
+    """``exclude=`` leaves ranges of lines out as ``--exclude`` does; a range with no line
+    is the CLI's error."""
+    name = CONFIGS / "mains_line.toml"
+    d_cli = json.loads(cli("diagnose", name, "--exclude", "2639.5:2640.5", "--exclude", "2500:2509",
+                           "--json").stdout)
+    d_py = rshape.diagnose(name, exclude=[(2639.5, 2640.5), (2500, 2509)])
+    strip = lambda d: {k: v for k, v in d.items() if k != "search"}
+    assert strip(d_py.to_dict()) == strip(d_cli)
+    assert d_py.to_dict()["n_data"] == 290
+    with pytest.raises(rshape.InputError, match="no line of the data lies in it"):
+        rshape.diagnose(name, exclude=[(2640.2, 2640.3)])
