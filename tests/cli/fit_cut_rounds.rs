@@ -101,11 +101,7 @@ fn order_3_of_the_lightly_damped_arm_certifies_after_a_cut_round() {
     for p in j["poles"].as_array().unwrap() {
         centres.push(p["re"].as_f64().unwrap().hypot(p["im"].as_f64().unwrap()));
     }
-    let around = centres
-        .iter()
-        .flat_map(|c| (0..=3000).map(move |k| c * (0.97 + 0.06 * k as f64 / 3000.0)));
-    let band = (0..=4000).map(|k| 10f64.powf(-2.0 + 3.0 * k as f64 / 4000.0));
-    for w in around.chain(band) {
+    for w in crate::common::a1_check_points(&centres) {
         let v = r(w) * (1.0 + plant_mag(w).powi(2)).sqrt();
         assert!(v < 1.0, "A1 fails at {w} rad/s: |r|·√(1+|G|²) = {v}");
     }

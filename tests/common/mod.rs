@@ -88,3 +88,13 @@ pub fn mode_hz(f_hz: f64, zeta: f64, rho: f64) -> rshape::model::physical::ModeS
         output_gain: Gains::Scalar(rho),
     }
 }
+
+/// Frequencies for an independent A1 check of a fitted `r`: ±3 % around each centre (a notch
+/// of `σ_min(M̃)`, a pole of `r`; 3001 points each) and 0.01–10 rad/s (4001 points).
+pub fn a1_check_points(centres: &[f64]) -> Vec<f64> {
+    let around = centres
+        .iter()
+        .flat_map(|c| (0..=3000).map(move |k| c * (0.97 + 0.06 * k as f64 / 3000.0)));
+    let band = (0..=4000).map(|k| 10f64.powf(-2.0 + 3.0 * k as f64 / 4000.0));
+    around.chain(band).collect()
+}

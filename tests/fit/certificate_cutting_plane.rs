@@ -44,11 +44,7 @@ fn worst_a1(fit: &FitResult) -> (f64, f64) {
     let mut centres = vec![0.3616, 0.7977];
     centres.extend(fit.poles.iter().map(|p| p.norm()));
     let mut worst: (f64, f64) = (0.0, f64::NAN);
-    let around = centres
-        .iter()
-        .flat_map(|c| (0..=3000).map(move |k| c * (0.97 + 0.06 * k as f64 / 3000.0)));
-    let band = (0..=4000).map(|k| 10f64.powf(-2.0 + 3.0 * k as f64 / 4000.0));
-    for w in around.chain(band) {
+    for w in crate::common::a1_check_points(&centres) {
         let v = r(w) * (1.0 + plant_mag(w).powi(2)).sqrt();
         if v > worst.0 {
             worst = (v, w);
