@@ -82,7 +82,7 @@ fn the_fit_asks_for_a1_once_per_frequency_and_certifies_the_same() {
     let fit_json = serde_json::to_string(&fit.certificate).unwrap();
     assert_eq!(fit_json, recertified(&fit, &env, &set, &plain));
 
-    // fit_auto to order 4: every order's certificate on the same grid (orders 0–2 fail A1
+    // fit_auto to order 4: every order's certificate on the same grid (the low orders fail A1
     // at the notch, their candidates certified and refused all the same).
     calls.set(0);
     seen.borrow_mut().clear();
