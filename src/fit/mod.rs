@@ -26,6 +26,7 @@
 //! Comparisons are written `!(x > y)` on purpose throughout: a NaN must fail a check.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub(crate) mod a1_memo;
 pub(crate) mod a1_proof;
 pub(crate) mod basis;
 pub(crate) mod between;
@@ -304,7 +305,10 @@ pub fn fit_unit(
     options: &FitOptions<'_>,
 ) -> Result<FitResult, FitError> {
     let progress = options.progress;
-    let ctx = prepare(env, a1, settings)?;
+    // Every candidate's certificate asks for A1 on the same grid: evaluate each ω once.
+    let memo = a1_memo::A1Memo::new(a1);
+    let memoized = |w: f64| memo.eval(w);
+    let ctx = prepare(env, memo.wrap(&memoized), settings)?;
     let fit_with =
         |set: &FitSettings, solves_before: usize| fit_with(&ctx, set, progress, solves_before);
     match fit_with(settings, 0) {

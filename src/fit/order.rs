@@ -126,7 +126,10 @@ pub fn fit_auto(
     options: &FitOptions<'_>,
 ) -> Result<(FitResult, Vec<OrderRow>), FitError> {
     let progress = options.progress;
-    let ctx = prepare(env, a1, settings)?;
+    // Every order's certificate asks for A1 on the same grid: evaluate each ω once.
+    let memo = super::a1_memo::A1Memo::new(a1);
+    let memoized = |w: f64| memo.eval(w);
+    let ctx = prepare(env, memo.wrap(&memoized), settings)?;
     let mut prev: Option<Scored> = None;
     let mut second: Option<MeanChain> = None;
     let mut masks = (Vec::new(), Vec::new());
