@@ -357,14 +357,20 @@ pub fn fit_bound_in_memory(
     label: &str,
     (inputs, env): &FitInput,
 ) -> Result<crate::fit::FitOutcome> {
-    let f = &inputs.config.factorization;
-    let a1 = |w: f64| f.a1_limit(w);
+    // A1 as `run` imposes it: none for closed-loop data (the pipeline's rule).
+    let f = crate::pipeline::closed_loop::a1_factorization(&inputs.config);
+    let a1_fn = f.map(|f| move |w: f64| f.a1_limit(w));
+    let a1 = a1_fn.as_ref().map(|g| g as crate::fit::A1Fn<'_>);
+    let settings = match f {
+        Some(f) => crate::fit::FitSettings::default().with_a1_model(f),
+        None => crate::fit::FitSettings::default(),
+    };
     let view = super::progress::FitProgressView::new(label);
     let progress = |p| view.update(p);
     let outcome = crate::fit::run_fit(
         env,
-        Some(&a1),
-        &crate::fit::FitSettings::default().with_a1_model(f),
+        a1,
+        &settings,
         crate::fit::OrderChoice::Auto { max: 8 },
         Some(&progress),
     );

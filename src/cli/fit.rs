@@ -95,16 +95,21 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             // `--out` is checked before the work: a refusal must not cost the user the envelope.
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             let env = input.envelope_of(&inputs)?;
-            let f = &inputs.config.factorization;
-            let a1 = |w: f64| f.a1_limit(w);
-            let settings = settings.with_a1_model(f);
-            let out = run_fit(&env, Some(&a1), &settings, a.order, Some(progress));
+            // A1 as `run` imposes it: none for closed-loop data (the pipeline's rule).
+            let f = crate::pipeline::closed_loop::a1_factorization(&inputs.config);
+            let a1_fn = f.map(|f| move |w: f64| f.a1_limit(w));
+            let a1 = a1_fn.as_ref().map(|g| g as crate::fit::A1Fn<'_>);
+            let settings = match f {
+                Some(f) => settings.with_a1_model(f),
+                None => settings,
+            };
+            let out = run_fit(&env, a1, &settings, a.order, Some(progress));
             if let (true, Ok(o)) = (a.verbose, &out) {
-                gap_line = crate::fit::proven_gap_line(&env, Some(&a1), &settings, &o.result);
+                gap_line = crate::fit::proven_gap_line(&env, a1, &settings, &o.result);
             }
             out.map_err(|e| {
                 // Why no order can pass, when the envelope shows it (the words of `run`).
-                match crate::pipeline::explain_fit_failure(e, &env, Some(f)) {
+                match crate::pipeline::explain_fit_failure(e, &env, f) {
                     crate::pipeline::FitFailure::A1Conflict { message, .. } => anyhow!(message),
                     crate::pipeline::FitFailure::Fit(e) => e.into(),
                     other => other.into(),

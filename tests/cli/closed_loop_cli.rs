@@ -444,3 +444,35 @@ fn figure_symbols_follow_the_kind_of_data() {
         assert!(!closed.contains(bad), "closed loop says `{bad}`:\n{closed}");
     }
 }
+
+/// `fit` on a closed-loop config imposes A1 as `run` does (`pipeline::closed_loop::
+/// a1_factorization`: not for closed-loop configs): the same `r.json`, byte for byte. Before,
+/// `fit` imposed the open-loop factors' `σ_min(M̃)`, which vanishes at DC here, and `fit --order
+/// 2` failed with "A1 fails … at ω = 1.000000e-3 rad/s" where `run --order 2` certified.
+#[test]
+fn fit_and_run_fit_a_closed_loop_config_alike() {
+    let d = tempfile::tempdir().unwrap();
+    let cfg = crate::common::repo("configs/closed_loop_same.toml");
+    let mut json = Vec::new();
+    for cmd in ["fit", "run"] {
+        let out = d.path().join(cmd);
+        let o = crate::common::rshape(&[
+            cmd,
+            cfg.to_str().unwrap(),
+            "--order",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{cmd}: {}",
+            crate::common::stderr(&o)
+        );
+        json.push(std::fs::read_to_string(out.join("r.json")).unwrap());
+    }
+    assert_eq!(json[0], json[1]);
+    let r: serde_json::Value = serde_json::from_str(&json[0]).unwrap();
+    assert_eq!(r["certificate"]["passed"], true);
+}
