@@ -9,6 +9,7 @@ mod common;
 mod certificate_arm_notch;
 mod certificate_cutting_plane;
 mod certificate_exact;
+mod fit_chain;
 mod fit_defects;
 mod fit_lower_bound;
 mod fit_paper;
