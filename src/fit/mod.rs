@@ -403,6 +403,8 @@ fn fit_with(
                 lp_solves: solves,
             });
         }
+        // A failed order's working sets are dropped (see `order::fit_auto`).
+        let masks_before = masks.clone();
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         all_events.extend(of.events);
         solves += of.lp_solves;
@@ -434,6 +436,7 @@ fn fit_with(
                 last = Some(Ok(res));
             }
             Err(e) => {
+                masks = masks_before;
                 last = Some(Err(e));
             }
         }

@@ -146,6 +146,9 @@ pub fn fit_auto(
                 lp_solves: solves,
             });
         }
+        // The working sets as the last certified order left them: a failed order's are
+        // dropped below, so a failure never changes where the next order starts.
+        let masks_before = masks.clone();
         let of = fit_order(&ctx.prep, n, prev.as_ref(), settings, &mut masks);
         let mut of = recheck_stall(&ctx.prep, n, prev.as_ref(), settings, of);
         let own = of.ranked.clone();
@@ -221,6 +224,7 @@ pub fn fit_auto(
                 fits.push(Some(res));
             }
             Err(e) => {
+                masks = masks_before;
                 rows.push(OrderRow {
                     order: n,
                     mean_log10: f64::NAN,

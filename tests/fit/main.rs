@@ -10,6 +10,7 @@ mod certificate_arm_notch;
 mod certificate_cutting_plane;
 mod certificate_exact;
 mod fit_a1_memo;
+mod fit_chain;
 mod fit_defects;
 mod fit_digest;
 mod fit_lower_bound;
