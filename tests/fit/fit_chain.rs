@@ -1,6 +1,8 @@
 //! The chained sweep against each order alone, on the closed-loop example where they parted
-//! (`configs/closed_loop_retuned_noisy.toml`, `rshape fit` with A1 from the config's
-//! factorization, found at stop 49).
+//! (`configs/closed_loop_retuned_noisy.toml`'s envelope with A1 from the config's open-loop
+//! factorization, as `rshape fit` imposed it until stop 50; found at stop 49). The chain's
+//! defect does not depend on where A1 comes from: any A1 that rules out the lowest orders
+//! showed it.
 //!
 //! Orders 0–3 fail there (no unit of those orders certifies under A1), so the chain reaches
 //! order 4 without a previous `r`; it used to carry the working sets the failed orders' level
