@@ -8,9 +8,12 @@
 //!   only the interior-point iterates (round-off, the KKT ordering) differ.  It measures
 //!   how far the fit moves with *no* change of method: the noise floor against which the
 //!   sweep's 0.002-decade rule judges a speedup.
-//! * The cheap speedups of the earlier steps (each a flag, all off in [`Switches::default`],
-//!   today's route; their figures against the noise floor and the rule proposed for them are
-//!   in `docs/internals-fit-speed.md`, eleventh step).
+//! * The cheap speedups of the earlier steps (each a flag).  Three of them are the fit's route
+//!   since the twelfth step ([`Switches::default`]: the working set kept across cut rounds,
+//!   refinement for the rest of a level, a budget of 30 LPs per level); [`Switches::BASELINE`]
+//!   turns them off again for measurements (the route of main f77b84c).  Their figures against
+//!   the noise floor and the sweep's rule are in `docs/internals-fit-speed.md`, eleventh and
+//!   twelfth steps.
 
 use std::sync::RwLock;
 
@@ -25,7 +28,8 @@ pub enum RowOrder {
     Seeded(u64),
 }
 
-/// The switches.  `Default` is what the fit runs.
+/// The switches.  `Default` is what the fit runs; the fields exist only to turn the route's
+/// parts off (or the measurements' perturbations on).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Switches {
     /// Row order of every LP (a perturbation, not a speedup).
@@ -47,7 +51,7 @@ pub struct Switches {
 }
 
 impl Switches {
-    /// Today's route (main 5059ca8): no speedup, rows as built.
+    /// The route before the twelfth step (main f77b84c): no speedup, rows as built.
     pub const BASELINE: Self = Self {
         row_order: RowOrder::AsBuilt,
         keep_working_set: false,
@@ -55,11 +59,22 @@ impl Switches {
         level_budget: 0,
         previous_centre_first: false,
     };
+
+    /// The fit's route since the twelfth step: `ws,refine,k30` (the sweep's LPs −33 % against
+    /// [`Self::BASELINE`], every order within the rule of `tests/fit/fit_sweep_rule.rs`);
+    /// `previous_centre_first` stays off (only 0.0001 decade inside that rule).
+    pub const ROUTE: Self = Self {
+        row_order: RowOrder::AsBuilt,
+        keep_working_set: true,
+        refine_rest_of_level: true,
+        level_budget: 30,
+        previous_centre_first: false,
+    };
 }
 
 impl Default for Switches {
     fn default() -> Self {
-        Self::BASELINE
+        Self::ROUTE
     }
 }
 
