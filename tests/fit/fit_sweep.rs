@@ -18,10 +18,10 @@
 //! Measurement switches (issue 38, eleventh step; [`rshape::fit::experiment`], hidden, read
 //! here only): `RSHAPE_SWEEP_PERM=reverse` or `=seed:N` hands every LP's rows to Clarabel
 //! reversed or in a fixed seeded permutation (the same LPs: the noise floor of the rule);
-//! `RSHAPE_SWEEP_FAST=none` or a list of `ws,refine,k30,centre` sets the speedups from the
-//! route before the twelfth step (`none`: that route, `Switches::BASELINE`; unset: the
-//! code's default, `ws,refine,k30`); `RSHAPE_SWEEP_OUT=FILE` writes this run's table (the
-//! reference's format) to `FILE`.
+//! `RSHAPE_SWEEP_FAST=none` or a list of `ws,refine,k30,centre` sets the speedups from
+//! today's route (`none`: today's route, `Switches::BASELINE`; unset: the code's default;
+//! `ws,refine,k30` is the twelfth step's candidate, `Switches::ROUTE`);
+//! `RSHAPE_SWEEP_OUT=FILE` writes this run's table (the reference's format) to `FILE`.
 
 #[path = "../../benches/support/random_envelopes.rs"]
 pub(crate) mod random_envelopes;
