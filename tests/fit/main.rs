@@ -19,5 +19,6 @@ mod fit_parallel;
 mod fit_random;
 mod fit_reference;
 mod fit_sweep;
+mod fit_sweep_rule;
 mod fit_thorough;
 mod fit_work_report;
