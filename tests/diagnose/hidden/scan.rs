@@ -23,6 +23,9 @@ const MAY_BE_NULL: [&str; 6] = [
     "separates_below",
     "figure",
 ];
+/// The object of the parameters' 2σ widths (keyed by parameter name): finite and ≥ 0, no
+/// band check.
+const WIDTHS: &str = "uncertainty_2sigma";
 /// Band factor.
 const BAND: f64 = 1e6;
 
@@ -30,6 +33,12 @@ const BAND: f64 = 1e6;
 fn check_number(key: &str, x: f64, w_lo: f64, w_hi: f64, out: &mut Vec<String>) {
     if !x.is_finite() {
         out.push(format!("{key} = {x} is not finite"));
+        return;
+    }
+    if key == WIDTHS {
+        if x < 0.0 {
+            out.push(format!("a 2σ width {x} is negative"));
+        }
         return;
     }
     let inside = |w: f64| w > w_lo / BAND && w < w_hi * BAND;
@@ -69,7 +78,10 @@ pub fn scan_json(v: &Value, w_lo: f64, w_hi: f64) -> Vec<String> {
             }
             Value::Object(o) => {
                 for (k, x) in o {
-                    walk(x, k, &format!("{path}.{k}"), w, out);
+                    // A parameter's 2σ width is not a frequency (a sharp mode's ω_n may be
+                    // known to 1e-3 rad/s): its entries keep the parent's key.
+                    let key = if key == WIDTHS { WIDTHS } else { k.as_str() };
+                    walk(x, key, &format!("{path}.{k}"), w, out);
                 }
             }
             _ => {}
