@@ -358,13 +358,8 @@ pub fn fit_bound_in_memory(
     (inputs, env): &FitInput,
 ) -> Result<crate::fit::FitOutcome> {
     // A1 as `run` imposes it: none for closed-loop data (the pipeline's rule).
-    let f = crate::pipeline::closed_loop::a1_factorization(&inputs.config);
-    let a1_fn = f.map(|f| move |w: f64| f.a1_limit(w));
-    let a1 = a1_fn.as_ref().map(|g| g as crate::fit::A1Fn<'_>);
-    let settings = match f {
-        Some(f) => crate::fit::FitSettings::default().with_a1_model(f),
-        None => crate::fit::FitSettings::default(),
-    };
+    let model = crate::pipeline::A1Model::of_config(&inputs.config);
+    let (a1, settings) = (model.limit(), model.settings(Default::default()));
     let view = super::progress::FitProgressView::new(label);
     let progress = |p| view.update(p);
     let outcome = crate::fit::run_fit(

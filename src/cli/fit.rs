@@ -96,13 +96,9 @@ pub fn run(a: &FitArgs) -> Result<i32> {
             let _manifest = super::common::prepare_out(&a.out, &[config, &inputs.data.path])?;
             let env = input.envelope_of(&inputs)?;
             // A1 as `run` imposes it: none for closed-loop data (the pipeline's rule).
-            let f = crate::pipeline::closed_loop::a1_factorization(&inputs.config);
-            let a1_fn = f.map(|f| move |w: f64| f.a1_limit(w));
-            let a1 = a1_fn.as_ref().map(|g| g as crate::fit::A1Fn<'_>);
-            let settings = match f {
-                Some(f) => settings.with_a1_model(f),
-                None => settings,
-            };
+            let model = crate::pipeline::A1Model::of_config(&inputs.config);
+            let (f, a1) = (model.factorization(), model.limit());
+            let settings = model.settings(settings);
             let out = run_fit(&env, a1, &settings, a.order, Some(progress));
             if let (true, Ok(o)) = (a.verbose, &out) {
                 gap_line = crate::fit::proven_gap_line(&env, a1, &settings, &o.result);

@@ -104,6 +104,39 @@ pub struct CertInput<'a> {
     pub axis_tol: f64,
 }
 
+impl<'a> CertInput<'a> {
+    /// The inputs with which a fit of `env` under `set` (A1 limit `a1`) certifies its result:
+    /// the settings' margin, grid and A1 proof, and the floor `floor_rel` × the smallest
+    /// positive `r_min` (infinite when every `r_min` is 0, which no fit accepts).  Another
+    /// route to a fit's certificate: [`certify`] of its `r` with these inputs.
+    pub fn of_fit(
+        env: &'a crate::consistency::Envelope,
+        a1: Option<&'a dyn Fn(f64) -> f64>,
+        set: &'a super::FitSettings,
+    ) -> Self {
+        let min_pos = env
+            .r_min
+            .iter()
+            .copied()
+            .filter(|r| *r > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        Self {
+            omega: &env.omega,
+            r_min: &env.r_min,
+            a1,
+            a1_data: env.a1_limit.as_deref(),
+            a1_dips: &set.a1_dips,
+            a1_proof: &set.a1_proof,
+            margin: set.margin,
+            floor: set.floor_rel * min_pos,
+            per_decade: set.cert_per_decade,
+            extend_decades: set.extend_decades,
+            no_dip: set.no_dip,
+            axis_tol: set.axis_tol,
+        }
+    }
+}
+
 fn golden_min(f: &dyn Fn(f64) -> f64, a: f64, b: f64, iters: usize) -> (f64, f64) {
     // On ln ω.
     let (x, fx) = crate::system::golden::golden_section_min(|x| f(x.exp()), a, b, iters);

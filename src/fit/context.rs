@@ -172,20 +172,8 @@ impl Context<'_> {
     }
 
     pub(crate) fn cert_input<'s>(&'s self, set: &'s FitSettings) -> certificate::CertInput<'s> {
-        certificate::CertInput {
-            omega: &self.env.omega,
-            r_min: &self.env.r_min,
-            a1: self.a1,
-            a1_data: self.env.a1_limit.as_deref(),
-            a1_dips: &set.a1_dips,
-            a1_proof: &set.a1_proof,
-            margin: set.margin,
-            floor: self.floor,
-            per_decade: set.cert_per_decade,
-            extend_decades: set.extend_decades,
-            no_dip: set.no_dip,
-            axis_tol: set.axis_tol,
-        }
+        // The same floor as `self.floor` (computed alike in `prepare`).
+        certificate::CertInput::of_fit(self.env, self.a1, set)
     }
 
     /// Certifies the ranked candidates of one order, best first; returns the first that

@@ -135,6 +135,51 @@ pub struct FittedR {
     pub table: Option<Vec<OrderRow>>,
 }
 
+/// The A1 limit a fit imposes (Theorem 1's assumption A1, `|r(jω)| < σ_min(M̃(jω))`): the
+/// factorization whose `σ_min(M̃)` bounds `r`, that bound as the fit's [`crate::fit::A1Fn`],
+/// and the settings the certificate needs to prove it ([`FitSettings::with_a1_model`]).
+/// `None` imposes no limit (closed-loop data: the model of Crowder & de Callafon's eq. (2)
+/// has none).  Every fit of a config (`run`, `fit`, `stability --fit`, `synthesize --fit`)
+/// takes its A1 from here.
+pub struct A1Model<'a> {
+    factorization: Option<&'a Factorization>,
+    limit: Option<Box<dyn Fn(f64) -> f64 + 'a>>,
+}
+
+impl<'a> A1Model<'a> {
+    /// The limit of `f` (none when `f` is `None`).
+    pub fn new(f: Option<&'a Factorization>) -> Self {
+        Self {
+            factorization: f,
+            limit: f.map(|f| Box::new(move |w: f64| f.a1_limit(w)) as Box<dyn Fn(f64) -> f64>),
+        }
+    }
+
+    /// The limit a config's fit imposes: its factorization for open-loop data, none for
+    /// closed-loop data ([`super::closed_loop::a1_factorization`]).
+    pub fn of_config(config: &'a Config) -> Self {
+        Self::new(super::closed_loop::a1_factorization(config))
+    }
+
+    /// The factorization, if a limit is imposed.
+    pub fn factorization(&self) -> Option<&'a Factorization> {
+        self.factorization
+    }
+
+    /// `ω ↦ σ_min(M̃(jω))`, if a limit is imposed.
+    pub fn limit(&self) -> Option<crate::fit::A1Fn<'_>> {
+        self.limit.as_deref().map(|g| g as crate::fit::A1Fn<'_>)
+    }
+
+    /// `base` with what the certificate needs to prove the limit (unchanged without one).
+    pub fn settings(&self, base: FitSettings) -> FitSettings {
+        match self.factorization {
+            Some(f) => base.with_a1_model(f),
+            None => base,
+        }
+    }
+}
+
 /// Fits the smallest unit `r` above the envelope with the defaults of `rshape fit`
 /// (minimax objective; `order` fixed or chosen automatically), keeping `|r| < σ_min(M̃)`
 /// (A1) when the factorization `a1_model` is given (the certificate proves A1 against it).
@@ -146,12 +191,9 @@ pub fn fit_r(
     order: OrderChoice,
     progress: Option<ProgressFn<'_>>,
 ) -> std::result::Result<FittedR, FitFailure> {
-    let a1_fn = a1_model.map(|f| move |w: f64| f.a1_limit(w));
-    let a1: Option<&dyn Fn(f64) -> f64> = a1_fn.as_ref().map(|g| g as &dyn Fn(f64) -> f64);
-    let base = match a1_model {
-        Some(f) => FitSettings::default().with_a1_model(f),
-        None => FitSettings::default(),
-    };
+    let model = A1Model::new(a1_model);
+    let a1 = model.limit();
+    let base = model.settings(FitSettings::default());
     let (result, table) = match order {
         OrderChoice::Auto { max } => {
             let (r, t) = fit_auto(env, a1, &base, max, &FitOptions { progress })

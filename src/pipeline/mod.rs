@@ -14,7 +14,7 @@ use crate::data::FrfData;
 use crate::error::Result;
 use crate::model::Config;
 use integration::FittedR;
-pub use integration::{explain as explain_fit_failure, write_fit_exports, FitFailure};
+pub use integration::{explain as explain_fit_failure, write_fit_exports, A1Model, FitFailure};
 use std::collections::BTreeMap;
 use std::time::Instant;
 

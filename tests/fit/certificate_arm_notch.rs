@@ -81,25 +81,7 @@ fn the_z001_arm_admits_alpha_times_m_tilde() {
     assert!(alpha < 1.0, "the nominal leaves no room: alpha* = {alpha}");
     let set = FitSettings::default().with_a1_model(f);
     let a1 = |w: f64| f.a1_limit(w);
-    let min_pos = rmin
-        .iter()
-        .copied()
-        .filter(|x| *x > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let inp = CertInput {
-        omega: om,
-        r_min: rmin,
-        a1: Some(&a1),
-        a1_data: env.a1_limit.as_deref(),
-        a1_dips: &set.a1_dips,
-        a1_proof: &set.a1_proof,
-        margin: set.margin,
-        floor: set.floor_rel * min_pos,
-        per_decade: set.cert_per_decade,
-        extend_decades: set.extend_decades,
-        no_dip: set.no_dip,
-        axis_tol: set.axis_tol,
-    };
+    let inp = CertInput::of_fit(&env, Some(&a1), &set);
     let a = (alpha * (1.0 + 1e-3)).min(0.5 * (alpha + 1.0));
     // r = α·M̃: a unit with a positive gain.
     let r = Zpk {

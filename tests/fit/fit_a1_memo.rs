@@ -18,26 +18,7 @@ fn recertified(
     set: &FitSettings,
     a1: &dyn Fn(f64) -> f64,
 ) -> String {
-    let min_pos = env
-        .r_min
-        .iter()
-        .copied()
-        .filter(|x| *x > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    let inp = CertInput {
-        omega: &env.omega,
-        r_min: &env.r_min,
-        a1: Some(a1),
-        a1_data: env.a1_limit.as_deref(),
-        a1_dips: &set.a1_dips,
-        a1_proof: &set.a1_proof,
-        margin: set.margin,
-        floor: set.floor_rel * min_pos,
-        per_decade: set.cert_per_decade,
-        extend_decades: set.extend_decades,
-        no_dip: set.no_dip,
-        axis_tol: set.axis_tol,
-    };
+    let inp = CertInput::of_fit(env, Some(a1), set);
     let r = Zpk {
         gain: fit.gain,
         zeros: fit.zeros.clone(),

@@ -116,19 +116,8 @@ impl Channels {
     /// radii.  Fewer than two lines left is an error naming the data's band.
     pub fn band(&self, f_lo: f64, f_hi: f64) -> Result<Self> {
         let tau = std::f64::consts::TAU;
-        if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
-            return Err(Error::Argument {
-                arg: format!("--band {f_lo}:{f_hi}"),
-                msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
-            });
-        }
-        let keep: Vec<usize> = (0..self.len())
-            // Hz from rad/s carries rounding: a line at exactly FMIN or FMAX is kept.
-            .filter(|k| {
-                let f = self.omega[*k] / tau;
-                f >= f_lo * (1.0 - 1e-12) && f <= f_hi * (1.0 + 1e-12)
-            })
-            .collect();
+        let inside = self.in_range("--band", f_lo, f_hi)?;
+        let keep: Vec<usize> = (0..self.len()).filter(|k| inside(*k)).collect();
         if keep.len() < 2 {
             return Err(Error::Argument {
                 arg: format!("--band {f_lo}:{f_hi}"),
@@ -149,17 +138,8 @@ impl Channels {
     pub fn exclude(&self, f_lo: f64, f_hi: f64) -> Result<Self> {
         let tau = std::f64::consts::TAU;
         let arg = format!("--exclude {f_lo}:{f_hi}");
-        if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
-            return Err(Error::Argument {
-                arg,
-                msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
-            });
-        }
-        let inside = |k: &usize| {
-            let f = self.omega[*k] / tau;
-            f >= f_lo * (1.0 - 1e-12) && f <= f_hi * (1.0 + 1e-12)
-        };
-        let keep: Vec<usize> = (0..self.len()).filter(|k| !inside(k)).collect();
+        let inside = self.in_range("--exclude", f_lo, f_hi)?;
+        let keep: Vec<usize> = (0..self.len()).filter(|k| !inside(*k)).collect();
         if keep.len() == self.len() {
             let mid = 0.5 * (f_lo + f_hi);
             let nearest = self
@@ -187,6 +167,22 @@ impl Channels {
             });
         }
         Ok(self.keep(&keep))
+    }
+
+    /// The test "line `k` lies in `f_lo ≤ f ≤ f_hi` Hz" of `--band` and `--exclude` (named by
+    /// `flag` in the error for a range that is not `0 ≤ FMIN < FMAX`).
+    fn in_range(&self, flag: &str, f_lo: f64, f_hi: f64) -> Result<impl Fn(usize) -> bool + '_> {
+        if !(f_lo.is_finite() && f_hi.is_finite() && 0.0 <= f_lo && f_lo < f_hi) {
+            return Err(Error::Argument {
+                arg: format!("{flag} {f_lo}:{f_hi}"),
+                msg: "give FMIN:FMAX in Hz with 0 ≤ FMIN < FMAX".into(),
+            });
+        }
+        // Hz from rad/s carries rounding: a line at exactly FMIN or FMAX is inside.
+        Ok(move |k: usize| {
+            let f = self.omega[k] / std::f64::consts::TAU;
+            f >= f_lo * (1.0 - 1e-12) && f <= f_hi * (1.0 + 1e-12)
+        })
     }
 
     /// The lines `keep` (ascending), every channel with its radii.
