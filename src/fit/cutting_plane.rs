@@ -9,8 +9,9 @@
 //! names the frequency where each failed candidate is worst ([`cut_frequencies`]); the round
 //! adds those frequencies to the order's grid and searches the order again, at most
 //! [`super::FitSettings::cut_rounds`] times. The grid only grows, so each round's LPs are
-//! those of the previous round with more rows, and the certificate stays the judge: a round
-//! changes where the fit looks, never what passes.
+//! those of the previous round with more rows (the rounds' A1 rows held a little further off,
+//! by [`ROUND_BACKOFF`]), and the certificate stays the judge: a round changes where the fit
+//! looks, never what passes.
 //!
 //! Only orders with no certified candidate enter a round, and the rounds work on a copy of
 //! the grid: an order that certifies in the first round, and every order of a fit without a
@@ -58,6 +59,19 @@ fn fresh(mut found: Vec<f64>, have: &[f64]) -> Vec<f64> {
     found.retain(|w| !have.iter().any(|h| (w / h - 1.0).abs() < SAME));
     found
 }
+
+/// The A1 back-off of a round's grid (`|r| ≤ (1 − b)·σ_min(M̃)` at its points), at least
+/// this, ten times the fit's default 1e-6. A round runs only where a candidate touched A1
+/// between grid points, i.e. next to a notch of `σ_min(M̃)`; there the cluster's points lie
+/// up to `h/2⁹ = 9e-5` apart at `1e-4` from a cut, over which a notch of damping ζ = 0.02
+/// (the arm's 0.3613 rad/s mode) curves `σ_min` by `(δ/ζ)²/2 ≈ 2.6e-6` (δ half the gap):
+/// more than 1e-6. Measured on the ζ = 0.01 arm's order 3 (issue 38, thirteenth step): with
+/// 1e-6 the candidate of a round overshoots A1 between points by up to 1.6e-6 (σ_min/|r| =
+/// 0.9999994, uncertified after 3 rounds) depending only on which feasible point the level
+/// LPs return (working set kept or not, row order), and certifies with margins of 1e-5 down
+/// to 7e-7 when it does; with 1e-5, every one of 25 such variants certifies orders 3 and 4,
+/// `max |r|/σ_min ≤ 0.9999915`. The cost is `|r|` lower by 1e-5 (4e-6 decade) where A1 binds.
+const ROUND_BACKOFF: f64 = 1e-5;
 
 /// Points a cut adds on each side of its frequency: at `ω·(1 ± h·2⁻ʲ)`, `j = 0..CLUSTER`,
 /// `h` the grid's step (4.7 % at 50 points per decade), down to `h/2¹³` (6e-6).
@@ -136,6 +150,11 @@ pub(crate) fn search_again(
     // The best certified fit of a round; later rounds run while a better-ranked candidate
     // failed between grid points (and the cap allows), and the best of all wins.
     let mut best: Option<(FitResult, Scored)> = None;
+    // The rounds' grid keeps A1 off by `ROUND_BACKOFF` (the first search's by the fit's own).
+    let round_set = FitSettings {
+        a1_backoff: set.a1_backoff.max(ROUND_BACKOFF),
+        ..set.clone()
+    };
     while rounds < set.cut_rounds && !next.is_empty() {
         rounds += 1;
         all.extend(&next);
@@ -154,7 +173,7 @@ pub(crate) fn search_again(
                 w: ctx.prep.w.clone(),
                 rmin: ctx.prep.rmin.clone(),
                 weights: ctx.prep.weights.clone(),
-                grid: ctx.grid_with_cuts(set, &points),
+                grid: ctx.grid_with_cuts(&round_set, &points),
                 band: ctx.prep.band,
             },
         };

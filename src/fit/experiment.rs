@@ -8,12 +8,12 @@
 //!   only the interior-point iterates (round-off, the KKT ordering) differ.  It measures
 //!   how far the fit moves with *no* change of method: the noise floor against which the
 //!   sweep's 0.002-decade rule judges a speedup.
-//! * The cheap speedups of the earlier steps (each a flag, all off in [`Switches::default`],
-//!   today's route).  [`Switches::ROUTE`] is the three that pass the sweep's rule (the working
-//!   set kept across cut rounds, refinement for the rest of a level, a budget of 30 LPs per
-//!   level); it is not the default because the cutting-plane round no longer certifies the
-//!   ζ = 0.01 arm at order 3 under it.  Their figures against the noise floor and the rule are
-//!   in `docs/internals-fit-speed.md`, eleventh and twelfth steps.
+//! * The cheap speedups of the earlier steps (each a flag).  [`Switches::ROUTE`], the
+//!   default since issue 38's thirteenth step, is the three that pass the sweep's rule (the
+//!   working set kept across cut rounds, refinement for the rest of a level, a budget of 30
+//!   LPs per level); [`Switches::BASELINE`] (all off) is the route before it, kept for
+//!   measurements (`RSHAPE_SWEEP_FAST=none`).  Their figures against the noise floor and the
+//!   rule are in `docs/internals-fit-speed.md`, eleventh to thirteenth steps.
 
 use std::sync::RwLock;
 
@@ -28,7 +28,7 @@ pub enum RowOrder {
     Seeded(u64),
 }
 
-/// The switches.  `Default` is what the fit runs.
+/// The switches.  `Default` ([`Switches::ROUTE`]) is what the fit runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Switches {
     /// Row order of every LP (a perturbation, not a speedup).
@@ -50,7 +50,8 @@ pub struct Switches {
 }
 
 impl Switches {
-    /// Today's route (main f77b84c): no speedup, rows as built.
+    /// The route before issue 38's thirteenth step (main f77b84c to 4016b19): no speedup,
+    /// rows as built.  For measurements only.
     pub const BASELINE: Self = Self {
         row_order: RowOrder::AsBuilt,
         keep_working_set: false,
@@ -59,11 +60,12 @@ impl Switches {
         previous_centre_first: false,
     };
 
-    /// The candidate route of the twelfth step, `ws,refine,k30`: the sweep's LPs −33 % against
-    /// [`Self::BASELINE`], every order within the rule of `tests/fit/fit_sweep_rule.rs`, the
-    /// reference sweep 240/240; not the default yet (the ζ = 0.01 arm's order 3 fails its
-    /// certificate after the cutting-plane round under it).  `previous_centre_first` stays
-    /// off (only 0.0001 decade inside the rule).
+    /// The default route (`ws,refine,k30`, the twelfth step's candidate, the default since the
+    /// thirteenth): the sweep's LPs −33 % against [`Self::BASELINE`], every order within the
+    /// rule of `tests/fit/fit_sweep_rule.rs`, the reference sweep 240/240.  It became the
+    /// default once the cutting-plane round kept A1 off by a larger back-off
+    /// (`fit::cutting_plane`), which certifies the ζ = 0.01 arm's order 3 under either route.
+    /// `previous_centre_first` stays off (only 0.0001 decade inside the rule).
     pub const ROUTE: Self = Self {
         row_order: RowOrder::AsBuilt,
         keep_working_set: true,
@@ -75,7 +77,7 @@ impl Switches {
 
 impl Default for Switches {
     fn default() -> Self {
-        Self::BASELINE
+        Self::ROUTE
     }
 }
 

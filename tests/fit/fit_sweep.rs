@@ -19,8 +19,8 @@
 //! here only): `RSHAPE_SWEEP_PERM=reverse` or `=seed:N` hands every LP's rows to Clarabel
 //! reversed or in a fixed seeded permutation (the same LPs: the noise floor of the rule);
 //! `RSHAPE_SWEEP_FAST=none` or a list of `ws,refine,k30,centre` sets the speedups from
-//! today's route (`none`: today's route, `Switches::BASELINE`; unset: the code's default;
-//! `ws,refine,k30` is the twelfth step's candidate, `Switches::ROUTE`);
+//! the route before them (`none`: `Switches::BASELINE`, the default to the twelfth step;
+//! unset: the code's default, `Switches::ROUTE` = `ws,refine,k30` since the thirteenth);
 //! `RSHAPE_SWEEP_OUT=FILE` writes this run's table (the reference's format) to `FILE`.
 
 #[path = "../../benches/support/random_envelopes.rs"]
