@@ -114,12 +114,7 @@ impl<'a> CertInput<'a> {
         a1: Option<&'a dyn Fn(f64) -> f64>,
         set: &'a super::FitSettings,
     ) -> Self {
-        let min_pos = env
-            .r_min
-            .iter()
-            .copied()
-            .filter(|r| *r > 0.0)
-            .fold(f64::INFINITY, f64::min);
+        let min_pos = min_positive(&env.r_min);
         Self {
             omega: &env.omega,
             r_min: &env.r_min,
@@ -135,6 +130,16 @@ impl<'a> CertInput<'a> {
             axis_tol: set.axis_tol,
         }
     }
+}
+
+/// The smallest positive `r_min` (`∞` when there is none): the scale of the fit's floor
+/// `floor_rel × min r_min`.
+pub(crate) fn min_positive(r_min: &[f64]) -> f64 {
+    r_min
+        .iter()
+        .copied()
+        .filter(|r| *r > 0.0)
+        .fold(f64::INFINITY, f64::min)
 }
 
 fn golden_min(f: &dyn Fn(f64) -> f64, a: f64, b: f64, iters: usize) -> (f64, f64) {

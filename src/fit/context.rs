@@ -80,12 +80,7 @@ pub(crate) fn prepare<'a>(
     if !beyond.is_empty() {
         return Err(FitError::BeyondA1(beyond));
     }
-    let min_pos = env
-        .r_min
-        .iter()
-        .copied()
-        .filter(|r| *r > 0.0)
-        .fold(f64::INFINITY, f64::min);
+    let min_pos = certificate::min_positive(&env.r_min);
     if !min_pos.is_finite() {
         return Err(FitError::Invalid(
             "every r_min is 0: the data are explained within the noise and need no bound; nothing to fit"
